@@ -1,0 +1,251 @@
+within GearTwin;
+model Gearbox21 "21-DOF lumped model of the UNSW spur-gear test rig (Feng et al., Fig. 3, Tables A1-A2)"
+  // Torsional chain (9 DOF): motor 1 - torque meter 2 - input coupling 3 - pinion 5 - slip ring 7,
+  // slip ring 8 - gear 10 - output coupling 12 - brake 13. Angles of the gear side are counted
+  // positive in the driven direction, so the mesh kinematics read rb1*theta5 = rb2*theta10.
+  // Lateral (12 DOF): pedestals 4, 6 (input shaft), pinion 5, pedestals 9, 11 (output shaft), gear 10.
+
+  // ---- Gear geometry -------------------------------------------------------------------------
+  parameter Integer z1 = 19 "Number of pinion teeth (structural: sizes the per-tooth arrays)";
+  parameter Real z2 = 52 "Number of gear teeth";
+  parameter Real module(unit = "m") = 3.0e-3 "Normal module";
+  parameter Real alpha(unit = "rad") = 20 * GearTwin.pi / 180 "Pressure angle";
+  parameter Real face_width(unit = "m") = 0.020 "Face width (stated assumption)";
+  parameter Real addendum_coefficient = 1.0 "Addendum as a multiple of the module";
+  parameter Real rb1(unit = "m") = 0.5 * module * z1 * cos(alpha) "Pinion base radius";
+  parameter Real rb2(unit = "m") = 0.5 * module * z2 * cos(alpha) "Gear base radius";
+  parameter Real contact_ratio = (sqrt((0.5 * module * z1 + addendum_coefficient * module) ^ 2 - rb1 ^ 2) + sqrt((0.5 * module * z2 + addendum_coefficient * module) ^ 2 - rb2 ^ 2) - 0.5 * module * (z1 + z2) * sin(alpha)) / (GearTwin.pi * module * cos(alpha)) "Transverse contact ratio";
+
+  // ---- Mesh stiffness and profile (tunable; the degradation models write these) -------------
+  parameter Integer n_profile = 11 "Number of nodes along the path of contact (structural)";
+  parameter Real k_pair[n_profile](each unit = "N/m") = {1.650e8, 2.136e8, 2.514e8, 2.784e8, 2.946e8, 3.000e8, 2.946e8, 2.784e8, 2.514e8, 2.136e8, 1.650e8} "Single-tooth-pair stiffness at equally spaced roll positions from start (root of pinion) to end (tip of pinion) of the path of contact";
+  parameter Real profile_deviation[n_profile](each unit = "m") = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0} "Material missing from the pinion flank (wear depth, relief) at the same nodes, common to all teeth";
+  parameter Real tooth_stiffness_factor[z1] = {1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1} "Per-pinion-tooth multiplier of the pair stiffness (crack, spall, pitting of one tooth)";
+  parameter Real tooth_deviation_offset[z1](each unit = "m") = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0} "Per-pinion-tooth extra material loss, added to profile_deviation";
+  parameter Real mesh_stiffness_scale = 1.0 "Calibration multiplier of all pair stiffnesses";
+  parameter Real c_mesh(unit = "N.s/m") = 1.1e3 "Mesh damping along the line of action";
+  parameter Real mesh_phase0(unit = "rad") = 0.0 "Mesh phase at theta5 = 0";
+  parameter Real contact_smoothing = 0.01 "Half-width of the entry/exit ramp of a tooth pair, as a fraction of the path of contact";
+
+  // ---- Inertias and masses (Table A1; values are stated assumptions) -------------------------
+  parameter Real I1(unit = "kg.m2") = 4.3e-3 "Motor, motor shaft, 1/2 coupling 1";
+  parameter Real I2(unit = "kg.m2") = 4.0e-4 "1/2 coupling 1, 1/2 coupling 2, torque-meter shaft";
+  parameter Real I3(unit = "kg.m2") = 3.0e-4 "1/2 coupling 2, input shaft to bearing";
+  parameter Real I5(unit = "kg.m2") = 2.5e-4 "Pinion and input shaft through casing";
+  parameter Real I7(unit = "kg.m2") = 5.0e-4 "Slip ring rotor, adapter, coupling 3, free shaft end (input)";
+  parameter Real I8(unit = "kg.m2") = 5.0e-4 "Slip ring rotor, adapter, coupling 5, free shaft end (output)";
+  parameter Real I10(unit = "kg.m2") = 9.5e-3 "Gear and output shaft through casing";
+  parameter Real I12(unit = "kg.m2") = 5.0e-4 "1/2 coupling 4, output shaft to bearing";
+  parameter Real I13(unit = "kg.m2") = 2.0e-2 "Brake, brake shaft, 1/2 coupling 4";
+  parameter Real m4(unit = "kg") = 2.0 "Pedestal and bearing 4 (input shaft, motor side)";
+  parameter Real m5(unit = "kg") = 0.6 "Pinion";
+  parameter Real m6(unit = "kg") = 2.0 "Pedestal and bearing 6 (input shaft, free end)";
+  parameter Real m9(unit = "kg") = 2.0 "Pedestal and bearing 9 (output shaft, free end)";
+  parameter Real m10(unit = "kg") = 3.5 "Gear";
+  parameter Real m11(unit = "kg") = 2.0 "Pedestal and bearing 11 (output shaft, brake side)";
+
+  // ---- Stiffness and damping (Table A2; values are stated assumptions) -----------------------
+  parameter Real kt12(unit = "N.m/rad") = 1.5e3 "Coupling 1";
+  parameter Real kt23(unit = "N.m/rad") = 2.0e3 "Coupling 2";
+  parameter Real kt35(unit = "N.m/rad") = 1.5e4 "Input shaft, coupling 2 to pinion";
+  parameter Real kt57(unit = "N.m/rad") = 1.5e4 "Input shaft, pinion to slip ring";
+  parameter Real kt810(unit = "N.m/rad") = 2.0e4 "Output shaft, slip ring to gear";
+  parameter Real kt1012(unit = "N.m/rad") = 2.0e4 "Output shaft, gear to coupling 4";
+  parameter Real kt1213(unit = "N.m/rad") = 1.5e3 "Coupling 4";
+  parameter Real ct12(unit = "N.m.s/rad") = 0.10 "Coupling 1";
+  parameter Real ct23(unit = "N.m.s/rad") = 0.10 "Coupling 2";
+  parameter Real ct35(unit = "N.m.s/rad") = 0.08 "Input shaft, coupling 2 to pinion";
+  parameter Real ct57(unit = "N.m.s/rad") = 0.08 "Input shaft, pinion to slip ring";
+  parameter Real ct810(unit = "N.m.s/rad") = 0.10 "Output shaft, slip ring to gear";
+  parameter Real ct1012(unit = "N.m.s/rad") = 0.10 "Output shaft, gear to coupling 4";
+  parameter Real ct1213(unit = "N.m.s/rad") = 0.10 "Coupling 4";
+  parameter Real kx45(unit = "N/m") = 1.0e8 "Input shaft and bearing between 4 and 5, horizontal";
+  parameter Real ky45(unit = "N/m") = 1.0e8 "Input shaft and bearing between 4 and 5, vertical";
+  parameter Real kx56(unit = "N/m") = 1.0e8 "Input shaft and bearing between 5 and 6, horizontal";
+  parameter Real ky56(unit = "N/m") = 1.0e8 "Input shaft and bearing between 5 and 6, vertical";
+  parameter Real kx910(unit = "N/m") = 1.5e8 "Output shaft and bearing between 9 and 10, horizontal";
+  parameter Real ky910(unit = "N/m") = 1.5e8 "Output shaft and bearing between 9 and 10, vertical";
+  parameter Real kx1011(unit = "N/m") = 1.5e8 "Output shaft and bearing between 10 and 11, horizontal";
+  parameter Real ky1011(unit = "N/m") = 1.5e8 "Output shaft and bearing between 10 and 11, vertical";
+  parameter Real cx45(unit = "N.s/m") = 400 "Damping 4-5, horizontal";
+  parameter Real cy45(unit = "N.s/m") = 400 "Damping 4-5, vertical";
+  parameter Real cx56(unit = "N.s/m") = 400 "Damping 5-6, horizontal";
+  parameter Real cy56(unit = "N.s/m") = 400 "Damping 5-6, vertical";
+  parameter Real cx910(unit = "N.s/m") = 500 "Damping 9-10, horizontal";
+  parameter Real cy910(unit = "N.s/m") = 500 "Damping 9-10, vertical";
+  parameter Real cx1011(unit = "N.s/m") = 500 "Damping 10-11, horizontal";
+  parameter Real cy1011(unit = "N.s/m") = 500 "Damping 10-11, vertical";
+  parameter Real kx4(unit = "N/m") = 3.0e7 "Pedestal 4 to ground, horizontal (not in Table A2; needed to remove the free mode)";
+  parameter Real ky4(unit = "N/m") = 5.0e7 "Pedestal 4 to ground, vertical";
+  parameter Real kx6(unit = "N/m") = 3.0e7 "Pedestal 6 to ground, horizontal";
+  parameter Real ky6(unit = "N/m") = 5.0e7 "Pedestal 6 to ground, vertical";
+  parameter Real kx9(unit = "N/m") = 3.0e7 "Pedestal 9 to ground, horizontal";
+  parameter Real ky9(unit = "N/m") = 5.0e7 "Pedestal 9 to ground, vertical";
+  parameter Real kx11(unit = "N/m") = 3.0e7 "Pedestal 11 to ground, horizontal";
+  parameter Real ky11(unit = "N/m") = 5.0e7 "Pedestal 11 to ground, vertical";
+  parameter Real cx4(unit = "N.s/m") = 400 "Pedestal 4 damping, horizontal";
+  parameter Real cy4(unit = "N.s/m") = 400 "Pedestal 4 damping, vertical";
+  parameter Real cx6(unit = "N.s/m") = 400 "Pedestal 6 damping, horizontal";
+  parameter Real cy6(unit = "N.s/m") = 400 "Pedestal 6 damping, vertical";
+  parameter Real cx9(unit = "N.s/m") = 400 "Pedestal 9 damping, horizontal";
+  parameter Real cy9(unit = "N.s/m") = 400 "Pedestal 9 damping, vertical";
+  parameter Real cx11(unit = "N.s/m") = 400 "Pedestal 11 damping, horizontal";
+  parameter Real cy11(unit = "N.s/m") = 400 "Pedestal 11 damping, vertical";
+
+  // ---- Drive, load and sensors ---------------------------------------------------------------
+  parameter Real c_motor(unit = "N.m.s/rad") = 3.0 "Slope of the induction motor torque-slip line (VFD speed control)";
+  parameter Real sensor_angle_pinion(unit = "rad") = 0.0 "Axis of the B&K 4396 accelerometer (0 = vertical, pi/2 = horizontal)";
+  parameter Real sensor_angle_gear(unit = "rad") = 0.0 "Axis of the B&K 4394 accelerometer (0 = vertical, pi/2 = horizontal)";
+  parameter Real speed_ref_start(unit = "rad/s") = 2 * GearTwin.pi * 20 "Commanded motor speed assumed for the steady start";
+  parameter Real load_start(unit = "N.m") = 20.0 "Brake torque used for the static pre-load at t = 0";
+
+  input Real motor_speed_ref(unit = "rad/s", start = 2 * GearTwin.pi * 20) "Synchronous speed commanded by the drive";
+  input Real drive_torque(unit = "N.m", start = 0.0) "Extra motor torque added to the slip torque";
+  input Real load_torque(unit = "N.m", start = 20.0) "Brake torque on the output shaft";
+
+  // Static pre-load so a run starts near steady running: torque transmitted by each shaft.
+  parameter Real torque_out(unit = "N.m") = load_start "Static torque in the output chain";
+  parameter Real torque_in(unit = "N.m") = load_start * rb1 / rb2 "Static torque in the input chain";
+  parameter Real mesh_force_static(unit = "N") = torque_in / rb1 "Static mesh force";
+  parameter Real speed_start(unit = "rad/s") = speed_ref_start - torque_in / c_motor "Motor speed at t = 0 (steady slip under the static load)";
+  parameter Real k_mesh_mean(unit = "N/m") = mesh_stiffness_scale * contact_ratio * sum(k_pair) / n_profile "Approximate mean mesh stiffness";
+
+  // ---- States ----------------------------------------------------------------------------------
+  Real theta1(unit = "rad", start = 0.0, fixed = true);
+  Real theta2(unit = "rad", start = -torque_in / kt12, fixed = true);
+  Real theta3(unit = "rad", start = -torque_in / kt12 - torque_in / kt23, fixed = true);
+  Real theta5(unit = "rad", start = -torque_in / kt12 - torque_in / kt23 - torque_in / kt35, fixed = true);
+  Real theta7(unit = "rad", start = -torque_in / kt12 - torque_in / kt23 - torque_in / kt35, fixed = true);
+  Real theta10(unit = "rad", start = (rb1 * (-torque_in / kt12 - torque_in / kt23 - torque_in / kt35) - mesh_force_static / k_mesh_mean) / rb2, fixed = true);
+  Real theta8(unit = "rad", start = (rb1 * (-torque_in / kt12 - torque_in / kt23 - torque_in / kt35) - mesh_force_static / k_mesh_mean) / rb2, fixed = true);
+  Real theta12(unit = "rad", start = (rb1 * (-torque_in / kt12 - torque_in / kt23 - torque_in / kt35) - mesh_force_static / k_mesh_mean) / rb2 - torque_out / kt1012, fixed = true);
+  Real theta13(unit = "rad", start = (rb1 * (-torque_in / kt12 - torque_in / kt23 - torque_in / kt35) - mesh_force_static / k_mesh_mean) / rb2 - torque_out / kt1012 - torque_out / kt1213, fixed = true);
+  Real omega1(unit = "rad/s", start = speed_start, fixed = true);
+  Real omega2(unit = "rad/s", start = speed_start, fixed = true);
+  Real omega3(unit = "rad/s", start = speed_start, fixed = true);
+  Real omega5(unit = "rad/s", start = speed_start, fixed = true);
+  Real omega7(unit = "rad/s", start = speed_start, fixed = true);
+  Real omega8(unit = "rad/s", start = speed_start * rb1 / rb2, fixed = true);
+  Real omega10(unit = "rad/s", start = speed_start * rb1 / rb2, fixed = true);
+  Real omega12(unit = "rad/s", start = speed_start * rb1 / rb2, fixed = true);
+  Real omega13(unit = "rad/s", start = speed_start * rb1 / rb2, fixed = true);
+  Real x4(unit = "m", start = 0.0, fixed = true);
+  Real y4(unit = "m", start = 0.0, fixed = true);
+  Real x5(unit = "m", start = 0.0, fixed = true);
+  Real y5(unit = "m", start = 0.0, fixed = true);
+  Real x6(unit = "m", start = 0.0, fixed = true);
+  Real y6(unit = "m", start = 0.0, fixed = true);
+  Real x9(unit = "m", start = 0.0, fixed = true);
+  Real y9(unit = "m", start = 0.0, fixed = true);
+  Real x10(unit = "m", start = 0.0, fixed = true);
+  Real y10(unit = "m", start = 0.0, fixed = true);
+  Real x11(unit = "m", start = 0.0, fixed = true);
+  Real y11(unit = "m", start = 0.0, fixed = true);
+  Real vx4(unit = "m/s", start = 0.0, fixed = true);
+  Real vy4(unit = "m/s", start = 0.0, fixed = true);
+  Real vx5(unit = "m/s", start = 0.0, fixed = true);
+  Real vy5(unit = "m/s", start = 0.0, fixed = true);
+  Real vx6(unit = "m/s", start = 0.0, fixed = true);
+  Real vy6(unit = "m/s", start = 0.0, fixed = true);
+  Real vx9(unit = "m/s", start = 0.0, fixed = true);
+  Real vy9(unit = "m/s", start = 0.0, fixed = true);
+  Real vx10(unit = "m/s", start = 0.0, fixed = true);
+  Real vy10(unit = "m/s", start = 0.0, fixed = true);
+  Real vx11(unit = "m/s", start = 0.0, fixed = true);
+  Real vy11(unit = "m/s", start = 0.0, fixed = true);
+
+  // ---- Mesh kinematics -------------------------------------------------------------------------
+  Real mesh_angle(unit = "rad") "Mesh phase: z1 * theta5 + mesh_phase0";
+  Real cycle_fraction "Position within the current mesh cycle, (0, 1]";
+  Real tooth_angle(unit = "rad") "Angle 2*pi*k/z1 of the pinion tooth that entered contact last (k = completed mesh cycles)";
+  Real roll[3] "Roll position along the path of contact (0 = start, 1 = end) of the pairs leading, current and next";
+  Real window[3] "Share of each pair in contact (smooth 0-1 gate over [0, 1])";
+  Real tooth_cos[3] "cos of the angle of the pinion tooth in each pair";
+  Real tooth_sin[3] "sin of the angle of the pinion tooth in each pair";
+  Real pair_stiffness[3](each unit = "N/m") "Stiffness of each tooth pair";
+  Real pair_deviation[3](each unit = "m") "Profile deviation at the contact point of each pair";
+  Real pair_force[3](each unit = "N") "Elastic force carried by each pair";
+  Real mesh_deflection(unit = "m") "Approach of the flanks along the line of action";
+  Real mesh_deflection_rate(unit = "m/s") "Time derivative of mesh_deflection";
+  output Real mesh_force(unit = "N") "Dynamic mesh force along the line of action";
+  output Real mesh_stiffness(unit = "N/m") "Instantaneous mesh stiffness (sum over pairs in contact)";
+  output Real accel_pinion_casing(unit = "m/s2") "Casing acceleration at the B&K 4396 (near the pinion)";
+  output Real accel_gear_casing(unit = "m/s2") "Casing acceleration at the B&K 4394 (near the gear)";
+  output Real encoder_pinion_angle(unit = "rad") = theta7 "Input-shaft encoder angle (free end)";
+  output Real encoder_gear_angle(unit = "rad") = theta8 "Output-shaft encoder angle (free end)";
+  output Real transmission_error(unit = "m") "rb1*theta5 - rb2*theta10 along the line of action";
+  output Real motor_speed(unit = "rad/s") = omega1 "Motor speed";
+  output Real motor_torque(unit = "N.m") "Torque delivered by the motor";
+equation
+  // Tooth-pair bookkeeping without events: the mesh phase is wrapped with atan2, the tooth
+  // identity is read from the angle of the last entered tooth on the unit circle.
+  mesh_angle = z1 * theta5 + mesh_phase0;
+  cycle_fraction = atan2(sin(mesh_angle - GearTwin.pi), cos(mesh_angle - GearTwin.pi)) / (2 * GearTwin.pi) + 0.5;
+  tooth_angle = (mesh_angle - 2 * GearTwin.pi * cycle_fraction) / z1;
+  roll = {(cycle_fraction + 1) / contact_ratio, cycle_fraction / contact_ratio, (cycle_fraction - 1) / contact_ratio};
+  window = {noEvent(min(1.0, max(0.0, (roll[i] + contact_smoothing) / (2 * contact_smoothing)))) ^ 2 * (3 - 2 * noEvent(min(1.0, max(0.0, (roll[i] + contact_smoothing) / (2 * contact_smoothing))))) * noEvent(min(1.0, max(0.0, (1 - roll[i] + contact_smoothing) / (2 * contact_smoothing)))) ^ 2 * (3 - 2 * noEvent(min(1.0, max(0.0, (1 - roll[i] + contact_smoothing) / (2 * contact_smoothing))))) for i in 1:3};
+  tooth_cos = {cos(tooth_angle - 2 * GearTwin.pi / z1), cos(tooth_angle), cos(tooth_angle + 2 * GearTwin.pi / z1)};
+  tooth_sin = {sin(tooth_angle - 2 * GearTwin.pi / z1), sin(tooth_angle), sin(tooth_angle + 2 * GearTwin.pi / z1)};
+  // Piecewise-linear interpolation along the profile (hat functions on n_profile nodes) and
+  // nearest-tooth selection on the unit circle (hat of radius half a chord around each tooth).
+  pair_stiffness = {mesh_stiffness_scale * window[i] * sum(k_pair[n] * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[i]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile) * sum(tooth_stiffness_factor[j] * noEvent(max(0.0, 1 - ((tooth_cos[i] - cos(2 * GearTwin.pi * (j - 1) / z1)) ^ 2 + (tooth_sin[i] - sin(2 * GearTwin.pi * (j - 1) / z1)) ^ 2) / sin(GearTwin.pi / z1) ^ 2)) for j in 1:z1) for i in 1:3};
+  pair_deviation = {sum(profile_deviation[n] * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[i]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile) + sum(tooth_deviation_offset[j] * noEvent(max(0.0, 1 - ((tooth_cos[i] - cos(2 * GearTwin.pi * (j - 1) / z1)) ^ 2 + (tooth_sin[i] - sin(2 * GearTwin.pi * (j - 1) / z1)) ^ 2) / sin(GearTwin.pi / z1) ^ 2)) for j in 1:z1) for i in 1:3};
+  mesh_deflection = rb1 * theta5 - rb2 * theta10 + (x5 - x10) * sin(alpha) + (y5 - y10) * cos(alpha);
+  mesh_deflection_rate = rb1 * omega5 - rb2 * omega10 + (vx5 - vx10) * sin(alpha) + (vy5 - vy10) * cos(alpha);
+  // A pair whose flanks are apart (deviation larger than the approach) carries no load.
+  pair_force = {pair_stiffness[i] * noEvent(max(0.0, mesh_deflection - pair_deviation[i])) for i in 1:3};
+  mesh_force = pair_force[1] + pair_force[2] + pair_force[3] + c_mesh * mesh_deflection_rate;
+  mesh_stiffness = pair_stiffness[1] + pair_stiffness[2] + pair_stiffness[3];
+  transmission_error = rb1 * theta5 - rb2 * theta10;
+  motor_torque = drive_torque + c_motor * (motor_speed_ref - omega1);
+
+  // ---- Torsional equations ------------------------------------------------------------------
+  der(theta1) = omega1;
+  der(theta2) = omega2;
+  der(theta3) = omega3;
+  der(theta5) = omega5;
+  der(theta7) = omega7;
+  der(theta8) = omega8;
+  der(theta10) = omega10;
+  der(theta12) = omega12;
+  der(theta13) = omega13;
+  I1 * der(omega1) = motor_torque - kt12 * (theta1 - theta2) - ct12 * (omega1 - omega2);
+  I2 * der(omega2) = kt12 * (theta1 - theta2) + ct12 * (omega1 - omega2) - kt23 * (theta2 - theta3) - ct23 * (omega2 - omega3);
+  I3 * der(omega3) = kt23 * (theta2 - theta3) + ct23 * (omega2 - omega3) - kt35 * (theta3 - theta5) - ct35 * (omega3 - omega5);
+  I5 * der(omega5) = kt35 * (theta3 - theta5) + ct35 * (omega3 - omega5) - kt57 * (theta5 - theta7) - ct57 * (omega5 - omega7) - rb1 * mesh_force;
+  I7 * der(omega7) = kt57 * (theta5 - theta7) + ct57 * (omega5 - omega7);
+  I8 * der(omega8) = kt810 * (theta10 - theta8) + ct810 * (omega10 - omega8);
+  I10 * der(omega10) = rb2 * mesh_force - kt810 * (theta10 - theta8) - ct810 * (omega10 - omega8) - kt1012 * (theta10 - theta12) - ct1012 * (omega10 - omega12);
+  I12 * der(omega12) = kt1012 * (theta10 - theta12) + ct1012 * (omega10 - omega12) - kt1213 * (theta12 - theta13) - ct1213 * (omega12 - omega13);
+  I13 * der(omega13) = kt1213 * (theta12 - theta13) + ct1213 * (omega12 - omega13) - load_torque;
+
+  // ---- Lateral equations --------------------------------------------------------------------
+  der(x4) = vx4;
+  der(y4) = vy4;
+  der(x5) = vx5;
+  der(y5) = vy5;
+  der(x6) = vx6;
+  der(y6) = vy6;
+  der(x9) = vx9;
+  der(y9) = vy9;
+  der(x10) = vx10;
+  der(y10) = vy10;
+  der(x11) = vx11;
+  der(y11) = vy11;
+  m4 * der(vx4) = -kx4 * x4 - cx4 * vx4 + kx45 * (x5 - x4) + cx45 * (vx5 - vx4);
+  m4 * der(vy4) = -ky4 * y4 - cy4 * vy4 + ky45 * (y5 - y4) + cy45 * (vy5 - vy4);
+  m5 * der(vx5) = -kx45 * (x5 - x4) - cx45 * (vx5 - vx4) - kx56 * (x5 - x6) - cx56 * (vx5 - vx6) - mesh_force * sin(alpha);
+  m5 * der(vy5) = -ky45 * (y5 - y4) - cy45 * (vy5 - vy4) - ky56 * (y5 - y6) - cy56 * (vy5 - vy6) - mesh_force * cos(alpha);
+  m6 * der(vx6) = -kx6 * x6 - cx6 * vx6 + kx56 * (x5 - x6) + cx56 * (vx5 - vx6);
+  m6 * der(vy6) = -ky6 * y6 - cy6 * vy6 + ky56 * (y5 - y6) + cy56 * (vy5 - vy6);
+  m9 * der(vx9) = -kx9 * x9 - cx9 * vx9 + kx910 * (x10 - x9) + cx910 * (vx10 - vx9);
+  m9 * der(vy9) = -ky9 * y9 - cy9 * vy9 + ky910 * (y10 - y9) + cy910 * (vy10 - vy9);
+  m10 * der(vx10) = -kx910 * (x10 - x9) - cx910 * (vx10 - vx9) - kx1011 * (x10 - x11) - cx1011 * (vx10 - vx11) + mesh_force * sin(alpha);
+  m10 * der(vy10) = -ky910 * (y10 - y9) - cy910 * (vy10 - vy9) - ky1011 * (y10 - y11) - cy1011 * (vy10 - vy11) + mesh_force * cos(alpha);
+  m11 * der(vx11) = -kx11 * x11 - cx11 * vx11 + kx1011 * (x10 - x11) + cx1011 * (vx10 - vx11);
+  m11 * der(vy11) = -ky11 * y11 - cy11 * vy11 + ky1011 * (y10 - y11) + cy1011 * (vy10 - vy11);
+
+  // ---- Sensors ------------------------------------------------------------------------------
+  accel_pinion_casing = cos(sensor_angle_pinion) * der(vy6) + sin(sensor_angle_pinion) * der(vx6);
+  accel_gear_casing = cos(sensor_angle_gear) * der(vy9) + sin(sensor_angle_gear) * der(vx9);
+end Gearbox21;

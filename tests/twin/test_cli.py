@@ -1,0 +1,134 @@
+"""The twin CLI shell, with the library modules replaced by fakes (no FMU needed)."""
+from __future__ import annotations
+
+import subprocess
+import sys
+import types
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import fmu_build
+from twin.cli import main, parse_assignments
+from twin.errors import ParameterError, SimulationError
+from twin.results import SimulationResult, read_hdf5
+
+
+@pytest.fixture
+def fake_fmu(monkeypatch):
+    """Install a fake ``twin.fmu`` module; returns the list of simulate_fmu calls."""
+    calls: list[tuple[tuple, dict]] = []
+
+    def simulate_fmu(path, **kwargs):
+        calls.append(((path,), kwargs))
+        t = np.arange(11) * kwargs["output_interval"]
+        return SimulationResult(time=t, signals={"a": np.cos(t)}, units={"a": "m/s2"},
+                                sample_rate=1.0 / kwargs["output_interval"],
+                                parameters=kwargs["parameters"])
+
+    module = types.ModuleType("twin.fmu")
+    module.simulate_fmu = simulate_fmu
+    module.describe = lambda path: f"FMU {path.name}: fake"
+    monkeypatch.setitem(sys.modules, "twin.fmu", module)
+    return calls
+
+
+def test_help(capsys):
+    assert main(["--help"]) == 0
+    out = capsys.readouterr().out
+    for command in ("build", "info", "simulate", "demo"):
+        assert command in out
+
+
+def test_help_subprocess_is_lazy():
+    code = "import sys, twin.cli; sys.exit(twin.cli.main(['--help']) or ('numpy' in sys.modules))"
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert "usage: twin" in done.stdout
+
+
+def test_usage_error_exit_code(capsys):
+    assert main(["simulate", "x.fmu"]) == 2  # --stop-time missing
+    assert "--stop-time" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("token", ["k_mesh", "=3", "k_mesh=abc", "k mesh=1", "k=nan", "k="])
+def test_bad_param_token(tmp_path, capsys, fake_fmu, token):
+    code = main(["simulate", "m.fmu", "--stop-time", "1", "--output", str(tmp_path / "r.h5"),
+                 "--param", "ok=1", "--param", token])
+    assert code == 2
+    err = capsys.readouterr().err
+    assert err.startswith("twin: error: ") and f"'{token}'" in err
+    assert fake_fmu == []  # rejected before simulating
+
+
+def test_bad_input_token(tmp_path, capsys, fake_fmu):
+    assert main(["simulate", "m.fmu", "--stop-time", "1", "--input", "torque:5"]) == 2
+    assert "--input 'torque:5'" in capsys.readouterr().err
+
+
+def test_parse_assignments_duplicate():
+    assert parse_assignments(["a=1", "b=-2.5e3"], "--param") == {"a": 1.0, "b": -2500.0}
+    with pytest.raises(ParameterError, match="'a=2'"):
+        parse_assignments(["a=1", "a=2"], "--param")
+
+
+def test_simulate_writes_result(tmp_path, capsys, fake_fmu):
+    out = tmp_path / "r.h5"
+    code = main(["simulate", "m.fmu", "--stop-time", "0.5", "--output-interval", "0.01",
+                 "--output", str(out), "--outputs", "a, b", "--param", "k=2e8",
+                 "--input", "torque=10", "--no-progress"])
+    assert code == 0
+    (path,), kwargs = fake_fmu[0]
+    assert path.name == "m.fmu"
+    assert kwargs == {"stop_time": 0.5, "start_time": 0.0, "output_interval": 0.01,
+                      "outputs": ["a", "b"], "parameters": {"k": 2e8},
+                      "inputs": {"torque": 10.0}, "progress": False}
+    assert read_hdf5(out).parameters == {"k": 2e8}
+    assert f"wrote {out}: 11 samples x 1 channels" in capsys.readouterr().out
+
+
+def test_simulate_bad_output_fails_before_running(tmp_path, capsys, fake_fmu):
+    assert main(["simulate", "m.fmu", "--stop-time", "1", "--output", str(tmp_path / "r.mat")]) == 2
+    assert "'.mat'" in capsys.readouterr().err and fake_fmu == []
+
+
+def test_twin_error_is_reported(monkeypatch, capsys, fake_fmu, tmp_path):
+    def boom(path, **kwargs):
+        raise SimulationError("doStep failed", time=0.25, status="fmi2Error")
+
+    monkeypatch.setattr(sys.modules["twin.fmu"], "simulate_fmu", boom)
+    assert main(["simulate", "m.fmu", "--stop-time", "1", "--output", str(tmp_path / "r.h5")]) == 2
+    assert capsys.readouterr().err.strip() == \
+        "twin: error: doStep failed at t=0.25 s (status fmi2Error)"
+
+
+def test_info_prints_mode_table(monkeypatch, capsys, fake_fmu):
+    module = types.ModuleType("twin.linearize")
+    module.natural_frequencies = lambda path, n: np.array([22.0, 88.74])
+    monkeypatch.setitem(sys.modules, "twin.linearize", module)
+    assert main(["info", "m.fmu"]) == 0
+    out = capsys.readouterr().out
+    assert "FMU m.fmu: fake" in out
+    assert "+2.0" in out and "1927" in out  # 88.74 vs 87 Hz; mode 8 listed without model value
+
+
+def test_info_no_modes_skips_linearize(monkeypatch, capsys, fake_fmu):
+    monkeypatch.setitem(sys.modules, "twin.linearize", None)  # importing it would fail
+    assert main(["info", "m.fmu", "--no-modes"]) == 0
+    assert capsys.readouterr().out.strip() == "FMU m.fmu: fake"
+
+
+def test_build_defaults(monkeypatch, capsys, tmp_path):
+    calls = []
+
+    def build_fmu(model, modelica_dir, out_dir, *, step_size, force):
+        calls.append((model, modelica_dir, out_dir, step_size, force))
+        return out_dir / f"{model}.fmu"
+
+    monkeypatch.setattr(fmu_build, "build_fmu", build_fmu, raising=False)
+    assert main(["build", "--out", str(tmp_path)]) == 0
+    assert calls == [("GearTwin.Gearbox21", Path("modelica"), tmp_path,
+                      5e-6, False)]
+    assert capsys.readouterr().out.strip() == str(tmp_path / "GearTwin.Gearbox21.fmu")

@@ -1,0 +1,94 @@
+"""Atomic file replacement shared by every writer in the twin.
+
+A reader (or a crashed run) must never see a half-written result, plot or FMU,
+and a failed write must leave an existing file untouched. Writers therefore
+produce a temporary sibling file and rename it over the target only once it is
+complete and on disk.
+"""
+from __future__ import annotations
+
+import contextlib
+import os
+import stat
+import tempfile
+from collections.abc import Iterator
+from pathlib import Path
+
+from twin.errors import OutputPathError
+
+
+def check_parent(path: str | os.PathLike[str]) -> Path:
+    """Return ``path`` as a :class:`Path` after checking it can be written.
+
+    Raises
+    ------
+    OutputPathError
+        If the parent directory does not exist (it is never created silently,
+        so a typo in a directory name is reported instead of hidden) or if the
+        path itself is an existing directory.
+    """
+    target = Path(path)
+    parent = target.parent
+    if not parent.is_dir():
+        raise OutputPathError(f"output directory '{parent}' does not exist (for '{target}')")
+    if target.is_dir():
+        raise OutputPathError(f"output path '{target}' is a directory")
+    return target
+
+
+def _final_mode(target: Path) -> int:
+    """Permission bits the finished file should get.
+
+    ``NamedTemporaryFile`` creates files as 0600; keep the mode of a file being
+    replaced, otherwise use what a plain ``open()`` would give under the umask.
+    """
+    try:
+        return stat.S_IMODE(target.stat().st_mode)
+    except FileNotFoundError:
+        umask = os.umask(0)
+        os.umask(umask)
+        return 0o666 & ~umask
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
+    """Yield a temporary path in the target's directory; move it over ``path`` on success.
+
+    The body writes the complete file to the yielded path (by name, e.g. with
+    ``h5py.File(tmp, "w")`` or ``fig.savefig(tmp)``) and closes it. On normal
+    exit the data are fsync'ed and the file is renamed onto ``path`` with
+    :func:`os.replace`, which is atomic within one file system (hence the
+    temporary file lives in the same directory). If the body raises, the
+    temporary file is removed, ``path`` is left as it was and the exception
+    propagates.
+
+    Raises
+    ------
+    OutputPathError
+        If the parent directory of ``path`` is missing or ``path`` is a directory.
+    """
+    target = check_parent(path)
+    with tempfile.NamedTemporaryFile(
+        delete=False, dir=target.parent, prefix=f".{target.name}.", suffix=".tmp"
+    ) as handle:
+        tmp = Path(handle.name)
+    try:
+        yield tmp
+        fd = os.open(tmp, os.O_RDWR)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+        os.chmod(tmp, _final_mode(target))
+        os.replace(tmp, target)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            tmp.unlink()
+        raise
+    # Persist the rename itself; not every platform lets a directory be opened.
+    with contextlib.suppress(OSError):
+        dir_fd = os.open(target.parent, os.O_RDONLY)
+        try:
+            os.fsync(dir_fd)
+        finally:
+            os.close(dir_fd)

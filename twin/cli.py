@@ -1,0 +1,172 @@
+"""Command-line shell ``twin``: build, inspect, simulate, demo.
+
+The CLI only parses arguments and prints; all work lives in the library.
+Library modules are imported inside each handler so ``twin --help`` does not
+pay for numpy, fmpy or torch.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import math
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+from types import ModuleType
+
+from twin.errors import ParameterError, TwinError
+
+DEFAULT_MODEL = "GearTwin.Gearbox21"
+#: Measured natural frequencies [Hz] of the test rig (paper, Table 2).
+MEASURED_MODES_HZ = (22.0, 87.0, 218.0, 430.0, 512.0, 767.0, 1248.0, 1927.0)
+
+
+def _lib(name: str) -> ModuleType:
+    # Resolved through sys.modules at call time, so tests can substitute a module.
+    return importlib.import_module(name)
+
+
+def parse_assignments(tokens: Sequence[str] | None, option: str) -> dict[str, float]:
+    """Parse ``NAME=VALUE`` tokens into ``{name: float}``.
+
+    Raises
+    ------
+    ParameterError
+        Missing ``=``, empty or blank-containing name, a value that is not a
+        finite float, or a name given twice; the message names the token.
+    """
+    out: dict[str, float] = {}
+    for token in tokens or ():
+        name, sep, text = token.partition("=")
+        name = name.strip()
+        if not sep or not name or any(c.isspace() for c in name):
+            raise ParameterError(f"bad {option} '{token}': expected NAME=VALUE")
+        try:
+            value = float(text)
+        except ValueError:
+            raise ParameterError(f"bad {option} '{token}': '{text}' is not a number") from None
+        if not math.isfinite(value):
+            raise ParameterError(f"bad {option} '{token}': value must be finite")
+        if name in out:
+            raise ParameterError(f"bad {option} '{token}': '{name}' given more than once")
+        out[name] = value
+    return out
+
+
+def _cmd_build(args: argparse.Namespace) -> int:
+    fmu_build = _lib("fmu_build")
+    for model in args.models or [DEFAULT_MODEL]:
+        path = fmu_build.build_fmu(model, Path(args.modelica_dir), Path(args.out),
+                                   step_size=args.step_size, force=args.force)
+        print(path)
+    return 0
+
+
+def _cmd_info(args: argparse.Namespace) -> int:
+    print(_lib("twin.fmu").describe(Path(args.fmu)))
+    if args.no_modes:
+        return 0
+    freqs = _lib("twin.linearize").natural_frequencies(Path(args.fmu), n=len(MEASURED_MODES_HZ))
+    print()
+    print("natural frequencies (linearised model vs. measured, paper Table 2)")
+    print(f"{'mode':>4}  {'model [Hz]':>11}  {'measured [Hz]':>13}  {'diff [%]':>8}")
+    for i, measured in enumerate(MEASURED_MODES_HZ):
+        if i < len(freqs):
+            model = float(freqs[i])
+            print(f"{i + 1:>4}  {model:>11.1f}  {measured:>13.0f}  "
+                  f"{100.0 * (model - measured) / measured:>+8.1f}")
+        else:
+            print(f"{i + 1:>4}  {'-':>11}  {measured:>13.0f}  {'-':>8}")
+    return 0
+
+
+def _cmd_simulate(args: argparse.Namespace) -> int:
+    parameters = parse_assignments(args.param, "--param")
+    inputs = parse_assignments(args.input, "--input")
+    outputs = [s.strip() for s in args.outputs.split(",") if s.strip()] if args.outputs else None
+    results = _lib("twin.results")
+    # Reject a bad output path before a possibly long simulation, not after it.
+    target = results.check_output_path(args.output)
+    result = _lib("twin.fmu").simulate_fmu(
+        Path(args.fmu), stop_time=args.stop_time, start_time=args.start_time,
+        output_interval=args.output_interval, outputs=outputs, parameters=parameters,
+        inputs=inputs, progress=not args.no_progress,
+    )
+    written = results.write_result(result, target)
+    n = len(result.time)
+    span = f"t=[{result.time[0]:.6g}, {result.time[-1]:.6g}] s" if n else "no samples"
+    print(f"wrote {written}: {n} samples x {len(result.signals)} channels, "
+          f"{span}, {result.sample_rate:.6g} Hz")
+    return 0
+
+
+def _cmd_demo(args: argparse.Namespace) -> int:
+    _lib("twin.demo").run_demo(Path(args.out), stop_time=args.stop_time)
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """Return the ``twin`` argument parser (one sub-parser per command)."""
+    parser = argparse.ArgumentParser(
+        prog="twin", description="FMU co-simulation digital twin of a spur gearbox.")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    p = sub.add_parser("build", help="export Modelica models to FMUs")
+    p.add_argument("models", nargs="*", metavar="MODEL",
+                   help=f"fully qualified model name(s) (default: {DEFAULT_MODEL})")
+    p.add_argument("--modelica-dir", default="modelica", help="Modelica source directory")
+    p.add_argument("--out", default="build", help="output directory for the .fmu files")
+    p.add_argument("--step-size", type=float, default=5e-6,
+                   help="fixed solver step size [s] (default: 5e-6)")
+    p.add_argument("--force", action="store_true", help="rebuild even if up to date")
+    p.set_defaults(handler=_cmd_build)
+
+    p = sub.add_parser("info", help="describe an FMU and compare its modes with measurements")
+    p.add_argument("fmu", metavar="FMU", help="path to the .fmu file")
+    p.add_argument("--no-modes", action="store_true",
+                   help="skip the linearisation / natural-frequency table")
+    p.set_defaults(handler=_cmd_info)
+
+    p = sub.add_parser("simulate", help="run an FMU and write its outputs")
+    p.add_argument("fmu", metavar="FMU", help="path to the .fmu file")
+    p.add_argument("--stop-time", type=float, required=True, help="stop time [s]")
+    p.add_argument("--start-time", type=float, default=0.0, help="start time [s] (default: 0)")
+    p.add_argument("--output-interval", type=float, default=1e-5,
+                   help="output sample interval [s] (default: 1e-5)")
+    p.add_argument("--output", default="out.h5", help="result file, .h5/.hdf5 or .csv")
+    p.add_argument("--outputs", help="comma-separated output variables (default: all)")
+    p.add_argument("--param", action="append", metavar="NAME=VALUE",
+                   help="set a parameter (repeatable)")
+    p.add_argument("--input", action="append", metavar="NAME=VALUE",
+                   help="hold an input at a constant value (repeatable)")
+    p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    p.set_defaults(handler=_cmd_simulate)
+
+    p = sub.add_parser("demo", help="build, simulate and plot the reference gearbox")
+    p.add_argument("--out", default="demo_out", help="output directory (default: demo_out)")
+    p.add_argument("--stop-time", type=float, default=10.0,
+                   help="simulated time [s] (default: 10)")
+    p.set_defaults(handler=_cmd_demo)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the CLI; return the exit code (0 ok, 2 usage or :class:`TwinError`).
+
+    Exceptions other than :class:`TwinError` propagate: they are bugs and
+    deserve a traceback.
+    """
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # --help or a usage error; argparse already printed
+        return exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 2)
+    try:
+        return args.handler(args)
+    except TwinError as exc:
+        print(f"twin: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

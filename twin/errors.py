@@ -1,0 +1,59 @@
+"""Typed exceptions, one per boundary of the twin.
+
+Every error the library raises on purpose derives from :class:`TwinError`, so a
+caller can catch the whole family while still telling boundaries apart.
+"""
+from __future__ import annotations
+
+
+class TwinError(Exception):
+    """Base class of every error raised on purpose by ``twin`` and ``fmu_build``."""
+
+
+class BuildError(TwinError):
+    """The Modelica -> FMU export failed (compiler, code generation or gcc)."""
+
+
+class ModelicaSubsetError(BuildError):
+    """A Modelica model uses a construct outside the supported subset.
+
+    Attributes
+    ----------
+    problems : list of (file, line, construct, reason)
+    """
+
+    def __init__(self, problems: list[tuple[str, int, str, str]]):
+        self.problems = list(problems)
+        lines = [f"{f}:{ln}: unsupported construct '{c}': {r}" for f, ln, c, r in self.problems]
+        super().__init__("Modelica model is outside the supported subset:\n  " + "\n  ".join(lines))
+
+
+class FMUError(TwinError):
+    """An FMU file is unusable: missing, not a zip, bad modelDescription, wrong platform."""
+
+
+class SimulationError(TwinError):
+    """An FMU call failed during simulation.
+
+    Attributes
+    ----------
+    time : float or None
+        Simulation time [s] at which the failing call was made.
+    status : str or None
+        FMI status name returned by the FMU (e.g. ``'fmi2Error'``).
+    """
+
+    def __init__(self, message: str, time: float | None = None, status: str | None = None):
+        self.time = time
+        self.status = status
+        where = f" at t={time:.6g} s" if time is not None else ""
+        what = f" (status {status})" if status else ""
+        super().__init__(f"{message}{where}{what}")
+
+
+class ParameterError(TwinError):
+    """A parameter name or value is not acceptable for the FMU."""
+
+
+class OutputPathError(TwinError):
+    """An output path cannot be written (missing directory, unknown suffix, ...)."""

@@ -1,0 +1,240 @@
+"""PNG plots of simulation results: Welch power spectra and time traces.
+
+Figures are built on matplotlib's Agg canvas without pyplot, so plotting works
+headless, leaks no global figures and never disturbs a caller's interactive
+backend. Files are written atomically (see :mod:`twin._atomic`).
+"""
+from __future__ import annotations
+
+import os
+import sys
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from twin._atomic import atomic_path, check_parent
+from twin.errors import OutputPathError
+from twin.results import SimulationResult
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+#: Frequency resolution [Hz] the default Welch segment length aims for.
+DEFAULT_RESOLUTION_HZ = 2.0
+# Floor for the dB conversion so an exactly-zero bin plots as very low, not -inf.
+_PSD_FLOOR = 1e-300
+
+
+def welch_psd(
+    result: SimulationResult, channel: str, *, nperseg: int | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """Welch power spectral density of one channel.
+
+    Hann window, 50 % overlap, mean removed per segment. The default segment
+    length gives a resolution of :data:`DEFAULT_RESOLUTION_HZ` (``fs / 2`` samples),
+    capped to the signal length.
+
+    Returns
+    -------
+    freq : numpy.ndarray, shape (m,)
+        Frequencies [Hz] from 0 to Nyquist.
+    psd_db : numpy.ndarray, shape (m,)
+        PSD in dB re 1 unit^2/Hz of the channel (dB re 1 (m/s^2)^2/Hz for
+        accelerations).
+
+    Raises
+    ------
+    ValueError
+        If the channel has fewer than 2 samples, the sample rate is not
+        positive or ``nperseg`` is below 2.
+    """
+    from scipy.signal import welch
+
+    x = result[channel]
+    fs = result.sample_rate
+    if not fs > 0:
+        raise ValueError(f"sample_rate must be > 0 Hz for a spectrum, got {fs}")
+    if x.size < 2:
+        raise ValueError(f"channel '{channel}' has {x.size} samples; a spectrum needs at least 2")
+    if nperseg is None:
+        nperseg = int(round(fs / DEFAULT_RESOLUTION_HZ))
+    if nperseg < 2:
+        raise ValueError(f"nperseg must be >= 2, got {nperseg}")
+    nperseg = min(nperseg, x.size)
+    freq, psd = welch(x, fs=fs, window="hann", nperseg=nperseg, detrend="constant",
+                      scaling="density")
+    return freq, 10.0 * np.log10(np.maximum(psd, _PSD_FLOOR))
+
+
+def _png_target(path: str | os.PathLike[str]) -> Path:
+    target = Path(path)
+    if target.suffix.lower() != ".png":
+        raise OutputPathError(f"plot path '{target}' has suffix '{target.suffix}'; only .png is written")
+    return check_parent(target)
+
+
+def _new_figure(n_axes: int) -> Figure:
+    import matplotlib
+
+    # Only pick the backend when pyplot is not in use: switching would break a
+    # caller's interactive session, and the explicit Agg canvas below suffices.
+    if "matplotlib.pyplot" not in sys.modules:
+        matplotlib.use("Agg")
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(9.0, 1.0 + 2.4 * n_axes), layout="constrained")
+    FigureCanvasAgg(fig)
+    fig.subplots(n_axes, 1, sharex=True, squeeze=False)
+    return fig
+
+
+def _save(fig: Figure, target: Path) -> Path:
+    with atomic_path(target) as tmp:
+        fig.savefig(tmp, format="png", dpi=110)
+    return target
+
+
+def spectrum_figure(
+    result: SimulationResult,
+    channels: Sequence[str],
+    *,
+    fmin: float = 0.0,
+    fmax: float | None = None,
+    title: str | None = None,
+    nperseg: int | None = None,
+    markers: Mapping[str, float] | None = None,
+    logx: bool = False,
+) -> Figure:
+    """Build the spectrum figure drawn by :func:`plot_spectrum` (see there) without saving it."""
+    if not channels:
+        raise ValueError("no channels given to plot")
+    nyquist = result.sample_rate / 2.0
+    fmax = nyquist if fmax is None else float(fmax)
+    if not 0.0 <= fmin < fmax:
+        raise ValueError(f"need 0 <= fmin < fmax, got fmin={fmin} Hz, fmax={fmax} Hz")
+    fig = _new_figure(len(channels))
+    axes = fig.axes
+    for i, (ax, name) in enumerate(zip(axes, channels)):
+        freq, psd_db = welch_psd(result, name, nperseg=nperseg)
+        # A log axis cannot show the DC bin.
+        keep = (freq >= fmin) & (freq <= fmax) & ((freq > 0) if logx else True)
+        ax.plot(freq[keep], psd_db[keep], lw=0.8, color="C0")
+        unit = result.units.get(name, "") or "1"
+        ax.set_ylabel(f"PSD [dB re 1 ({unit})²/Hz]", fontsize=8)
+        ax.set_title(name, fontsize=9, loc="left")
+        ax.grid(True, which="both", lw=0.3, alpha=0.6)
+        for label, f_mark in (markers or {}).items():
+            if not fmin <= f_mark <= fmax:
+                continue
+            ax.axvline(f_mark, ls=":", lw=1.0, color="C3", label=label)
+            if i == 0:
+                # Label each marker once, at the top of the first panel.
+                ax.annotate(label, xy=(f_mark, 1.0), xycoords=("data", "axes fraction"),
+                            rotation=90, ha="right", va="top", fontsize=7, color="C3")
+    last = axes[-1]
+    if logx:
+        last.set_xscale("log")
+    last.set_xlim(max(fmin, freq[1]) if logx else fmin, fmax)
+    last.set_xlabel("frequency [Hz]")
+    if title:
+        fig.suptitle(title)
+    return fig
+
+
+def plot_spectrum(
+    result: SimulationResult,
+    channels: Sequence[str],
+    path: str | os.PathLike[str],
+    *,
+    fmin: float = 0.0,
+    fmax: float | None = None,
+    title: str | None = None,
+    nperseg: int | None = None,
+    markers: Mapping[str, float] | None = None,
+    logx: bool = False,
+) -> Path:
+    """Write a PNG with the Welch PSD of each channel, one panel per channel.
+
+    Parameters
+    ----------
+    result : SimulationResult
+    channels : sequence of str
+        Channels to plot, top to bottom.
+    path : path-like
+        Output ``.png``; its directory must exist.
+    fmin, fmax : float
+        Frequency range shown [Hz]; ``fmax`` defaults to Nyquist.
+    title : str, optional
+        Figure title.
+    nperseg : int, optional
+        Welch segment length [samples]; default ``fs / 2`` (2 Hz resolution),
+        capped to the signal length.
+    markers : mapping of label -> frequency [Hz], optional
+        Vertical dotted lines, e.g. gear-mesh harmonics; those outside
+        ``[fmin, fmax]`` are skipped.
+    logx : bool
+        Logarithmic frequency axis (DC bin omitted).
+
+    Returns
+    -------
+    Path of the written PNG.
+
+    Raises
+    ------
+    OutputPathError
+        Suffix other than ``.png`` or missing directory (checked before computing).
+    KeyError
+        Unknown channel.
+    """
+    target = _png_target(path)
+    fig = spectrum_figure(result, channels, fmin=fmin, fmax=fmax, title=title,
+                          nperseg=nperseg, markers=markers, logx=logx)
+    return _save(fig, target)
+
+
+def plot_time(
+    result: SimulationResult,
+    channels: Sequence[str],
+    path: str | os.PathLike[str],
+    t0: float,
+    t1: float,
+    *,
+    title: str | None = None,
+) -> Path:
+    """Write a PNG of the channels over the window ``t0 <= t <= t1`` [s], one panel each.
+
+    Raises
+    ------
+    OutputPathError
+        Suffix other than ``.png`` or missing directory.
+    ValueError
+        Empty channel list, ``t1 <= t0`` or no samples in the window.
+    KeyError
+        Unknown channel.
+    """
+    target = _png_target(path)
+    if not channels:
+        raise ValueError("no channels given to plot")
+    if not t1 > t0:
+        raise ValueError(f"need t0 < t1, got t0={t0} s, t1={t1} s")
+    window = (result.time >= t0) & (result.time <= t1)
+    if not window.any():
+        raise ValueError(
+            f"no samples in [{t0}, {t1}] s; result spans "
+            f"[{result.time[0] if len(result) else 'n/a'}, "
+            f"{result.time[-1] if len(result) else 'n/a'}] s"
+        )
+    fig = _new_figure(len(channels))
+    for ax, name in zip(fig.axes, channels):
+        ax.plot(result.time[window], result[name][window], lw=0.8, color="C0")
+        unit = result.units.get(name, "")
+        ax.set_ylabel(f"{name} [{unit}]" if unit else name, fontsize=8)
+        ax.grid(True, lw=0.3, alpha=0.6)
+    fig.axes[-1].set_xlabel("time [s]")
+    fig.axes[-1].set_xlim(t0, t1)
+    if title:
+        fig.suptitle(title)
+    return _save(fig, target)
