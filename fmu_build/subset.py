@@ -56,6 +56,20 @@ _FORBIDDEN_CALLS = {
     "semiLinear": "semiLinear() is not supported",
 }
 
+_DISCRETE_TYPES = ("Boolean", "Integer", "String")
+_DECL_BOUNDARY = {";", "public", "protected", "equation", "algorithm",
+                  "model", "block", "connector", "record", "package", "class"}
+
+
+def _is_parameter_decl(toks: list, i: int) -> bool:
+    """True if the declaration whose type token is ``toks[i]`` has a parameter/constant prefix."""
+    j = i - 1
+    while j >= 0 and toks[j].text not in _DECL_BOUNDARY:
+        if toks[j].text in ("parameter", "constant"):
+            return True
+        j -= 1
+    return False
+
 
 class _Tok:
     __slots__ = ("text", "line", "file")
@@ -166,6 +180,14 @@ def _scan(toks: list[_Tok], nested: set[str]) -> list[tuple[str, int, str, str]]
         if s in _FORBIDDEN_KEYWORDS and prev != "end":
             problems.append((t.file, t.line, s, _FORBIDDEN_KEYWORDS[s]))
             continue
+        if (s in _DISCRETE_TYPES and not in_equations and prev != "."
+                and (nxt == "[" or re.match(r"[A-Za-z_]\w*$", nxt)) and not _is_parameter_decl(toks, i)):
+            # A time-varying Boolean/Integer/String only changes at events; flattening would
+            # accept it and the error would surface later without a source line.
+            problems.append((t.file, t.line, f"{s} variable",
+                             f"{s} variables that vary in time are discrete and need events; only "
+                             f"parameter/constant {s} (structural) is supported"))
+            continue
         if s == "(":
             depth += 1
             if prev == "noEvent":
@@ -192,8 +214,10 @@ def _scan(toks: list[_Tok], nested: set[str]) -> list[tuple[str, int, str, str]]
             continue
         if s == "if" and not depth_noevent:
             what = "if-equation" if depth == 0 and brace == 0 and prev in (";", "equation", "then", "else") else "if-expression"
-            problems.append((t.file, t.line, what,
-                             f"an {what} outside noEvent() generates events; wrap the expression in noEvent(...)"))
+            # An if-equation cannot be wrapped in noEvent(); point to the equivalent expression form.
+            fix = ("write a single equation with noEvent(if ... then ... else ...)" if what == "if-equation"
+                   else "wrap the expression in noEvent(...)")
+            problems.append((t.file, t.line, what, f"an {what} outside noEvent() generates events; {fix}"))
         elif s == "for" and depth == 0 and brace == 0:
             problems.append((t.file, t.line, "for-loop equation",
                              "for-loop equations are not supported; use an array comprehension {... for i in 1:n}"))

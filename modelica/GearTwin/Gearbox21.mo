@@ -22,6 +22,8 @@ model Gearbox21 "21-DOF lumped model of the UNSW spur-gear test rig (Feng et al.
   parameter Real profile_deviation[n_profile](each unit = "m") = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0} "Material missing from the pinion flank (wear depth, relief) at the same nodes, common to all teeth";
   parameter Real tooth_stiffness_factor[z1] = {1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1} "Per-pinion-tooth multiplier of the pair stiffness (crack, spall, pitting of one tooth)";
   parameter Real tooth_deviation_offset[z1](each unit = "m") = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0} "Per-pinion-tooth extra material loss, added to profile_deviation";
+  parameter Integer tooth_prev[z1] = {if j == 1 then z1 else j - 1 for j in 1:z1} "Index of the tooth ahead of tooth j (structural)";
+  parameter Integer tooth_next[z1] = {if j == z1 then 1 else j + 1 for j in 1:z1} "Index of the tooth behind tooth j (structural)";
   parameter Real mesh_stiffness_scale = 1.0 "Calibration multiplier of all pair stiffnesses";
   parameter Real c_mesh(unit = "N.s/m") = 1.1e3 "Mesh damping along the line of action";
   parameter Real mesh_phase0(unit = "rad") = 0.0 "Mesh phase at theta5 = 0";
@@ -160,8 +162,9 @@ model Gearbox21 "21-DOF lumped model of the UNSW spur-gear test rig (Feng et al.
   Real tooth_angle(unit = "rad") "Angle 2*pi*k/z1 of the pinion tooth that entered contact last (k = completed mesh cycles)";
   Real roll[3] "Roll position along the path of contact (0 = start, 1 = end) of the pairs leading, current and next";
   Real window[3] "Share of each pair in contact (smooth 0-1 gate over [0, 1])";
-  Real tooth_cos[3] "cos of the angle of the pinion tooth in each pair";
-  Real tooth_sin[3] "sin of the angle of the pinion tooth in each pair";
+  Real tooth_weight[z1] "1 for the pinion tooth of the current pair, 0 for the others";
+  Real pair_tooth_factor[3] "tooth_stiffness_factor of the pinion tooth in each pair";
+  Real pair_tooth_offset[3](each unit = "m") "tooth_deviation_offset of the pinion tooth in each pair";
   Real pair_stiffness[3](each unit = "N/m") "Stiffness of each tooth pair";
   Real pair_deviation[3](each unit = "m") "Profile deviation at the contact point of each pair";
   Real pair_force[3](each unit = "N") "Elastic force carried by each pair";
@@ -184,12 +187,14 @@ equation
   tooth_angle = (mesh_angle - 2 * GearTwin.pi * cycle_fraction) / z1;
   roll = {(cycle_fraction + 1) / contact_ratio, cycle_fraction / contact_ratio, (cycle_fraction - 1) / contact_ratio};
   window = {noEvent(min(1.0, max(0.0, (roll[i] + contact_smoothing) / (2 * contact_smoothing)))) ^ 2 * (3 - 2 * noEvent(min(1.0, max(0.0, (roll[i] + contact_smoothing) / (2 * contact_smoothing))))) * noEvent(min(1.0, max(0.0, (1 - roll[i] + contact_smoothing) / (2 * contact_smoothing)))) ^ 2 * (3 - 2 * noEvent(min(1.0, max(0.0, (1 - roll[i] + contact_smoothing) / (2 * contact_smoothing))))) for i in 1:3};
-  tooth_cos = {cos(tooth_angle - 2 * GearTwin.pi / z1), cos(tooth_angle), cos(tooth_angle + 2 * GearTwin.pi / z1)};
-  tooth_sin = {sin(tooth_angle - 2 * GearTwin.pi / z1), sin(tooth_angle), sin(tooth_angle + 2 * GearTwin.pi / z1)};
-  // Piecewise-linear interpolation along the profile (hat functions on n_profile nodes) and
-  // nearest-tooth selection on the unit circle (hat of radius half a chord around each tooth).
-  pair_stiffness = {mesh_stiffness_scale * window[i] * sum(k_pair[n] * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[i]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile) * sum(tooth_stiffness_factor[j] * noEvent(max(0.0, 1 - ((tooth_cos[i] - cos(2 * GearTwin.pi * (j - 1) / z1)) ^ 2 + (tooth_sin[i] - sin(2 * GearTwin.pi * (j - 1) / z1)) ^ 2) / sin(GearTwin.pi / z1) ^ 2)) for j in 1:z1) for i in 1:3};
-  pair_deviation = {sum(profile_deviation[n] * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[i]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile) + sum(tooth_deviation_offset[j] * noEvent(max(0.0, 1 - ((tooth_cos[i] - cos(2 * GearTwin.pi * (j - 1) / z1)) ^ 2 + (tooth_sin[i] - sin(2 * GearTwin.pi * (j - 1) / z1)) ^ 2) / sin(GearTwin.pi / z1) ^ 2)) for j in 1:z1) for i in 1:3};
+  // Nearest-tooth selection on the unit circle (hat of radius half a chord around each tooth);
+  // the leading and next pairs use the same weights on the cyclically shifted tooth arrays.
+  tooth_weight = {noEvent(max(0.0, 1 - ((cos(tooth_angle) - cos(2 * GearTwin.pi * (j - 1) / z1)) ^ 2 + (sin(tooth_angle) - sin(2 * GearTwin.pi * (j - 1) / z1)) ^ 2) / sin(GearTwin.pi / z1) ^ 2)) for j in 1:z1};
+  pair_tooth_factor = {sum(tooth_stiffness_factor[tooth_prev[j]] * tooth_weight[j] for j in 1:z1), sum(tooth_stiffness_factor[j] * tooth_weight[j] for j in 1:z1), sum(tooth_stiffness_factor[tooth_next[j]] * tooth_weight[j] for j in 1:z1)};
+  pair_tooth_offset = {sum(tooth_deviation_offset[tooth_prev[j]] * tooth_weight[j] for j in 1:z1), sum(tooth_deviation_offset[j] * tooth_weight[j] for j in 1:z1), sum(tooth_deviation_offset[tooth_next[j]] * tooth_weight[j] for j in 1:z1)};
+  // Piecewise-linear interpolation along the profile: hat functions on n_profile nodes.
+  pair_stiffness = {mesh_stiffness_scale * window[i] * pair_tooth_factor[i] * sum(k_pair[n] * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[i]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile) for i in 1:3};
+  pair_deviation = {pair_tooth_offset[i] + sum(profile_deviation[n] * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[i]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile) for i in 1:3};
   mesh_deflection = rb1 * theta5 - rb2 * theta10 + (x5 - x10) * sin(alpha) + (y5 - y10) * cos(alpha);
   mesh_deflection_rate = rb1 * omega5 - rb2 * omega10 + (vx5 - vx10) * sin(alpha) + (vy5 - vy10) * cos(alpha);
   // A pair whose flanks are apart (deviation larger than the approach) carries no load.

@@ -1,0 +1,487 @@
+"""The only module of ``twin`` that talks to FMUs (through fmpy).
+
+It turns value references into names, FMI status codes into :class:`SimulationError`, and
+captures high-rate outputs without a Python call per sample: FMUs built by ``fmu_build``
+buffer their outputs inside each ``doStep`` (parameter ``solver.output_interval``) and the
+buffer is read with one C call per communication step.  Any other FMI 2.0 Co-Simulation
+FMU works too, at one ``doStep`` + ``getReal`` per output sample.
+
+Typical use::
+
+    with FMU("build/GearTwin.Gearbox21.fmu") as fmu:
+        fmu.setup(parameters={"c_mesh": 900.0})
+        result = fmu.run(stop_time=1.0, output_interval=1e-5)
+"""
+from __future__ import annotations
+
+import ctypes
+import hashlib
+import shutil
+import tempfile
+import zipfile
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from twin.errors import FMUError, ParameterError, SimulationError
+from twin.results import SimulationResult
+
+_STATUS = ["fmi2OK", "fmi2Warning", "fmi2Discard", "fmi2Error", "fmi2Fatal", "fmi2Pending"]
+STEP_SIZE = "solver.step_size"
+OUTPUT_INTERVAL = "solver.output_interval"
+
+
+@dataclass(frozen=True)
+class Variable:
+    """One scalar variable of an FMU, as declared in its modelDescription.xml."""
+
+    name: str
+    value_reference: int
+    type: str               # Real, Integer, Boolean, String, Enumeration
+    causality: str          # parameter, calculatedParameter, input, output, local, independent
+    variability: str        # constant, fixed, tunable, discrete, continuous
+    unit: str
+    description: str
+    start: float | None
+
+
+def _sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for chunk in iter(lambda: f.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+class FMU:
+    """An FMI 2.0 Co-Simulation FMU opened for simulation.
+
+    Parameters
+    ----------
+    path : path of the ``.fmu`` file.
+    instance_name : name passed to ``fmi2Instantiate``.
+    """
+
+    def __init__(self, path: str | Path, *, instance_name: str = "twin"):
+        import fmpy
+        from fmpy.model_description import read_model_description
+
+        self.path = Path(path)
+        if not self.path.exists():
+            raise FMUError(f"FMU file {self.path} does not exist")
+        if not zipfile.is_zipfile(self.path):
+            raise FMUError(f"{self.path} is not an FMU (not a zip archive)")
+        try:
+            self.model_description = read_model_description(str(self.path))
+        except Exception as exc:
+            raise FMUError(f"{self.path}: invalid modelDescription.xml: {exc}") from exc
+        md = self.model_description
+        if md.fmiVersion != "2.0":
+            raise FMUError(f"{self.path}: FMI version {md.fmiVersion} is not supported (need 2.0)")
+        if md.coSimulation is None:
+            raise FMUError(f"{self.path}: the FMU does not support Co-Simulation")
+        self.sha256 = _sha256(self.path)
+        self.variables: dict[str, Variable] = {}
+        for v in md.modelVariables:
+            start = v.start
+            try:
+                start = float(start) if start is not None else None
+            except (TypeError, ValueError):
+                start = None
+            self.variables[v.name] = Variable(v.name, int(v.valueReference), v.type, v.causality,
+                                              v.variability, v.unit or "", v.description or "", start)
+        self._unzip = tempfile.mkdtemp(prefix="twin_fmu_")
+        try:
+            fmpy.extract(str(self.path), self._unzip)
+        except Exception as exc:
+            shutil.rmtree(self._unzip, ignore_errors=True)
+            raise FMUError(f"{self.path}: cannot extract: {exc}") from exc
+        self._instance_name = instance_name
+        self._slave = None
+        self._messages: list[str] = []
+        self._callbacks = None
+        self.time = 0.0
+        self._buffer_fn = None
+
+    # -- description -----------------------------------------------------------------------
+    @property
+    def model_name(self) -> str:
+        return self.model_description.modelName
+
+    @property
+    def guid(self) -> str:
+        return self.model_description.guid
+
+    def _by(self, causality: str) -> list[Variable]:
+        return sorted((v for v in self.variables.values() if v.causality == causality),
+                      key=lambda v: v.value_reference)
+
+    @property
+    def parameters(self) -> list[Variable]:
+        return self._by("parameter")
+
+    @property
+    def inputs(self) -> list[Variable]:
+        return self._by("input")
+
+    @property
+    def outputs(self) -> list[Variable]:
+        return self._by("output")
+
+    @property
+    def supports_output_buffer(self) -> bool:
+        return OUTPUT_INTERVAL in self.variables
+
+    def variable(self, name: str) -> Variable:
+        try:
+            return self.variables[name]
+        except KeyError:
+            close = [n for n in self.variables if name.lower() in n.lower()][:5]
+            hint = f"; similar: {', '.join(close)}" if close else ""
+            raise ParameterError(f"{self.model_name} has no variable {name!r}{hint}") from None
+
+    # -- lifecycle -------------------------------------------------------------------------
+    def _logger(self, component, instance, status, category, message):
+        text = message.decode("utf-8", "replace") if isinstance(message, bytes) else str(message)
+        if status >= 2:
+            self._messages.append(text)
+
+    def _make_callbacks(self):
+        from fmpy import calloc, free
+        from fmpy.fmi2 import (fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE, fmi2CallbackFunctions,
+                               fmi2CallbackLoggerTYPE)
+        cb = fmi2CallbackFunctions()
+        cb.logger = fmi2CallbackLoggerTYPE(self._logger)
+        cb.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+        cb.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+        try:
+            from fmpy.logging import addLoggerProxy
+            addLoggerProxy(ctypes.byref(cb))
+        except Exception:  # the proxy only formats printf arguments; messages stay readable without it
+            pass
+        return cb
+
+    def _call(self, what: str, fn, *args):
+        try:
+            return fn(*args)
+        except Exception as exc:
+            status = getattr(exc, "status", None)
+            name = _STATUS[status] if isinstance(status, int) and 0 <= status < len(_STATUS) else None
+            detail = "; ".join(self._messages[-3:]) or str(exc)
+            self._messages.clear()
+            raise SimulationError(f"{self.model_name}: {what} failed: {detail}", time=self.time,
+                                  status=name) from exc
+
+    def instantiate(self) -> None:
+        """Load the binary and instantiate (idempotent)."""
+        if self._slave is not None:
+            return
+        from fmpy.fmi2 import FMU2Slave
+        md = self.model_description
+        try:
+            self._slave = FMU2Slave(guid=md.guid, unzipDirectory=self._unzip,
+                                    modelIdentifier=md.coSimulation.modelIdentifier,
+                                    instanceName=self._instance_name)
+        except Exception as exc:
+            raise FMUError(f"{self.path}: cannot load the binary for this platform: {exc}") from exc
+        self._callbacks = self._make_callbacks()
+        try:
+            self._slave.instantiate(callbacks=self._callbacks)
+        except Exception as exc:
+            detail = "; ".join(self._messages) or str(exc)
+            raise FMUError(f"{self.path}: fmi2Instantiate failed: {detail}") from exc
+        fn = getattr(self._slave.dll, "twin_fmi2GetOutputBuffer", None)
+        if fn is not None:
+            fn.restype = ctypes.c_size_t
+            fn.argtypes = [ctypes.c_void_p, ctypes.POINTER(ctypes.c_double), ctypes.c_size_t]
+        self._buffer_fn = fn
+
+    def setup(self, start_time: float = 0.0, *, parameters: Mapping[str, float] | None = None,
+              inputs: Mapping[str, float] | None = None) -> None:
+        """Instantiate, set parameters/inputs, and run the initialization mode."""
+        self.instantiate()
+        self.time = float(start_time)
+        self._call("fmi2SetupExperiment", self._slave.setupExperiment, None, float(start_time))
+        self._call("fmi2EnterInitializationMode", self._slave.enterInitializationMode)
+        if parameters:
+            self.set(parameters)
+        if inputs:
+            self.set(inputs)
+        self._call("fmi2ExitInitializationMode", self._slave.exitInitializationMode)
+
+    def reset(self) -> None:
+        """Return to the state right after instantiation (parameters back to defaults)."""
+        if self._slave is not None:
+            self._call("fmi2Reset", self._slave.reset)
+        self.time = 0.0
+
+    def close(self) -> None:
+        if self._slave is not None:
+            try:
+                self._slave.terminate()
+            except Exception:  # terminating a failed instance may fail again; the instance is freed anyway
+                pass
+            self._slave.freeInstance()
+            try:
+                self._slave.freeLibrary() if hasattr(self._slave, "freeLibrary") else None
+            except Exception:
+                pass
+            self._slave = None
+        shutil.rmtree(self._unzip, ignore_errors=True)
+
+    def __enter__(self) -> "FMU":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def __del__(self):
+        try:
+            shutil.rmtree(self._unzip, ignore_errors=True)
+        except Exception:
+            pass
+
+    # -- values ----------------------------------------------------------------------------
+    def set(self, values: Mapping[str, float]) -> None:
+        """Set Real parameters or inputs by name. Non-finite values and read-only names are refused."""
+        self.instantiate()
+        vrs, vals = [], []
+        for name, value in values.items():
+            v = self.variable(name)
+            if v.type != "Real":
+                raise ParameterError(f"{name!r} is a {v.type} variable; only Real variables can be set here")
+            if v.causality not in ("parameter", "input"):
+                raise ParameterError(f"{name!r} has causality {v.causality!r} and cannot be set "
+                                     "(only parameters and inputs)")
+            if v.causality == "parameter" and v.variability not in ("tunable",) and self.time > 0:
+                raise ParameterError(f"{name!r} is a {v.variability} parameter and cannot change during a run")
+            try:
+                f = float(value)
+            except (TypeError, ValueError):
+                raise ParameterError(f"value of {name!r} must be a number, got {value!r}") from None
+            if not np.isfinite(f):
+                raise ParameterError(f"value of {name!r} must be finite, got {value!r}")
+            vrs.append(v.value_reference)
+            vals.append(f)
+        if vrs:
+            self._call("fmi2SetReal", self._slave.setReal, vrs, vals)
+
+    def get(self, names: str | Sequence[str]) -> float | np.ndarray:
+        """Current values of Real variables by name (a float for one name, else an array)."""
+        self.instantiate()
+        single = isinstance(names, str)
+        names = [names] if single else list(names)
+        vrs = [self.variable(n).value_reference for n in names]
+        vals = np.array(self._call("fmi2GetReal", self._slave.getReal, vrs))
+        return float(vals[0]) if single else vals
+
+    def step(self, dt: float) -> None:
+        """Advance one communication step of ``dt`` seconds."""
+        if not dt > 0:
+            raise SimulationError(f"communication step must be > 0 s, got {dt!r}", time=self.time)
+        self._call("fmi2DoStep", self._slave.doStep, self.time, dt)
+        self.time += dt
+
+    def get_state(self):
+        """Opaque snapshot of the FMU (fmi2GetFMUstate); restore it with :meth:`set_state`."""
+        return self._call("fmi2GetFMUstate", self._slave.getFMUstate), self.time
+
+    def set_state(self, state) -> None:
+        handle, t = state
+        self._call("fmi2SetFMUstate", self._slave.setFMUstate, handle)
+        self.time = t
+
+    def free_state(self, state) -> None:
+        self._call("fmi2FreeFMUstate", self._slave.freeFMUstate, state[0])
+
+    # -- capture ---------------------------------------------------------------------------
+    def run(self, stop_time: float, output_interval: float, *, outputs: Iterable[str] | None = None,
+            communication_step: float | None = None, progress: bool = False, callback=None) -> SimulationResult:
+        """Simulate from the current time to ``stop_time`` and return the sampled outputs.
+
+        Parameters
+        ----------
+        stop_time : end time [s].
+        output_interval : output sample period [s] (1e-5 for 100 kHz).
+        outputs : names to record (default: every output).
+        communication_step : doStep size [s]; default about 10 ms, a whole number of samples.
+        callback : ``callback(fmu, t)`` called after every communication step (events, hooks).
+
+        Returns a :class:`SimulationResult` whose ``time`` has shape (n,) with
+        n = round((stop_time - start) / output_interval) + 1.
+        """
+        if self._slave is None:
+            self.setup(self.time)
+        if not output_interval > 0:
+            raise SimulationError(f"output_interval must be > 0 s, got {output_interval!r}", time=self.time)
+        t0 = self.time
+        n_samples = int(round((stop_time - t0) / output_interval))
+        if n_samples < 1:
+            raise SimulationError(f"stop_time {stop_time} s leaves no output sample after t={t0} s", time=t0)
+        names = [v.name for v in self.outputs] if outputs is None else list(outputs)
+        for n in names:
+            self.variable(n)
+        per_step = max(1, int(round((communication_step or 0.01) / output_interval)))
+        out = np.empty((n_samples + 1, len(names)))
+        out[0] = self.get(names) if names else []
+        buffered = self._buffer_fn is not None
+        if buffered:
+            all_outputs = [v.name for v in self.outputs]
+            cols = [all_outputs.index(n) if n in all_outputs else -1 for n in names]
+            extra = [n for n, c in zip(names, cols) if c < 0]
+            if extra:
+                raise ParameterError(f"only outputs can be recorded from the buffer; not outputs: {extra}")
+            self.set({OUTPUT_INTERVAL: output_interval})
+            width = len(all_outputs)
+            scratch = np.empty((per_step + 2, max(width, 1)))
+        bar = _progress(n_samples, progress, self.model_name)
+        k = 0
+        try:
+            while k < n_samples:
+                m = min(per_step, n_samples - k)
+                if buffered:
+                    t_next = t0 + (k + m) * output_interval
+                    self._call("fmi2DoStep", self._slave.doStep, self.time, t_next - self.time)
+                    self.time = t_next
+                    got = self._buffer_fn(self._slave.component,
+                                          scratch.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), scratch.shape[0])
+                    if got != m:
+                        raise SimulationError(f"output buffer held {got} samples, expected {m}", time=self.time)
+                    out[k + 1:k + 1 + m] = scratch[:m, cols]
+                else:
+                    for j in range(m):
+                        t_next = t0 + (k + j + 1) * output_interval
+                        self._call("fmi2DoStep", self._slave.doStep, self.time, t_next - self.time)
+                        self.time = t_next
+                        out[k + j + 1] = self.get(names) if names else []
+                k += m
+                if callback is not None:
+                    callback(self, self.time)
+                bar.update(m)
+        finally:
+            bar.close()
+            if buffered:
+                self.set({OUTPUT_INTERVAL: 0.0})
+        time = t0 + output_interval * np.arange(n_samples + 1)
+        bad = ~np.isfinite(out)
+        if bad.any():
+            i = int(np.argmax(bad.any(axis=1)))
+            raise SimulationError(f"output {names[int(np.argmax(bad[i]))]} is not finite", time=float(time[i]))
+        params = self.parameter_values()
+        return SimulationResult(
+            time=time, signals={n: out[:, j].copy() for j, n in enumerate(names)},
+            units={n: self.variables[n].unit for n in names}, sample_rate=1.0 / output_interval,
+            parameters=params, model_name=self.model_name, guid=self.guid, fmu_sha256=self.sha256)
+
+    def parameter_values(self) -> dict[str, float]:
+        """Current values of every Real parameter."""
+        reals = [v.name for v in self.parameters if v.type == "Real"]
+        if not reals:
+            return {}
+        return dict(zip(reals, (float(x) for x in self.get(reals))))
+
+    # -- Model Exchange view for linearisation -------------------------------------------------
+    def state_derivative_function(self, parameters: Mapping[str, float] | None = None,
+                                  inputs: Mapping[str, float] | None = None):
+        """Return ``(f, x0, state_names)`` where ``f(x) -> xdot`` uses the FMU's Model Exchange interface.
+
+        ``x0`` (n,) holds the initial states; the caller must call ``f.close()`` when done.
+        """
+        md = self.model_description
+        if md.modelExchange is None:
+            raise FMUError(f"{self.path}: no Model Exchange interface, cannot linearise")
+        from fmpy.fmi2 import FMU2Model
+        model = FMU2Model(guid=md.guid, unzipDirectory=self._unzip,
+                          modelIdentifier=md.modelExchange.modelIdentifier, instanceName="linearize")
+        callbacks = self._make_callbacks()
+        model.instantiate(callbacks=callbacks)
+        model.setupExperiment(startTime=0.0)
+        model.enterInitializationMode()
+        values = {**(parameters or {}), **(inputs or {})}
+        if values:
+            vrs = [self.variable(n).value_reference for n in values]
+            model.setReal(vrs, [float(x) for x in values.values()])
+        model.exitInitializationMode()
+        model.enterContinuousTimeMode()
+        nx = md.numberOfContinuousStates
+        x0 = np.zeros(nx)
+        dx = np.zeros(nx)
+        model.getContinuousStates(x0.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), nx)
+        state_names = [self._derivative_of(d) for d in md.derivatives]
+
+        class _F:
+            def __call__(self_inner, x):
+                x = np.ascontiguousarray(x, dtype=float)
+                model.setContinuousStates(x.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), nx)
+                model.getDerivatives(dx.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), nx)
+                return dx.copy()
+
+            def close(self_inner):
+                model.terminate()
+                model.freeInstance()
+
+        f = _F()
+        f._callbacks = callbacks  # keep the ctypes callbacks alive as long as f
+        return f, x0, state_names
+
+    @staticmethod
+    def _derivative_of(unknown) -> str:
+        var = unknown.variable
+        return var.derivative.name if getattr(var, "derivative", None) is not None else var.name
+
+
+class _NoBar:
+    def update(self, n):
+        pass
+
+    def close(self):
+        pass
+
+
+def _progress(total: int, enabled: bool, name: str):
+    if not enabled:
+        return _NoBar()
+    from tqdm import tqdm
+    return tqdm(total=total, unit="samples", unit_scale=True, desc=name, leave=False)
+
+
+def simulate_fmu(path: str | Path, *, stop_time: float, start_time: float = 0.0, output_interval: float = 1e-5,
+                 outputs: Sequence[str] | None = None, parameters: Mapping[str, float] | None = None,
+                 inputs: Mapping[str, float] | None = None, progress: bool = False,
+                 step_size: float | None = None) -> SimulationResult:
+    """Simulate an FMU with constant inputs and return its sampled outputs (like ``fmpy.simulate_fmu``).
+
+    ``step_size`` [s] sets the internal solver step of FMUs built by ``fmu_build``.
+    """
+    if stop_time <= start_time:
+        raise SimulationError(f"stop_time ({stop_time} s) must be after start_time ({start_time} s)")
+    params = dict(parameters or {})
+    with FMU(path) as fmu:
+        if step_size is not None:
+            if STEP_SIZE not in fmu.variables:
+                raise ParameterError(f"{fmu.model_name} has no {STEP_SIZE} parameter (not built by fmu_build)")
+            params[STEP_SIZE] = step_size
+        fmu.setup(start_time, parameters=params, inputs=inputs)
+        return fmu.run(stop_time, output_interval, outputs=outputs, progress=progress)
+
+
+def describe(path: str | Path) -> str:
+    """Human-readable summary of an FMU: identity, interfaces and variables with units."""
+    with FMU(path) as fmu:
+        md = fmu.model_description
+        lines = [f"Model        {fmu.model_name}",
+                 f"Description  {md.description or ''}",
+                 f"FMI          {md.fmiVersion}  ({', '.join(k for k, v in (('Co-Simulation', md.coSimulation), ('Model Exchange', md.modelExchange)) if v is not None)})",
+                 f"GUID         {fmu.guid}",
+                 f"SHA-256      {fmu.sha256}",
+                 f"Generated by {md.generationTool or 'unknown'}",
+                 f"States       {md.numberOfContinuousStates}",
+                 f"Output buffer {'yes (' + OUTPUT_INTERVAL + ')' if fmu.supports_output_buffer else 'no'}"]
+        for title, group in (("Inputs", fmu.inputs), ("Outputs", fmu.outputs), ("Parameters", fmu.parameters)):
+            lines.append(f"\n{title} ({len(group)}):")
+            for v in group:
+                start = f"{v.start:.6g}" if v.start is not None else ""
+                lines.append(f"  {v.name:32s} {start:>14s} {v.unit:10s} {v.description}")
+        return "\n".join(lines)
