@@ -21,7 +21,7 @@ from xml.sax.saxutils import escape
 
 from twin.errors import BuildError
 
-BUILDER_VERSION = "1"
+BUILDER_VERSION = "2"
 DEFAULT_STEP_SIZE = 5e-6
 _HERE = Path(__file__).resolve().parent
 _TEMPLATE = _HERE / "templates" / "fmi2_wrapper.c"
@@ -129,6 +129,7 @@ def build_fmu(model: str = "GearTwin.Gearbox21", modelica_dir: Path | str = "mod
         prefix = "m" + digest[:10]
         _generate_c(ode, root / "sources", prefix, guid, step_size)
         shutil.copy(_TEMPLATE, root / "sources" / "fmi2_wrapper.c")
+        shutil.copy(_HERE / "templates" / "twin_math.h", root / "sources" / "twin_math.h")
         hdr = _fmi_headers()
         for name in ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"):
             shutil.copy(hdr / name, root / "sources" / name)
@@ -185,6 +186,8 @@ def _generate_c(ode, src: Path, prefix: str, guid: str, step_size: float) -> Non
     for f in funcs:
         cg.add(f)
     cg.generate(str(src) + os.sep)
+    generated = src / "model_functions.c"
+    generated.write_text('#include "twin_math.h"\n' + generated.read_text())
     nx, nu, ny, np_, nq = (len(ode.states), len(ode.inputs), len(ode.outputs), len(ode.parameters),
                            len(ode.calculated))
     lay = _layout(ode)
