@@ -57,3 +57,28 @@ class ParameterError(TwinError):
 
 class OutputPathError(TwinError):
     """An output path cannot be written (missing directory, unknown suffix, ...)."""
+
+
+class ScenarioError(TwinError):
+    """A scenario file is invalid. Lists every problem found, not only the first.
+
+    Attributes
+    ----------
+    problems : list of (file, key_path, reason)
+    """
+
+    def __init__(self, problems: list[tuple[str, str, str]]):
+        self.problems = list(problems)
+        lines = [f"{f}: {k}: {r}" if k else f"{f}: {r}" for f, k, r in self.problems]
+        n = len(self.problems)
+        super().__init__(f"{n} problem{'s' if n != 1 else ''} in scenario:\n  " + "\n  ".join(lines))
+
+
+class FMUCompatibilityError(TwinError):
+    """An FMU does not offer what a scenario needs. Lists every mismatch."""
+
+    def __init__(self, fmu: str, mismatches: list[str]):
+        self.fmu = fmu
+        self.mismatches = list(mismatches)
+        super().__init__(f"FMU {fmu} does not fit the scenario ({len(mismatches)} mismatch"
+                         f"{'es' if len(mismatches) != 1 else ''}):\n  " + "\n  ".join(mismatches))

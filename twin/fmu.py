@@ -104,6 +104,8 @@ class FMU:
         self._callbacks = None
         self.time = 0.0
         self._buffer_fn = None
+        self._buffer_interval = None
+        self._scratch = None
 
     # -- description -----------------------------------------------------------------------
     @property
@@ -216,6 +218,7 @@ class FMU:
         if self._slave is not None:
             self._call("fmi2Reset", self._slave.reset)
         self.time = 0.0
+        self._buffer_interval = None
 
     def close(self) -> None:
         if self._slave is not None:
@@ -292,6 +295,7 @@ class FMU:
         handle, t = state
         self._call("fmi2SetFMUstate", self._slave.setFMUstate, handle)
         self.time = t
+        self._buffer_interval = self.get(OUTPUT_INTERVAL) if self.supports_output_buffer else None
 
     def free_state(self, state) -> None:
         self._call("fmi2FreeFMUstate", self._slave.freeFMUstate, state[0])
@@ -326,44 +330,18 @@ class FMU:
         per_step = max(1, int(round((communication_step or 0.01) / output_interval)))
         out = np.empty((n_samples + 1, len(names)))
         out[0] = self.get(names) if names else []
-        buffered = self._buffer_fn is not None
-        if buffered:
-            all_outputs = [v.name for v in self.outputs]
-            cols = [all_outputs.index(n) if n in all_outputs else -1 for n in names]
-            extra = [n for n, c in zip(names, cols) if c < 0]
-            if extra:
-                raise ParameterError(f"only outputs can be recorded from the buffer; not outputs: {extra}")
-            self.set({OUTPUT_INTERVAL: output_interval})
-            width = len(all_outputs)
-            scratch = np.empty((per_step + 2, max(width, 1)))
         bar = _progress(n_samples, progress, self.model_name)
         k = 0
         try:
             while k < n_samples:
                 m = min(per_step, n_samples - k)
-                if buffered:
-                    t_next = t0 + (k + m) * output_interval
-                    self._call("fmi2DoStep", self._slave.doStep, self.time, t_next - self.time)
-                    self.time = t_next
-                    got = self._buffer_fn(self._slave.component,
-                                          scratch.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), scratch.shape[0])
-                    if got != m:
-                        raise SimulationError(f"output buffer held {got} samples, expected {m}", time=self.time)
-                    out[k + 1:k + 1 + m] = scratch[:m, cols]
-                else:
-                    for j in range(m):
-                        t_next = t0 + (k + j + 1) * output_interval
-                        self._call("fmi2DoStep", self._slave.doStep, self.time, t_next - self.time)
-                        self.time = t_next
-                        out[k + j + 1] = self.get(names) if names else []
+                out[k + 1:k + 1 + m] = self.capture(t0 + (k + m) * output_interval, output_interval, names)
                 k += m
                 if callback is not None:
                     callback(self, self.time)
                 bar.update(m)
         finally:
             bar.close()
-            if buffered:
-                self.set({OUTPUT_INTERVAL: 0.0})
         time = t0 + output_interval * np.arange(n_samples + 1)
         bad = ~np.isfinite(out)
         if bad.any():
@@ -374,6 +352,46 @@ class FMU:
             time=time, signals={n: out[:, j].copy() for j, n in enumerate(names)},
             units={n: self.variables[n].unit for n in names}, sample_rate=1.0 / output_interval,
             parameters=params, model_name=self.model_name, guid=self.guid, fmu_sha256=self.sha256)
+
+    def capture(self, t_end: float, output_interval: float, names: Sequence[str]) -> np.ndarray:
+        """Advance to ``t_end`` and return the outputs sampled every ``output_interval``.
+
+        Returns shape (m, len(names)): the samples at t + output_interval, ..., t_end, where
+        m = round((t_end - t) / output_interval). FMUs built by fmu_build fill an internal
+        buffer during one doStep; other FMUs get one doStep + getReal per sample.
+        """
+        m = int(round((t_end - self.time) / output_interval))
+        if m < 1:
+            raise SimulationError(f"capture to t={t_end} s leaves no sample after t={self.time} s", time=self.time)
+        block = np.empty((m, len(names)))
+        if self._buffer_fn is not None:
+            all_outputs = [v.name for v in self.outputs]
+            try:
+                cols = [all_outputs.index(n) for n in names]
+            except ValueError:
+                extra = [n for n in names if n not in all_outputs]
+                raise ParameterError(f"only outputs can be recorded from the buffer; not outputs: {extra}") from None
+            if self._buffer_interval != output_interval:
+                self.set({OUTPUT_INTERVAL: output_interval})
+                self._buffer_interval = output_interval
+            if self._scratch is None or self._scratch.shape[0] < m + 2:
+                self._scratch = np.empty((m + 2, max(len(all_outputs), 1)))
+            self._call("fmi2DoStep", self._slave.doStep, self.time, t_end - self.time)
+            self.time = t_end
+            got = self._buffer_fn(self._slave.component,
+                                  self._scratch.ctypes.data_as(ctypes.POINTER(ctypes.c_double)),
+                                  self._scratch.shape[0])
+            if got != m:
+                raise SimulationError(f"output buffer held {got} samples, expected {m}", time=self.time)
+            block[:] = self._scratch[:m, cols]
+        else:
+            start = self.time
+            for j in range(m):
+                t_next = t_end if j == m - 1 else start + (j + 1) * output_interval
+                self._call("fmi2DoStep", self._slave.doStep, self.time, t_next - self.time)
+                self.time = t_next
+                block[j] = self.get(names) if names else []
+        return block
 
     def parameter_values(self) -> dict[str, float]:
         """Current values of every Real parameter."""

@@ -37,7 +37,7 @@ import io
 import json
 import os
 import warnings
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -193,10 +193,13 @@ def _param_value(value: Any) -> Any:
     return value.item() if isinstance(value, np.generic) else value
 
 
-def write_hdf5(result: SimulationResult, path: str | os.PathLike[str]) -> Path:
+def write_hdf5(result: SimulationResult, path: str | os.PathLike[str], *,
+               extra: "Callable[[Any], None] | None" = None) -> Path:
     """Write ``result`` to an HDF5 file with the layout in the module docstring.
 
-    Returns the written path; the write is atomic.
+    ``extra(h5file)``, if given, adds further groups inside the same atomic write (the
+    orchestrator stores the scenario and degradation stages this way). Returns the written
+    path; the write is atomic.
     """
     import h5py
 
@@ -227,6 +230,8 @@ def write_hdf5(result: SimulationResult, path: str | os.PathLike[str]) -> Path:
             params = f.create_group("parameters", track_order=True)
             for name, value in result.parameters.items():
                 params.attrs[name] = _param_value(value)
+            if extra is not None:
+                extra(f)
     return target
 
 

@@ -160,14 +160,14 @@ model Gearbox21 "21-DOF lumped model of the UNSW spur-gear test rig (Feng et al.
   Real mesh_angle(unit = "rad") "Mesh phase: z1 * theta5 + mesh_phase0";
   Real cycle_fraction "Position within the current mesh cycle, (0, 1]";
   Real tooth_angle(unit = "rad") "Angle 2*pi*k/z1 of the pinion tooth that entered contact last (k = completed mesh cycles)";
-  Real roll[3] "Roll position along the path of contact (0 = start, 1 = end) of the pairs leading, current and next";
+  output Real roll[3] "Roll position along the path of contact (0 = start, 1 = end) of the pairs leading, current and next";
   Real window[3] "Share of each pair in contact (smooth 0-1 gate over [0, 1])";
   Real tooth_weight[z1] "1 for the pinion tooth of the current pair, 0 for the others";
   Real pair_tooth_factor[3] "tooth_stiffness_factor of the pinion tooth in each pair";
   Real pair_tooth_offset[3](each unit = "m") "tooth_deviation_offset of the pinion tooth in each pair";
   Real pair_stiffness[3](each unit = "N/m") "Stiffness of each tooth pair";
   Real pair_deviation[3](each unit = "m") "Profile deviation at the contact point of each pair";
-  Real pair_force[3](each unit = "N") "Elastic force carried by each pair";
+  output Real pair_force[3](each unit = "N") "Elastic force carried by each pair";
   Real mesh_deflection(unit = "m") "Approach of the flanks along the line of action";
   Real mesh_deflection_rate(unit = "m/s") "Time derivative of mesh_deflection";
   output Real mesh_force(unit = "N") "Dynamic mesh force along the line of action";

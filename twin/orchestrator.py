@@ -1,0 +1,221 @@
+"""The co-simulation orchestrator: runs a :class:`~twin.scenario.Scenario` on any FMU.
+
+One explicit loop over communication steps::
+
+    for each step [t, t + h):
+        apply the timed events due at t      (override / bias / reset)
+        set the inputs from the operating profile at t (held over the step)
+        call the between-step hooks          (hook(context, t); degradation lives here)
+        advance the FMU and record its outputs for (t, t + h]
+
+Before running, the FMU's model description is checked against what the scenario needs
+(variables by name, causality, variability, type); every mismatch is listed in one
+:class:`~twin.errors.FMUCompatibilityError`.  Ctrl-C stops after the current step and the
+samples recorded so far are still written (marked ``complete = False``).
+"""
+from __future__ import annotations
+
+import json
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from twin.errors import FMUCompatibilityError
+from twin.fmu import FMU
+from twin.results import SimulationResult, write_hdf5
+from twin.scenario import Scenario
+
+
+@dataclass
+class StepContext:
+    """What a between-step hook sees and may change."""
+
+    fmu: FMU
+    scenario: Scenario
+    time: float
+    step: int
+    store: dict = field(default_factory=dict)   # hook-owned data that ends up in the run record
+
+
+Hook = Callable[[StepContext], None]
+
+
+@dataclass(frozen=True)
+class RunRecord:
+    """Outcome of :func:`run_scenario`."""
+
+    scenario: Scenario
+    result: SimulationResult
+    complete: bool
+    path: Path | None
+    events_applied: tuple[tuple[float, str], ...]
+
+
+def required_variables(scenario: Scenario) -> dict[str, tuple[set[str], str]]:
+    """name -> (accepted causalities, why) for everything the scenario touches."""
+    need: dict[str, tuple[set[str], str]] = {}
+    for n in scenario.outputs or ():
+        need[n] = ({"output", "local"}, "recorded output")
+    for n in scenario.parameters:
+        need[n] = ({"parameter"}, "parameter value")
+    for n in scenario.inputs:
+        need[n] = ({"input"}, "input driven by the operating profile")
+    for e in scenario.events:
+        for n in [*e.override, *e.bias, *e.reset]:
+            need.setdefault(n, ({"parameter", "input"}, f"changed by the event at t={e.time:g} s"))
+    return need
+
+
+def check_compatibility(fmu: FMU, scenario: Scenario) -> None:
+    """Raise :class:`FMUCompatibilityError` listing every way ``fmu`` does not fit ``scenario``."""
+    problems = []
+    for name, (causalities, why) in required_variables(scenario).items():
+        v = fmu.variables.get(name)
+        if v is None:
+            problems.append(f"missing variable {name!r} ({why})")
+            continue
+        if v.causality not in causalities:
+            problems.append(f"{name!r} has causality {v.causality!r}, needs {' or '.join(sorted(causalities))} ({why})")
+        if v.type != "Real":
+            problems.append(f"{name!r} is {v.type}, needs Real ({why})")
+        if v.causality == "parameter" and "event" in why and v.variability != "tunable":
+            problems.append(f"{name!r} is a {v.variability} parameter and cannot change during the run ({why})")
+    if scenario.outputs is None and not fmu.outputs:
+        problems.append("the FMU has no outputs to record and the scenario names none")
+    if scenario.degradation is not None:
+        for n in ("roll[1]", "pair_force[1]", "k_pair[1]", "profile_deviation[1]"):
+            if n not in fmu.variables:
+                problems.append(f"missing variable {n!r} (needed by the degradation coupling)")
+    if problems:
+        raise FMUCompatibilityError(str(fmu.path), problems)
+
+
+def run_scenario(scenario: Scenario, output: str | Path | None = None, *, fmu_path: Path | None = None,
+                 hooks: Sequence[Hook] = (), progress: bool = True) -> RunRecord:
+    """Run ``scenario``; write the result to ``output`` (HDF5) if given.
+
+    Returns a :class:`RunRecord`. On Ctrl-C the partial result is written and returned with
+    ``complete=False``.
+    """
+    path = Path(output) if output is not None else None
+    if path is not None:
+        from twin.results import check_output_path
+        check_output_path(path)
+    fmu_file = fmu_path or scenario.fmu_path()
+    applied: list[tuple[float, str]] = []
+    with FMU(fmu_file) as fmu:
+        check_compatibility(fmu, scenario)
+        names = list(scenario.outputs) if scenario.outputs else [v.name for v in fmu.outputs]
+        t0 = scenario.start_time
+        inputs_now = {n: p(t0) for n, p in scenario.inputs.items()}
+        fmu.setup(t0, parameters=dict(scenario.parameters), inputs=inputs_now)
+        initial = {n: fmu.get(n) for n in required_variables(scenario)
+                   if fmu.variables[n].causality in ("parameter", "input")}
+        h = scenario.communication_step
+        dt = scenario.output_interval
+        n_steps = int(round((scenario.stop_time - t0) / h))
+        per_step = int(round(h / dt))
+        blocks = [np.asarray(fmu.get(names)).reshape(1, -1)]
+        overrides: dict[str, float] = {}
+        biases: dict[str, float] = {}
+        events = list(scenario.events)
+        ctx = StepContext(fmu, scenario, t0, 0)
+        bar = _bar(n_steps * per_step, progress, scenario.name)
+        complete = True
+        try:
+            for k in range(n_steps):
+                t = t0 + k * h
+                while events and events[0].time <= t + 1e-9 * h:
+                    e = events.pop(0)
+                    applied += _apply_event(fmu, e, initial, overrides, biases)
+                if scenario.inputs or overrides or biases:
+                    values = {n: p(t) for n, p in scenario.inputs.items()}
+                    for n, v in overrides.items():
+                        if fmu.variables[n].causality == "input":
+                            values[n] = v
+                    for n, b in biases.items():
+                        if fmu.variables[n].causality == "input":
+                            values[n] = values.get(n, initial[n]) + b
+                    if values:
+                        fmu.set(values)
+                ctx.time, ctx.step = t, k
+                for hook in hooks:
+                    hook(ctx)
+                blocks.append(fmu.capture(t0 + (k + 1) * h, dt, names))
+                bar.update(per_step)
+        except KeyboardInterrupt:
+            complete = False
+        finally:
+            bar.close()
+        data = np.concatenate(blocks)
+        time = t0 + dt * np.arange(data.shape[0])
+        result = SimulationResult(time=time, signals={n: data[:, j].copy() for j, n in enumerate(names)},
+                                  units={n: fmu.variables[n].unit for n in names}, sample_rate=scenario.sample_rate,
+                                  parameters=fmu.parameter_values(), model_name=fmu.model_name, guid=fmu.guid,
+                                  fmu_sha256=fmu.sha256)
+    if path is not None:
+        write_hdf5(result, path, extra=lambda f: _write_run_groups(f, scenario, complete, applied, ctx.store))
+    return RunRecord(scenario, result, complete, path, tuple(applied))
+
+
+def _apply_event(fmu: FMU, e, initial, overrides, biases) -> list[tuple[float, str]]:
+    log = []
+    changes = {}
+    for n, v in e.override.items():
+        overrides[n] = v
+        biases.pop(n, None)
+        if fmu.variables[n].causality == "parameter":
+            changes[n] = v
+        log.append((e.time, f"override {n} = {v:g}"))
+    for n, b in e.bias.items():
+        if fmu.variables[n].causality == "parameter":
+            changes[n] = fmu.get(n) + b
+        else:
+            biases[n] = biases.get(n, 0.0) + b
+        log.append((e.time, f"bias {n} += {b:g}"))
+    for n in e.reset:
+        overrides.pop(n, None)
+        biases.pop(n, None)
+        if fmu.variables[n].causality == "parameter":
+            changes[n] = initial[n]
+        log.append((e.time, f"reset {n}"))
+    if changes:
+        fmu.set(changes)
+    return log
+
+
+def _write_run_groups(f, scenario: Scenario, complete: bool, applied, store: dict) -> None:
+    f.attrs["complete"] = complete
+    f.attrs["scenario_name"] = scenario.name
+    g = f.create_group("scenario")
+    g.attrs["json"] = json.dumps(scenario.raw, default=str)
+    g.attrs["source"] = str(scenario.source or "")
+    ev = f.create_group("events")
+    ev.create_dataset("time", data=np.array([t for t, _ in applied], dtype="f8"))
+    ev.attrs["actions"] = json.dumps([a for _, a in applied])
+    for key, writer in store.get("_writers", {}).items():
+        writer(f)
+
+
+def _bar(total: int, enabled: bool, name: str):
+    if not enabled:
+        class _No:
+            def update(self, n):
+                pass
+
+            def close(self):
+                pass
+        return _No()
+    from tqdm import tqdm
+    return tqdm(total=total, unit="samples", unit_scale=True, desc=name, leave=False)
+
+
+def describe_scenario(scenario: Scenario) -> dict[str, Any]:
+    """A JSON-friendly summary (used by the CLI)."""
+    return {"name": scenario.name, "fmu": scenario.fmu, "start_time": scenario.start_time,
+            "stop_time": scenario.stop_time, "communication_step": scenario.communication_step,
+            "sample_rate": scenario.sample_rate, "events": len(scenario.events),
+            "inputs": sorted(scenario.inputs), "degradation": bool(scenario.degradation)}

@@ -1,0 +1,394 @@
+"""Scenario files: what to simulate, declaratively (``scenarios/*.yaml``).
+
+A scenario names an FMU, a time span, the outputs to record, parameter values, an operating
+profile (shaft speed and load: constant, ramp, steps or a CSV table), timed events that
+override, bias or reset parameters and inputs (after the Open Simulation Platform's scenario
+files), an optional ``degradation:`` block, an optional ``archive:`` block and an optional
+``executor:``.  The format is versioned and published as a JSON Schema (``twin schema``).
+
+Reading a file validates it completely: every problem is collected and raised at once as a
+:class:`~twin.errors.ScenarioError` with the file, the key path and the reason.  Unknown keys
+are errors.
+"""
+from __future__ import annotations
+
+import csv
+import json
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from twin.errors import ScenarioError
+
+FORMAT_VERSION = 1
+
+_NUM = {"type": "number"}
+_POS = {"type": "number", "exclusiveMinimum": 0}
+_NONNEG = {"type": "number", "minimum": 0}
+_NAME_MAP = {"type": "object", "additionalProperties": {"type": "number"}}
+
+_PROFILE = {
+    "description": "A scalar signal over time: constant, ramp, steps or a CSV table.",
+    "oneOf": [
+        {"type": "number"},
+        {"type": "object", "additionalProperties": False, "required": ["constant"],
+         "properties": {"constant": _NUM}},
+        {"type": "object", "additionalProperties": False, "required": ["ramp"],
+         "properties": {"ramp": {"type": "object", "additionalProperties": False,
+                                 "required": ["from", "to", "duration"],
+                                 "properties": {"from": _NUM, "to": _NUM, "start": _NONNEG, "duration": _POS}}}},
+        {"type": "object", "additionalProperties": False, "required": ["steps"],
+         "properties": {"steps": {"type": "array", "minItems": 1,
+                                  "items": {"type": "array", "prefixItems": [_NONNEG, _NUM],
+                                            "minItems": 2, "maxItems": 2}}}},
+        {"type": "object", "additionalProperties": False, "required": ["table"],
+         "properties": {"table": {"type": "object", "additionalProperties": False, "required": ["file", "column"],
+                                  "properties": {"file": {"type": "string"}, "column": {"type": "string"},
+                                                 "time_column": {"type": "string"}}}}},
+    ],
+}
+
+SCHEMA: dict[str, Any] = {
+    "$schema": "https://json-schema.org/draft/2020-12/schema",
+    "$id": "https://gear-twin.invalid/schemas/scenario-v1.json",
+    "title": "gear-twin scenario",
+    "type": "object",
+    "additionalProperties": False,
+    "required": ["version", "name", "fmu", "stop_time"],
+    "properties": {
+        "version": {"const": FORMAT_VERSION, "description": "Scenario format version."},
+        "name": {"type": "string", "minLength": 1},
+        "description": {"type": "string"},
+        "fmu": {"type": "string", "minLength": 1,
+                "description": "Path of an .fmu (relative to the scenario file) or a Modelica model name built from modelica/."},
+        "start_time": {**_NONNEG, "description": "s"},
+        "stop_time": {**_POS, "description": "s"},
+        "communication_step": {**_POS, "description": "s, default 0.01"},
+        "seed": {"type": "integer", "minimum": 0},
+        "output": {
+            "type": "object", "additionalProperties": False,
+            "properties": {"sample_rate": {**_POS, "description": "Hz, default 100000"},
+                           "variables": {"type": "array", "items": {"type": "string"}, "minItems": 1}},
+        },
+        "parameters": {**_NAME_MAP, "description": "Parameter values by FMU variable name."},
+        "parameter_files": {"type": "array", "items": {"type": "string"},
+                            "description": "JSON ({name: value}) or SSP .ssv parameter sets, applied in order before 'parameters'."},
+        "operating": {
+            "type": "object", "additionalProperties": False,
+            "properties": {"speed": {**_PROFILE, "description": "Shaft speed, Hz"},
+                           "load": {**_PROFILE, "description": "Load torque, N.m"},
+                           "speed_input": {"type": "string", "description": "FMU input that receives 2*pi*speed (rad/s)"},
+                           "load_input": {"type": "string", "description": "FMU input that receives the load (N.m)"},
+                           "inputs": {"type": "object", "additionalProperties": _PROFILE,
+                                      "description": "Other FMU inputs by name, in their own units"}},
+        },
+        "events": {
+            "type": "array",
+            "items": {"type": "object", "additionalProperties": False, "required": ["time"],
+                      "minProperties": 2,
+                      "properties": {"time": _NONNEG, "override": _NAME_MAP, "bias": _NAME_MAP,
+                                     "reset": {"type": "array", "items": {"type": "string"}}}},
+        },
+        "degradation": {
+            "type": "object", "additionalProperties": False, "required": ["model"],
+            "properties": {
+                "model": {"enum": ["pitting", "wear"]},
+                "coefficients": _NAME_MAP,
+                "cycles_per_update": _POS,
+                "stop": {"type": "object", "additionalProperties": False, "minProperties": 1,
+                         "properties": {"pitting_density": {"type": "number", "exclusiveMinimum": 0, "maximum": 1},
+                                        "wear_depth": _POS, "cycles": _POS}},
+                "max_updates": {"type": "integer", "minimum": 1},
+                "load_window": {**_POS, "description": "s of co-simulation sampled to estimate the mesh load at each update"},
+                "record_duration": {**_NONNEG, "description": "s of vibration stored at each update (0 = none)"},
+            },
+        },
+        "archive": {
+            "type": "object", "additionalProperties": False, "required": ["stages"],
+            "properties": {
+                "stages": {"type": "array", "minItems": 2, "items": _NONNEG,
+                           "description": "Stage boundaries of the damage measure (pitting density or wear depth in m), ascending"},
+                "records_per_stage": {"type": "integer", "minimum": 1},
+                "record_duration": _POS,
+                "speed_scatter": {**_NONNEG, "description": "relative standard deviation of the shaft speed"},
+                "load_scatter": {**_NONNEG, "description": "relative standard deviation of the load"},
+                "noise": {**_NONNEG, "description": "measurement noise, relative to the signal RMS"},
+                "settle_time": {**_NONNEG, "description": "s simulated and discarded before each record"},
+            },
+        },
+        "executor": {
+            "type": "object", "additionalProperties": False,
+            "properties": {"type": {"enum": ["local", "dask"]},
+                           "workers": {"type": "integer", "minimum": 1},
+                           "address": {"type": "string"}},
+        },
+    },
+}
+
+
+@dataclass(frozen=True)
+class Profile:
+    """A piecewise-linear signal ``value(t)`` (times in s) holding its last value."""
+
+    times: tuple[float, ...]
+    values: tuple[float, ...]
+    hold: bool = False          # True: steps (zero-order hold); False: linear interpolation
+
+    def __call__(self, t: float) -> float:
+        if self.hold:
+            i = int(np.searchsorted(self.times, t, side="right")) - 1
+            return float(self.values[max(i, 0)])
+        return float(np.interp(t, self.times, self.values))
+
+
+@dataclass(frozen=True)
+class Event:
+    time: float
+    override: Mapping[str, float] = field(default_factory=dict)
+    bias: Mapping[str, float] = field(default_factory=dict)
+    reset: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A validated scenario (see :data:`SCHEMA` for the meaning of each field)."""
+
+    name: str
+    fmu: str
+    stop_time: float
+    source: Path | None = None
+    description: str = ""
+    start_time: float = 0.0
+    communication_step: float = 0.01
+    sample_rate: float = 100_000.0
+    outputs: tuple[str, ...] | None = None
+    parameters: Mapping[str, float] = field(default_factory=dict)
+    inputs: Mapping[str, Profile] = field(default_factory=dict)
+    events: tuple[Event, ...] = ()
+    degradation: Mapping[str, Any] | None = None
+    archive: Mapping[str, Any] | None = None
+    executor: Mapping[str, Any] = field(default_factory=lambda: {"type": "local"})
+    seed: int = 0
+    raw: Mapping[str, Any] = field(default_factory=dict)
+
+    @property
+    def output_interval(self) -> float:
+        return 1.0 / self.sample_rate
+
+    def fmu_path(self, modelica_dir: Path | None = None, build_dir: Path | None = None) -> Path:
+        """The FMU file: a path as given, or the model built from ``modelica/`` on demand."""
+        candidate = Path(self.fmu)
+        if not candidate.is_absolute() and self.source is not None:
+            candidate = self.source.parent / candidate
+        if self.fmu.endswith(".fmu"):
+            if not candidate.exists():
+                raise ScenarioError([(str(self.source), "fmu", f"FMU file {candidate} does not exist")])
+            return candidate
+        from fmu_build import build_fmu
+        repo = Path(__file__).resolve().parents[1]
+        return build_fmu(self.fmu, modelica_dir or repo / "modelica", build_dir or repo / "build")
+
+    def with_overrides(self, **changes) -> "Scenario":
+        from dataclasses import replace
+        return replace(self, **changes)
+
+
+def schema_json() -> str:
+    return json.dumps(SCHEMA, indent=2)
+
+
+def load_scenario(path: str | Path) -> Scenario:
+    """Read and validate a YAML (or JSON) scenario file."""
+    import yaml
+
+    path = Path(path)
+    if not path.exists():
+        raise ScenarioError([(str(path), "", "file does not exist")])
+    try:
+        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except yaml.YAMLError as exc:
+        raise ScenarioError([(str(path), "", f"not valid YAML: {exc}")]) from None
+    return scenario_from_dict(data, source=path)
+
+
+def _key_path(parts) -> str:
+    out = ""
+    for p in parts:
+        out += f"[{p}]" if isinstance(p, int) else (f".{p}" if out else str(p))
+    return out or "(top level)"
+
+
+def scenario_from_dict(data: Any, source: Path | None = None) -> Scenario:
+    """Validate a scenario given as a dict (e.g. parsed YAML) and build the :class:`Scenario`."""
+    import jsonschema
+
+    where = str(source) if source else "<scenario>"
+    if not isinstance(data, dict):
+        raise ScenarioError([(where, "", "a scenario must be a mapping of keys to values")])
+    problems: list[tuple[str, str, str]] = []
+    validator = jsonschema.Draft202012Validator(SCHEMA)
+    for err in sorted(validator.iter_errors(data), key=lambda e: list(map(str, e.absolute_path))):
+        msg = err.message
+        if err.validator == "oneOf":
+            msg = ("must be a number or one of {constant: v}, {ramp: {from, to, start, duration}}, "
+                   "{steps: [[t, v], ...]}, {table: {file, column, time_column}}")
+        elif err.validator == "additionalProperties":
+            msg = msg.replace("Additional properties are not allowed", "unknown key(s)")
+        problems.append((where, _key_path(err.absolute_path), msg))
+    if problems:
+        raise ScenarioError(problems)
+
+    start = float(data.get("start_time", 0.0))
+    stop = float(data["stop_time"])
+    if stop <= start:
+        problems.append((where, "stop_time", f"must be after start_time ({start} s), got {stop} s"))
+    comm = float(data.get("communication_step", 0.01))
+    out = data.get("output", {})
+    rate = float(out.get("sample_rate", 100_000.0))
+    if comm * rate < 1 - 1e-9:
+        problems.append((where, "communication_step",
+                         f"{comm} s is shorter than one output sample (1/{rate:g} Hz)"))
+    elif abs(comm * rate - round(comm * rate)) > 1e-6 * comm * rate:
+        problems.append((where, "communication_step",
+                         f"{comm} s must be a whole number of output samples (1/{rate:g} Hz)"))
+
+    params: dict[str, float] = {}
+    for i, f in enumerate(data.get("parameter_files", [])):
+        p = Path(f)
+        if not p.is_absolute() and source is not None:
+            p = source.parent / p
+        try:
+            params.update(read_parameter_file(p))
+        except ScenarioError as exc:
+            problems += [(where, f"parameter_files[{i}]", r) for _, _, r in exc.problems]
+    params.update({k: float(v) for k, v in data.get("parameters", {}).items()})
+
+    inputs: dict[str, Profile] = {}
+    op = data.get("operating", {})
+    for key, unit_scale, default_input in (("speed", 2 * math.pi, "motor_speed_ref"), ("load", 1.0, "load_torque")):
+        if key in op:
+            name = op.get(f"{key}_input", default_input)
+            prof = _profile(op[key], f"operating.{key}", source, problems, where)
+            if prof is not None:
+                inputs[name] = Profile(prof.times, tuple(v * unit_scale for v in prof.values), prof.hold)
+    for name, spec in op.get("inputs", {}).items():
+        prof = _profile(spec, f"operating.inputs.{name}", source, problems, where)
+        if prof is not None:
+            if name in inputs:
+                problems.append((where, f"operating.inputs.{name}", "this input is already driven by speed/load"))
+            inputs[name] = prof
+
+    events = []
+    for i, e in enumerate(data.get("events", [])):
+        t = float(e["time"])
+        if not start <= t <= stop:
+            problems.append((where, f"events[{i}].time", f"{t} s is outside [{start}, {stop}] s"))
+        k = round((t - start) / comm)
+        if abs(start + k * comm - t) > 1e-9 * max(1.0, abs(t)):
+            problems.append((where, f"events[{i}].time",
+                             f"{t} s is not on a communication step boundary (step {comm} s)"))
+        events.append(Event(t, dict(e.get("override", {})), dict(e.get("bias", {})), tuple(e.get("reset", ()))))
+    if any(b.time < a.time for a, b in zip(events, events[1:])):
+        problems.append((where, "events", "events must be in ascending time order"))
+
+    deg = data.get("degradation")
+    if deg is not None:
+        stop_crit = deg.get("stop", {})
+        if deg["model"] == "pitting" and "wear_depth" in stop_crit:
+            problems.append((where, "degradation.stop.wear_depth", "a pitting model stops on pitting_density or cycles"))
+        if deg["model"] == "wear" and "pitting_density" in stop_crit:
+            problems.append((where, "degradation.stop.pitting_density", "a wear model stops on wear_depth or cycles"))
+        if not stop_crit and "max_updates" not in deg:
+            problems.append((where, "degradation.stop", "give a stop criterion or max_updates, or the run never ends"))
+    arc = data.get("archive")
+    if arc is not None:
+        st = arc["stages"]
+        if any(b <= a for a, b in zip(st, st[1:])):
+            problems.append((where, "archive.stages", f"stage boundaries must be strictly ascending, got {st}"))
+        if deg is None:
+            problems.append((where, "archive", "an archive needs a degradation block to produce its stages"))
+    ex = data.get("executor", {"type": "local"})
+    if ex.get("type") == "dask" and "address" not in ex:
+        pass  # no address: a LocalCluster is started
+    if problems:
+        raise ScenarioError(problems)
+
+    outputs = tuple(out["variables"]) if "variables" in out else None
+    return Scenario(name=data["name"], fmu=data["fmu"], stop_time=stop, source=source,
+                    description=data.get("description", ""), start_time=start, communication_step=comm,
+                    sample_rate=rate, outputs=outputs, parameters=params, inputs=inputs,
+                    events=tuple(events), degradation=deg, archive=arc, executor=dict(ex),
+                    seed=int(data.get("seed", 0)), raw=data)
+
+
+def _profile(spec, key, source, problems, where) -> Profile | None:
+    if isinstance(spec, (int, float)):
+        return Profile((0.0,), (float(spec),))
+    if "constant" in spec:
+        return Profile((0.0,), (float(spec["constant"]),))
+    if "ramp" in spec:
+        r = spec["ramp"]
+        t0 = float(r.get("start", 0.0))
+        return Profile((t0, t0 + float(r["duration"])), (float(r["from"]), float(r["to"])))
+    if "steps" in spec:
+        steps = sorted((float(t), float(v)) for t, v in spec["steps"])
+        return Profile(tuple(t for t, _ in steps), tuple(v for _, v in steps), hold=True)
+    tab = spec["table"]
+    p = Path(tab["file"])
+    if not p.is_absolute() and source is not None:
+        p = source.parent / p
+    if not p.exists():
+        problems.append((where, f"{key}.table.file", f"CSV file {p} does not exist"))
+        return None
+    tcol = tab.get("time_column", "time")
+    try:
+        with open(p, newline="") as f:
+            rows = list(csv.DictReader(f))
+        t = [float(r[tcol]) for r in rows]
+        v = [float(r[tab["column"]]) for r in rows]
+    except KeyError as exc:
+        problems.append((where, f"{key}.table", f"column {exc} not found in {p}"))
+        return None
+    except ValueError as exc:
+        problems.append((where, f"{key}.table", f"non-numeric value in {p}: {exc}"))
+        return None
+    if len(t) < 1 or any(b <= a for a, b in zip(t, t[1:])):
+        problems.append((where, f"{key}.table", f"time column of {p} must be strictly increasing and non-empty"))
+        return None
+    if not all(math.isfinite(x) for x in v):
+        problems.append((where, f"{key}.table", f"values in {p} must be finite"))
+        return None
+    return Profile(tuple(t), tuple(v))
+
+
+def read_parameter_file(path: str | Path) -> dict[str, float]:
+    """Parameter set from JSON (``{name: value}`` or ``{"parameters": {...}}``) or SSP ``.ssv``."""
+    path = Path(path)
+    if not path.exists():
+        raise ScenarioError([(str(path), "", "parameter file does not exist")])
+    if path.suffix == ".ssv":
+        import xml.etree.ElementTree as ET
+        try:
+            root = ET.parse(path).getroot()
+        except ET.ParseError as exc:
+            raise ScenarioError([(str(path), "", f"not valid XML: {exc}")]) from None
+        out = {}
+        for p in root.iter():
+            if p.tag.endswith("Parameter") and "name" in p.attrib:
+                for child in p:
+                    if child.tag.endswith("Real") and "value" in child.attrib:
+                        out[p.attrib["name"]] = float(child.attrib["value"])
+        return out
+    try:
+        data = json.loads(path.read_text())
+    except json.JSONDecodeError as exc:
+        raise ScenarioError([(str(path), "", f"not valid JSON: {exc}")]) from None
+    if isinstance(data, dict) and "parameters" in data and isinstance(data["parameters"], dict):
+        data = data["parameters"]
+    if not isinstance(data, dict) or not all(isinstance(v, (int, float)) for v in data.values()):
+        raise ScenarioError([(str(path), "", "expected a JSON object of parameter name -> number")])
+    return {k: float(v) for k, v in data.items()}
