@@ -345,15 +345,19 @@ def _profile(spec, key, source, problems, where) -> Profile | None:
         problems.append((where, f"{key}.table.file", f"CSV file {p} does not exist"))
         return None
     tcol = tab.get("time_column", "time")
+    with open(p, newline="") as f:
+        reader = csv.DictReader(f)
+        header = reader.fieldnames or []
+        rows = list(reader)
+    missing = [c for c in (tcol, tab["column"]) if c not in header]
+    if missing:
+        problems.append((where, f"{key}.table", f"column(s) {', '.join(repr(c) for c in missing)} not found in {p} "
+                                                 f"(it has: {', '.join(header) or 'no header'})"))
+        return None
     try:
-        with open(p, newline="") as f:
-            rows = list(csv.DictReader(f))
         t = [float(r[tcol]) for r in rows]
         v = [float(r[tab["column"]]) for r in rows]
-    except KeyError as exc:
-        problems.append((where, f"{key}.table", f"column {exc} not found in {p}"))
-        return None
-    except ValueError as exc:
+    except (TypeError, ValueError) as exc:
         problems.append((where, f"{key}.table", f"non-numeric value in {p}: {exc}"))
         return None
     if len(t) < 1 or any(b <= a for a, b in zip(t, t[1:])):
