@@ -105,6 +105,29 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_schema(args: argparse.Namespace) -> int:
+    print(_lib("twin.scenario").schema_json())
+    return 0
+
+
+def _cmd_run(args: argparse.Namespace) -> int:
+    scenario = _lib("twin.scenario").load_scenario(Path(args.scenario))
+    if args.stop_time is not None:
+        scenario = scenario.with_overrides(stop_time=args.stop_time)
+    orch = _lib("twin.orchestrator")
+    out = Path(args.output) if args.output else Path(f"{scenario.name}.h5")
+    if scenario.degradation is not None:
+        run = _lib("twin.degradation_run").run_degradation(scenario, out, progress=not args.no_progress,
+                                                          resume=args.resume)
+        print(f"{scenario.name}: {len(run.stages)} stages, {run.summary()} -> {out}")
+        return 0 if run.complete else 130
+    rec = orch.run_scenario(scenario, out, progress=not args.no_progress)
+    state = "complete" if rec.complete else "interrupted, partial result kept"
+    print(f"{scenario.name}: {rec.result.time.size} samples of {len(rec.result.signals)} channels "
+          f"({state}) -> {out}")
+    return 0 if rec.complete else 130
+
+
 def build_parser() -> argparse.ArgumentParser:
     """Return the ``twin`` argument parser (one sub-parser per command)."""
     parser = argparse.ArgumentParser(
@@ -141,6 +164,17 @@ def build_parser() -> argparse.ArgumentParser:
                    help="hold an input at a constant value (repeatable)")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     p.set_defaults(handler=_cmd_simulate)
+
+    p = sub.add_parser("run", help="run a scenario file through the co-simulation orchestrator")
+    p.add_argument("scenario", metavar="SCENARIO", help="scenario .yaml file")
+    p.add_argument("--output", help="result HDF5 file (default: <scenario name>.h5)")
+    p.add_argument("--stop-time", type=float, help="override the scenario's stop time [s]")
+    p.add_argument("--resume", action="store_true", help="degradation runs: continue from the last completed stage")
+    p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    p.set_defaults(handler=_cmd_run)
+
+    p = sub.add_parser("schema", help="print the JSON Schema of scenario files")
+    p.set_defaults(handler=_cmd_schema)
 
     p = sub.add_parser("demo", help="build, simulate and plot the reference gearbox")
     p.add_argument("--out", default="demo_out", help="output directory (default: demo_out)")
