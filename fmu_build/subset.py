@@ -15,6 +15,9 @@ Supported subset (documented in fmu_build/README.md):
   variable it is solved for;
 * ``if``-expressions only inside ``noEvent(...)``; ``abs``, ``min``, ``max``, ``atan2``
   and the usual elementary functions; array comprehensions and ``sum``.
+
+Declaration equations of time-varying variables (``Real y = expr;``) are checked like
+equations; parameter bindings and modifiers are not (they are evaluated once, without events).
 """
 from __future__ import annotations
 
@@ -57,6 +60,9 @@ _FORBIDDEN_CALLS = {
 }
 
 _DISCRETE_TYPES = ("Boolean", "Integer", "String")
+# `type X = Real(...)`, `model A = B(...)`, `import X = A.B`: a `=` that is no declaration equation
+_SHORT_DEFINITION = {"model", "block", "connector", "record", "package", "function", "type", "class",
+                     "operator", "import"}
 _DECL_BOUNDARY = {";", "public", "protected", "equation", "algorithm",
                   "model", "block", "connector", "record", "package", "class"}
 
@@ -121,6 +127,18 @@ def _class_spans(path: Path) -> dict[str, list[_Tok]]:
     return spans
 
 
+def _own_tokens(toks: list[_Tok], spans) -> list[_Tok]:
+    """``toks`` without the tokens of complete class definitions nested inside it."""
+    mine = {id(t) for t in toks}
+    nested: set[int] = set()
+    for other in spans:
+        # full definitions end with `end Name`; short ones (`type X = ...`) stay in place
+        if (other is not toks and len(other) < len(toks) and len(other) > 3 and other[-2].text == "end"
+                and id(other[0]) in mine):
+            nested.update(id(t) for t in other)
+    return [t for t in toks if id(t) not in nested] if nested else toks
+
+
 def check_subset(root: Path, model: str) -> None:
     """Raise :class:`ModelicaSubsetError` listing every unsupported construct used by ``model``."""
     classes: dict[str, list[_Tok]] = {}
@@ -143,6 +161,9 @@ def check_subset(root: Path, model: str) -> None:
             problems.append((toks[0].file, toks[0].line, "function",
                              f"user-defined function {name} is not supported; inline it as equations"))
             continue
+        # Classes nested in this one (e.g. the models of a one-file package) are scanned only if
+        # something refers to them, so an unused sibling cannot fail the build.
+        toks = _own_tokens(toks, classes.values())
         problems += _scan(toks, nested={n for n in classes if n != name})
         for t in toks:
             for part in t.text.split("."):
@@ -157,6 +178,7 @@ def check_subset(root: Path, model: str) -> None:
 def _scan(toks: list[_Tok], nested: set[str]) -> list[tuple[str, int, str, str]]:
     problems = []
     in_equations = False
+    in_binding = False              # inside `Real y = <expr>;` of a time-varying variable
     depth_noevent: list[int] = []   # paren depths at which a noEvent( was opened
     depth = 0
     brace = 0
@@ -165,6 +187,9 @@ def _scan(toks: list[_Tok], nested: set[str]) -> list[tuple[str, int, str, str]]
         s = t.text
         prev = toks[i - 1].text if i else ""
         nxt = toks[i + 1].text if i + 1 < n else ""
+        if s == ";" and depth == 0 and brace == 0:
+            in_binding = False
+            continue
         if s == "equation":
             in_equations = True
             if prev == "initial":
@@ -210,7 +235,12 @@ def _scan(toks: list[_Tok], nested: set[str]) -> list[tuple[str, int, str, str]]
             if s not in ("if", "for", "when", "while"):
                 in_equations = False
             continue
-        if not in_equations:
+        if (s == "=" and not in_equations and depth == 0 and brace == 0 and i >= 2
+                and toks[i - 2].text not in _SHORT_DEFINITION and not _is_parameter_decl(toks, i)):
+            # A declaration equation of a time-varying variable is an equation like any other.
+            in_binding = True
+            continue
+        if not (in_equations or in_binding):
             continue
         if s == "if" and not depth_noevent:
             what = "if-equation" if depth == 0 and brace == 0 and prev in (";", "equation", "then", "else") else "if-expression"
