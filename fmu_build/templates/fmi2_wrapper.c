@@ -398,7 +398,8 @@ fmi2Status fmi2DeSerializeFMUstate(fmi2Component comp, const fmi2Byte bytes[], s
     if (size != sizeof(Snapshot) + sizeof magic) { logmsg((Comp *)comp, fmi2Error, "logStatusError", "serialized state has the wrong size"); return fmi2Error; }
     memcpy(&magic, bytes, sizeof magic);
     if (magic != N_X * 1000003u + N_P) { logmsg((Comp *)comp, fmi2Error, "logStatusError", "serialized state belongs to another model"); return fmi2Error; }
-    s = (Snapshot *)malloc(sizeof(Snapshot));
+    /* FMI 2.0: a non-NULL *state is an existing snapshot to overwrite, not to leak */
+    s = *state ? (Snapshot *)*state : (Snapshot *)malloc(sizeof(Snapshot));
     if (!s) return fmi2Error;
     memcpy(s, bytes + sizeof magic, sizeof(Snapshot));
     *state = s;
