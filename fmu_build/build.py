@@ -21,7 +21,7 @@ from xml.sax.saxutils import escape
 
 from twin.errors import BuildError
 
-BUILDER_VERSION = "2"
+BUILDER_VERSION = "3"
 DEFAULT_STEP_SIZE = 5e-6
 _HERE = Path(__file__).resolve().parent
 _TEMPLATE = _HERE / "templates" / "fmi2_wrapper.c"
@@ -182,6 +182,10 @@ def _generate_c(ode, src: Path, prefix: str, guid: str, step_size: float) -> Non
     for f, tag in ((ode.rhs, "rhs"), (ode.outputs_fn, "out"), (ode.init, "init"), (ode.derived, "derived")):
         ins = f.sx_in()
         funcs.append(ca.Function(f"{prefix}_{tag}", ins, f.call(ins), opts))
+    # xdot and y together: at an output sample the wrapper needs both at the same (t, x), and
+    # CSE shares the mesh computation between them (the next RK4 stage reuses xdot).
+    ins = ode.rhs.sx_in()
+    funcs.append(ca.Function(f"{prefix}_rhsout", ins, [*ode.rhs.call(ins), *ode.outputs_fn.call(ins)], opts))
     cg = ca.CodeGenerator("model_functions.c", {"with_header": False, "prefix": f"{prefix}_"})
     for f in funcs:
         cg.add(f)
@@ -220,6 +224,8 @@ def _generate_c(ode, src: Path, prefix: str, guid: str, step_size: float) -> Non
 #define FN_INIT_WORK {prefix}_init_work
 #define FN_DERIVED {prefix}_derived
 #define FN_DERIVED_WORK {prefix}_derived_work
+#define FN_RHSOUT {prefix}_rhsout
+#define FN_RHSOUT_WORK {prefix}_rhsout_work
 static const double P_DEFAULT[{max(np_, 1)}] = {_c_array(v.start for v in ode.parameters)};
 static const double U_DEFAULT[{max(nu, 1)}] = {_c_array(v.start for v in ode.inputs)};
 static const int C_VALUES[{max(len(ode.constants), 1)}] = {{{', '.join(str(int(v.start)) for v in ode.constants) or '0'}}};

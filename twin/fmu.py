@@ -106,6 +106,7 @@ class FMU:
         self._buffer_fn = None
         self._buffer_interval = None
         self._scratch = None
+        self._initialized = False
 
     # -- description -----------------------------------------------------------------------
     @property
@@ -212,6 +213,7 @@ class FMU:
         if inputs:
             self.set(inputs)
         self._call("fmi2ExitInitializationMode", self._slave.exitInitializationMode)
+        self._initialized = True
 
     def reset(self) -> None:
         """Return to the state right after instantiation (parameters back to defaults)."""
@@ -219,6 +221,7 @@ class FMU:
             self._call("fmi2Reset", self._slave.reset)
         self.time = 0.0
         self._buffer_interval = None
+        self._initialized = False
 
     def close(self) -> None:
         if self._slave is not None:
@@ -258,7 +261,7 @@ class FMU:
             if v.causality not in ("parameter", "input"):
                 raise ParameterError(f"{name!r} has causality {v.causality!r} and cannot be set "
                                      "(only parameters and inputs)")
-            if v.causality == "parameter" and v.variability not in ("tunable",) and self.time > 0:
+            if v.causality == "parameter" and v.variability != "tunable" and self._initialized:
                 raise ParameterError(f"{name!r} is a {v.variability} parameter and cannot change during a run")
             try:
                 f = float(value)
@@ -310,7 +313,7 @@ class FMU:
         stop_time : end time [s].
         output_interval : output sample period [s] (1e-5 for 100 kHz).
         outputs : names to record (default: every output).
-        communication_step : doStep size [s]; default about 10 ms, a whole number of samples.
+        communication_step : doStep size [s]; default 0.1 s (one Python call per 10,000 samples at 100 kHz).
         callback : ``callback(fmu, t)`` called after every communication step (events, hooks).
 
         Returns a :class:`SimulationResult` whose ``time`` has shape (n,) with
@@ -327,7 +330,7 @@ class FMU:
         names = [v.name for v in self.outputs] if outputs is None else list(outputs)
         for n in names:
             self.variable(n)
-        per_step = max(1, int(round((communication_step or 0.01) / output_interval)))
+        per_step = max(1, int(round((communication_step or 0.1) / output_interval)))
         out = np.empty((n_samples + 1, len(names)))
         out[0] = self.get(names) if names else []
         bar = _progress(n_samples, progress, self.model_name)

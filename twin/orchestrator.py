@@ -54,35 +54,41 @@ class RunRecord:
     events_applied: tuple[tuple[float, str], ...]
 
 
-def required_variables(scenario: Scenario) -> dict[str, tuple[set[str], str]]:
-    """name -> (accepted causalities, why) for everything the scenario touches."""
-    need: dict[str, tuple[set[str], str]] = {}
+def required_variables(scenario: Scenario) -> dict[str, list[tuple[set[str], str, bool]]]:
+    """name -> every requirement on it: (accepted causalities, why, must be tunable)."""
+    need: dict[str, list[tuple[set[str], str, bool]]] = {}
+
+    def add(name, causalities, why, tunable=False):
+        need.setdefault(name, []).append((causalities, why, tunable))
+
     for n in scenario.outputs or ():
-        need[n] = ({"output", "local"}, "recorded output")
+        add(n, {"output", "local"}, "recorded output")
     for n in scenario.parameters:
-        need[n] = ({"parameter"}, "parameter value")
+        add(n, {"parameter"}, "parameter value")
     for n in scenario.inputs:
-        need[n] = ({"input"}, "input driven by the operating profile")
+        add(n, {"input"}, "input driven by the operating profile")
     for e in scenario.events:
         for n in [*e.override, *e.bias, *e.reset]:
-            need.setdefault(n, ({"parameter", "input"}, f"changed by the event at t={e.time:g} s"))
+            add(n, {"parameter", "input"}, f"changed by the event at t={e.time:g} s", tunable=True)
     return need
 
 
 def check_compatibility(fmu: FMU, scenario: Scenario) -> None:
     """Raise :class:`FMUCompatibilityError` listing every way ``fmu`` does not fit ``scenario``."""
     problems = []
-    for name, (causalities, why) in required_variables(scenario).items():
+    for name, reqs in required_variables(scenario).items():
         v = fmu.variables.get(name)
         if v is None:
-            problems.append(f"missing variable {name!r} ({why})")
+            problems.append(f"missing variable {name!r} ({'; '.join(why for _, why, _ in reqs)})")
             continue
-        if v.causality not in causalities:
-            problems.append(f"{name!r} has causality {v.causality!r}, needs {' or '.join(sorted(causalities))} ({why})")
+        for causalities, why, tunable in reqs:
+            if v.causality not in causalities:
+                problems.append(f"{name!r} has causality {v.causality!r}, needs "
+                                f"{' or '.join(sorted(causalities))} ({why})")
+            elif tunable and v.causality == "parameter" and v.variability != "tunable":
+                problems.append(f"{name!r} is a {v.variability} parameter and cannot change during the run ({why})")
         if v.type != "Real":
-            problems.append(f"{name!r} is {v.type}, needs Real ({why})")
-        if v.causality == "parameter" and "event" in why and v.variability != "tunable":
-            problems.append(f"{name!r} is a {v.variability} parameter and cannot change during the run ({why})")
+            problems.append(f"{name!r} is {v.type}, needs Real")
     if scenario.outputs is None and not fmu.outputs:
         problems.append("the FMU has no outputs to record and the scenario names none")
     if scenario.degradation is not None:
@@ -114,6 +120,7 @@ def run_scenario(scenario: Scenario, output: str | Path | None = None, *, fmu_pa
         fmu.setup(t0, parameters=dict(scenario.parameters), inputs=inputs_now)
         initial = {n: fmu.get(n) for n in required_variables(scenario)
                    if fmu.variables[n].causality in ("parameter", "input")}
+        start_parameters = fmu.parameter_values()
         h = scenario.communication_step
         dt = scenario.output_interval
         n_steps = int(round((scenario.stop_time - t0) / h))
@@ -146,6 +153,9 @@ def run_scenario(scenario: Scenario, output: str | Path | None = None, *, fmu_pa
                     hook(ctx)
                 blocks.append(fmu.capture(t0 + (k + 1) * h, dt, names))
                 bar.update(per_step)
+            # events at exactly stop_time change nothing simulated but are applied and logged
+            while events and events[0].time <= scenario.stop_time + 1e-9 * h:
+                applied += _apply_event(fmu, events.pop(0), initial, overrides, biases)
         except KeyboardInterrupt:
             complete = False
         finally:
@@ -154,7 +164,7 @@ def run_scenario(scenario: Scenario, output: str | Path | None = None, *, fmu_pa
         time = t0 + dt * np.arange(data.shape[0])
         result = SimulationResult(time=time, signals={n: data[:, j].copy() for j, n in enumerate(names)},
                                   units={n: fmu.variables[n].unit for n in names}, sample_rate=scenario.sample_rate,
-                                  parameters=fmu.parameter_values(), model_name=fmu.model_name, guid=fmu.guid,
+                                  parameters=start_parameters, model_name=fmu.model_name, guid=fmu.guid,
                                   fmu_sha256=fmu.sha256)
     if path is not None:
         write_hdf5(result, path, extra=lambda f: _write_run_groups(f, scenario, complete, applied, ctx.store))

@@ -32,6 +32,8 @@ int FN_INIT(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_r
 int FN_INIT_WORK(casadi_int* sz_arg, casadi_int* sz_res, casadi_int* sz_iw, casadi_int* sz_w);
 int FN_DERIVED(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem);
 int FN_DERIVED_WORK(casadi_int* sz_arg, casadi_int* sz_res, casadi_int* sz_iw, casadi_int* sz_w);
+int FN_RHSOUT(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem);
+int FN_RHSOUT_WORK(casadi_int* sz_arg, casadi_int* sz_res, casadi_int* sz_iw, casadi_int* sz_w);
 
 #define NX_ (N_X > 0 ? N_X : 1)
 #define NU_ (N_U > 0 ? N_U : 1)
@@ -46,6 +48,7 @@ typedef struct {
     double x[NX_], u[NU_], p[NP_], q[NQ_], y[NY_], xdot[NX_];
     double step_size, output_interval;
     int q_dirty, y_dirty, xdot_dirty;
+    int k1_valid;                 /* k1 holds xdot at (t, x) from the last output sample */
     enum Phase phase;
     int is_me;
     long long out_index;          /* index of the next output sample after t0 */
@@ -110,7 +113,8 @@ static void refresh(Comp *c) {
 
 static void rk4(Comp *c, double t, double h) {
     int i;
-    eval_rhs(c, t, c->x, c->k1);
+    if (!c->k1_valid) eval_rhs(c, t, c->x, c->k1);
+    c->k1_valid = 0;
     for (i = 0; i < N_X; i++) c->xt[i] = c->x[i] + 0.5 * h * c->k1[i];
     eval_rhs(c, t + 0.5 * h, c->xt, c->k2);
     for (i = 0; i < N_X; i++) c->xt[i] = c->x[i] + 0.5 * h * c->k2[i];
@@ -152,7 +156,14 @@ static int push_sample(Comp *c) {
         c->buf = nb;
         c->buf_cap = cap;
     }
-    if (N_Y > 0) eval_out(c, c->t, c->x, c->buf + c->buf_n * NY_);
+    {
+        double tt = c->t;
+        c->arg[0] = &tt; c->arg[1] = c->x; c->arg[2] = c->u; c->arg[3] = c->p; c->arg[4] = c->q;
+        c->res[0] = c->k1;
+        c->res[1] = c->buf + c->buf_n * NY_;
+        FN_RHSOUT(c->arg, c->res, c->iw, c->w, 0);
+        c->k1_valid = 1;          /* the next RK4 step starts from this very (t, x) */
+    }
     c->buf_n++;
     return 0;
 }
@@ -167,6 +178,7 @@ static int alloc_work(Comp *c) {
     FN_OUT_WORK(&a, &r, &iw, &w);     if (a > ma) ma = a; if (r > mr) mr = r; if (iw > miw) miw = iw; if (w > mw) mw = w;
     FN_INIT_WORK(&a, &r, &iw, &w);    if (a > ma) ma = a; if (r > mr) mr = r; if (iw > miw) miw = iw; if (w > mw) mw = w;
     FN_DERIVED_WORK(&a, &r, &iw, &w); if (a > ma) ma = a; if (r > mr) mr = r; if (iw > miw) miw = iw; if (w > mw) mw = w;
+    FN_RHSOUT_WORK(&a, &r, &iw, &w);  if (a > ma) ma = a; if (r > mr) mr = r; if (iw > miw) miw = iw; if (w > mw) mw = w;
     c->arg = (const casadi_real **)calloc((size_t)ma, sizeof(casadi_real *));
     c->res = (casadi_real **)calloc((size_t)mr, sizeof(casadi_real *));
     c->iw = (casadi_int *)calloc((size_t)miw, sizeof(casadi_int));
@@ -182,6 +194,7 @@ static void set_defaults(Comp *c) {
     c->output_interval = 0.0;
     c->t = c->t0 = 0.0;
     c->q_dirty = c->y_dirty = c->xdot_dirty = 1;
+    c->k1_valid = 0;
     c->buf_n = 0;
     c->out_index = 1;
     c->phase = INSTANTIATED;
@@ -250,6 +263,7 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component comp) {
         FN_INIT(c->arg, c->res, c->iw, c->w, 0);
     }
     c->y_dirty = c->xdot_dirty = 1;
+    c->k1_valid = 0;
     c->phase = STEPPING;
     return fmi2OK;
 }
@@ -314,6 +328,7 @@ fmi2Status fmi2SetReal(fmi2Component comp, const fmi2ValueReference vr[], size_t
         }
     }
     c->y_dirty = c->xdot_dirty = 1;
+    c->k1_valid = 0;
     return fmi2OK;
 }
 
@@ -371,6 +386,7 @@ fmi2Status fmi2SetFMUstate(fmi2Component comp, fmi2FMUstate state) {
     c->step_size = s->step_size; c->output_interval = s->output_interval;
     c->out_index = s->out_index; c->phase = (enum Phase)s->phase;
     c->q_dirty = c->y_dirty = c->xdot_dirty = 1;
+    c->k1_valid = 0;
     c->buf_n = 0;
     return fmi2OK;
 }
@@ -478,13 +494,14 @@ fmi2Status fmi2CompletedIntegratorStep(fmi2Component comp, fmi2Boolean noSetPrio
     (void)comp; (void)noSetPrior; *enterEventMode = fmi2False; *terminate = fmi2False; return fmi2OK;
 }
 fmi2Status fmi2SetTime(fmi2Component comp, fmi2Real time) {
-    Comp *c = (Comp *)comp; c->t = time; c->y_dirty = c->xdot_dirty = 1; return fmi2OK;
+    Comp *c = (Comp *)comp; c->t = time; c->y_dirty = c->xdot_dirty = 1; c->k1_valid = 0; return fmi2OK;
 }
 fmi2Status fmi2SetContinuousStates(fmi2Component comp, const fmi2Real x[], size_t nx) {
     Comp *c = (Comp *)comp;
     if (nx != (size_t)N_X) { logmsg(c, fmi2Error, "logStatusError", "expected %d states, got %zu", N_X, nx); return fmi2Error; }
     memcpy(c->x, x, nx * sizeof(double));
     c->y_dirty = c->xdot_dirty = 1;
+    c->k1_valid = 0;
     return fmi2OK;
 }
 fmi2Status fmi2GetDerivatives(fmi2Component comp, fmi2Real dx[], size_t nx) {

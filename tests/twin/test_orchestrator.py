@@ -80,3 +80,16 @@ def test_ctrl_c_keeps_what_was_recorded(two_mass_fmu, tmp_path):
     with h5py.File(out) as f:
         assert not f.attrs["complete"]
         assert f["time"].shape == (41,)
+
+
+def test_event_on_a_recorded_output_is_refused(two_mass_fmu):
+    sc = _scenario(two_mass_fmu, events=[{"time": 0.5, "override": {"a2": 0.0}}])
+    with pytest.raises(FMUCompatibilityError, match="'a2' has causality 'output'.*event at t=0.5"):
+        run_scenario(sc, progress=False)
+
+
+def test_event_at_stop_time_is_logged_and_start_parameters_are_stored(two_mass_fmu):
+    rec = run_scenario(_scenario(two_mass_fmu, parameters={"k1": 120.0},
+                                 events=[{"time": 1.0, "override": {"k1": 300.0}}]), progress=False)
+    assert [a for _, a in rec.events_applied] == ["override k1 = 300"]
+    assert rec.result.parameters["k1"] == 120.0   # the values the run started with
