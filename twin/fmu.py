@@ -502,7 +502,23 @@ def describe(path: str | Path) -> str:
                  f"Output buffer {'yes (' + OUTPUT_INTERVAL + ')' if fmu.supports_output_buffer else 'no'}"]
         for title, group in (("Inputs", fmu.inputs), ("Outputs", fmu.outputs), ("Parameters", fmu.parameters)):
             lines.append(f"\n{title} ({len(group)}):")
+            arrays: dict[str, list[Variable]] = {}
             for v in group:
+                base, bracket, _ = v.name.partition("[")
+                if bracket:
+                    arrays.setdefault(base, []).append(v)
+            shown = set()
+            for v in group:
+                base, bracket, _ = v.name.partition("[")
+                if bracket:
+                    if base in shown:
+                        continue
+                    shown.add(base)
+                    items = arrays[base]
+                    starts = [x.start for x in items if x.start is not None]
+                    rng = f"{min(starts):.4g}..{max(starts):.4g}" if starts else ""
+                    lines.append(f"  {base + f'[1..{len(items)}]':32s} {rng:>14s} {v.unit:10s} {v.description}")
+                    continue
                 start = f"{v.start:.6g}" if v.start is not None else ""
                 lines.append(f"  {v.name:32s} {start:>14s} {v.unit:10s} {v.description}")
         return "\n".join(lines)
