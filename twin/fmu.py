@@ -107,6 +107,7 @@ class FMU:
         self._buffer_interval = None
         self._scratch = None
         self._initialized = False
+        self._t_start = 0.0
 
     # -- description -----------------------------------------------------------------------
     @property
@@ -206,6 +207,7 @@ class FMU:
         """Instantiate, set parameters/inputs, and run the initialization mode."""
         self.instantiate()
         self.time = float(start_time)
+        self._t_start = float(start_time)
         self._call("fmi2SetupExperiment", self._slave.setupExperiment, None, float(start_time))
         self._call("fmi2EnterInitializationMode", self._slave.enterInitializationMode)
         if parameters:
@@ -363,7 +365,12 @@ class FMU:
         m = round((t_end - t) / output_interval). FMUs built by fmu_build fill an internal
         buffer during one doStep; other FMUs get one doStep + getReal per sample.
         """
-        m = int(round((t_end - self.time) / output_interval))
+        # snap to the sample grid t_start + k*interval, which is where the FMU samples, so float
+        # drift over many captures cannot drop or add a sample
+        k_now = round((self.time - self._t_start) / output_interval)
+        k_end = round((t_end - self._t_start) / output_interval)
+        t_end = self._t_start + k_end * output_interval
+        m = int(k_end - k_now)
         if m < 1:
             raise SimulationError(f"capture to t={t_end} s leaves no sample after t={self.time} s", time=self.time)
         block = np.empty((m, len(names)))

@@ -98,7 +98,8 @@ SCHEMA: dict[str, Any] = {
             "properties": {
                 "model": {"enum": ["pitting", "wear"]},
                 "coefficients": _NAME_MAP,
-                "cycles_per_update": _POS,
+                "cycles_per_update": {**_POS, "description": "largest jump of pinion cycles between load re-samplings"},
+                "max_increment": {**_POS, "description": "largest local damage increment per update (m of wear depth, or pitting density)"},
                 "stop": {"type": "object", "additionalProperties": False, "minProperties": 1,
                          "properties": {"pitting_density": {"type": "number", "exclusiveMinimum": 0, "maximum": 1},
                                         "wear_depth": _POS, "cycles": _POS}},

@@ -459,7 +459,7 @@ fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real t, fmi2Real h, fmi2Boolean no
     if (c->output_interval > 0) {
         for (;;) {
             double ts = c->t0 + (double)c->out_index * c->output_interval;
-            if (ts > t_end + 1e-9 * c->output_interval) break;
+            if (ts > t_end + 1e-6 * c->output_interval) break;
             if (integrate(c, ts) != 0) return fmi2Error;
             if (push_sample(c) != 0) return fmi2Error;
             c->out_index++;

@@ -1,0 +1,107 @@
+"""Damage states -> FMU k_pair / profile_deviation."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from twin.degradation.archard import ArchardWear
+from twin.degradation.base import PittingState, WearState
+from twin.degradation.geometry import GearPair
+from twin.degradation.load import MeshLoad
+from twin.degradation.mapping import HEALTHY_K_PAIR, mesh_parameters, project_on_nodes, project_wear
+from twin.errors import ParameterError
+
+GEOMETRY = GearPair()
+XI = np.linspace(0, 1, 101)
+NODES = np.linspace(0, 1, 11)
+K_KEYS = [f"k_pair[{i}]" for i in range(1, 12)]
+E_KEYS = [f"profile_deviation[{i}]" for i in range(1, 12)]
+
+
+def test_zero_damage_gives_the_healthy_parameters_exactly():
+    for update in (mesh_parameters(GEOMETRY),
+                   mesh_parameters(GEOMETRY, wear=WearState.pristine(GEOMETRY, 101),
+                                   pitting=PittingState.pristine(GEOMETRY, 101))):
+        assert list(update.parameters) == K_KEYS + E_KEYS
+        assert [update.parameters[k] for k in K_KEYS] == list(HEALTHY_K_PAIR)
+        assert [update.parameters[k] for k in E_KEYS] == [0.0] * 11
+        assert update.truncation_error == {"k_pair": 0.0, "profile_deviation": 0.0}
+
+
+def test_piecewise_linear_wear_on_the_nodes_is_exact():
+    node_depth = 1e-6 * np.array([40, 30, 22, 15, 8, 2, 6, 10, 14, 18, 20], dtype=float)
+    wear = WearState(1e5, XI, np.interp(XI, NODES, node_depth), GEOMETRY)
+    update = mesh_parameters(GEOMETRY, wear=wear)
+    assert np.allclose([update.parameters[k] for k in E_KEYS], node_depth, rtol=0, atol=1e-15)
+    assert update.truncation_error["profile_deviation"] < 1e-15
+    assert [update.parameters[k] for k in K_KEYS] == list(HEALTHY_K_PAIR)
+
+
+def test_uniform_pitting_scales_the_stiffness():
+    pitting = PittingState(1e6, XI, np.full(101, 0.1), GEOMETRY)
+    update = mesh_parameters(GEOMETRY, pitting=pitting)
+    assert np.allclose([update.parameters[k] for k in K_KEYS], 0.9 * np.array(HEALTHY_K_PAIR), rtol=1e-12)
+    assert update.truncation_error["k_pair"] < 1e-12
+
+
+def test_truncation_error_of_a_field_between_the_nodes():
+    # A wear bump narrower than a node interval: the nodes cannot follow it.
+    depth = 10e-6 * np.exp(-((XI - 0.23) / 0.02) ** 2)
+    update = mesh_parameters(GEOMETRY, wear=WearState(1.0, XI, depth, GEOMETRY))
+    nodes = np.array([update.parameters[k] for k in E_KEYS])
+    assert nodes.min() >= 0
+    fitted = np.interp(XI, NODES, nodes)
+    assert update.truncation_error["profile_deviation"] == pytest.approx(np.abs(fitted - depth).max())
+    assert 1e-6 < update.truncation_error["profile_deviation"] < 10e-6
+    # The same for the stiffness, relative to the local healthy value.
+    density = 0.5 * (np.abs(XI - 0.45) < 0.05)
+    update = mesh_parameters(GEOMETRY, pitting=PittingState(1.0, XI, density, GEOMETRY))
+    k_nodes = np.array([update.parameters[k] for k in K_KEYS])
+    k_field = np.interp(XI, NODES, HEALTHY_K_PAIR) * (1 - density)
+    expected = np.abs(np.interp(XI, NODES, k_nodes) - k_field) / np.interp(XI, NODES, HEALTHY_K_PAIR)
+    assert update.truncation_error["k_pair"] == pytest.approx(expected.max())
+    assert 0 < update.truncation_error["k_pair"] < 0.5
+
+
+def test_custom_healthy_stiffness_and_node_count():
+    healthy = np.linspace(1e8, 2e8, 6)
+    update = mesh_parameters(GEOMETRY, k_pair_healthy=healthy, n_nodes=6)
+    expected = [f"k_pair[{i}]" for i in range(1, 7)] + [f"profile_deviation[{i}]" for i in range(1, 7)]
+    assert list(update.parameters) == expected
+    assert [update.parameters[f"k_pair[{i}]"] for i in range(1, 7)] == list(healthy)
+
+
+def test_pitting_reduces_the_load_share_through_the_static_load():
+    density = np.where(XI < 0.3, 0.5, 0.0)
+    update = mesh_parameters(GEOMETRY, pitting=PittingState(1e6, XI, density, GEOMETRY))
+    healthy = MeshLoad.static(GEOMETRY, 7.3)
+    pitted = MeshLoad.static(GEOMETRY, 7.3, parameters=update.parameters)
+    assert pitted.force_at(0.1) < 0.8 * healthy.force_at(0.1)
+    assert pitted.force_at(0.5) == pytest.approx(healthy.force_at(0.5))   # single-pair zone: all of it anyway
+
+
+def test_project_wear_is_the_fmu_view_and_keeps_the_volume():
+    model = ArchardWear()
+    wear = model.advance(model.initial_state(GEOMETRY), MeshLoad.static(GEOMETRY, 1.83), 1e5, 62.8)
+    projected = project_wear(wear)
+    nodes = [mesh_parameters(GEOMETRY, wear=wear).parameters[k] for k in E_KEYS]
+    assert np.allclose(projected.depth, np.interp(XI, NODES, nodes), rtol=0, atol=1e-18)
+    assert projected.cycles == wear.cycles and projected.geometry == wear.geometry
+    assert projected.mean_depth == pytest.approx(wear.mean_depth, rel=0.02)
+    assert mesh_parameters(GEOMETRY, wear=projected).truncation_error["profile_deviation"] < 1e-12
+
+
+def test_invalid_inputs_raise_typed_errors_naming_the_value():
+    with pytest.raises(ParameterError, match="got 10"):
+        mesh_parameters(GEOMETRY, k_pair_healthy=HEALTHY_K_PAIR[:10])
+    with pytest.raises(ParameterError, match="-1.0"):
+        mesh_parameters(GEOMETRY, k_pair_healthy=(-1.0,) + HEALTHY_K_PAIR[1:])
+    with pytest.raises(ParameterError, match="n_nodes"):
+        mesh_parameters(GEOMETRY, n_nodes=1)
+    other = GearPair(face_width=0.03)
+    with pytest.raises(ParameterError, match="face_width=0.03"):
+        mesh_parameters(GEOMETRY, wear=WearState.pristine(other, 11))
+    with pytest.raises(ParameterError, match="PittingState"):
+        mesh_parameters(GEOMETRY, pitting=WearState.pristine(GEOMETRY, 11))
+    with pytest.raises(ParameterError, match="too coarse"):
+        project_on_nodes(np.linspace(0, 1, 5), np.ones(5), 11)

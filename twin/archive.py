@@ -1,0 +1,216 @@
+"""The degradation archive: labelled vibration records for each damage stage (source domain).
+
+``build_archive(scenario)``:
+
+1. runs the scenario's degradation (:func:`twin.degradation_run.run_degradation`) from the
+   healthy mesh to its stop criterion; each update gives the damage measure (pitting density,
+   or mean wear depth in m) and the FMU mesh parameters at that damage;
+2. for every stage [lo, hi) of ``archive.stages``, draws ``records_per_stage`` damage values
+   uniformly in the stage, interpolates the mesh parameters at each value between the
+   updates around it, and scatters the operating point (speed and load, relative normal
+   scatter) with a per-record seed;
+3. simulates the records in parallel (local processes by default, Dask when the scenario's
+   ``executor`` says so), each ``settle_time`` + ``record_duration`` seconds long, keeps the
+   last ``record_duration`` seconds, and adds white measurement noise relative to the record's RMS.
+
+The result is deterministic for a given scenario and seed, whatever the executor and worker
+count. It is written atomically to HDF5 in the measurement layout (one group per record).
+"""
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from twin.errors import ScenarioError, SimulationError
+from twin.executor import make_executor
+from twin.scenario import Scenario
+
+ARCHIVE_FORMAT = "gear-twin-archive"
+
+
+@dataclass(frozen=True)
+class RecordTask:
+    """Everything one worker needs to simulate one record (picklable)."""
+
+    index: int
+    fmu_path: str
+    parameters: dict
+    inputs: dict
+    settle_time: float
+    duration: float
+    output_interval: float
+    channels: tuple
+    noise: float
+    seed: int
+
+
+def simulate_record(task: RecordTask) -> dict[str, np.ndarray]:
+    """Simulate one archive record; returns channel -> (n,) float32 array (noise added)."""
+    from twin.fmu import FMU
+    with FMU(task.fmu_path) as fmu:
+        fmu.setup(0.0, parameters=task.parameters, inputs=task.inputs)
+        if task.settle_time > 0:
+            fmu.capture(task.settle_time, task.output_interval, list(task.channels))
+        block = fmu.capture(task.settle_time + task.duration, task.output_interval, list(task.channels))
+    rng = np.random.default_rng(task.seed)
+    out = {}
+    for j, c in enumerate(task.channels):
+        x = block[:, j]
+        if task.noise > 0:
+            x = x + rng.normal(0.0, task.noise * float(np.sqrt(np.mean(x ** 2))), size=x.shape)
+        out[c] = x.astype(np.float32)
+    return out
+
+
+@dataclass(frozen=True)
+class Archive:
+    labels: np.ndarray          # (n,) stage index
+    damage: np.ndarray          # (n,) damage measure of each record
+    speed: np.ndarray           # (n,) shaft speed [Hz]
+    load: np.ndarray            # (n,) load torque [N.m]
+    signals: dict               # channel -> (n, samples) float32
+    sample_rate: float
+    stages: tuple               # stage boundaries
+    damage_kind: str            # "pitting_density" or "wear_depth"
+    path: Path | None = None
+
+
+def interpolate_parameters(damages: np.ndarray, parameter_sets: list[dict], value: float) -> dict:
+    """Mesh parameters at damage ``value``, linear between the two updates that bracket it."""
+    damages = np.asarray(damages, dtype=float)
+    if value > damages[-1] + 1e-12 or value < damages[0] - 1e-12:
+        raise SimulationError(f"damage {value:.4g} is outside the simulated range "
+                              f"[{damages[0]:.4g}, {damages[-1]:.4g}]; extend the degradation stop criterion")
+    i = int(np.clip(np.searchsorted(damages, value, side="right") - 1, 0, len(damages) - 2))
+    d0, d1 = damages[i], damages[i + 1]
+    w = 0.0 if d1 == d0 else (value - d0) / (d1 - d0)
+    a, b = parameter_sets[i], parameter_sets[i + 1]
+    return {k: (1 - w) * a[k] + w * b[k] for k in a}
+
+
+def build_archive(scenario: Scenario, output: str | Path | None = None, *, progress: bool = True,
+                  fmu_path: Path | None = None, executor=None) -> Archive:
+    """Build the archive described by ``scenario.archive`` (see the module docstring)."""
+    from twin.degradation_run import run_degradation
+
+    spec = scenario.archive
+    if spec is None:
+        raise ScenarioError([(str(scenario.source), "archive", "the scenario has no archive block")])
+    path = Path(output) if output is not None else None
+    if path is not None:
+        from twin.results import check_output_path
+        check_output_path(path)
+    fmu_file = fmu_path or scenario.fmu_path()
+    run = run_degradation(scenario, None, fmu_path=fmu_file, progress=progress, channels=("accel_pinion_casing",))
+    damages = run.damage
+    if np.any(np.diff(damages) < 0):
+        raise SimulationError("the damage measure decreased during the degradation run")
+    params = [s.parameters for s in run.stages]
+    bounds = [float(b) for b in spec["stages"]]
+    if bounds[-1] > damages[-1] * (1 + 1e-9):
+        raise SimulationError(f"the degradation run reached {damages[-1]:.4g}, short of the last stage boundary "
+                              f"{bounds[-1]:.4g}; raise its stop criterion or max_updates")
+    per_stage = int(spec.get("records_per_stage", 50))
+    duration = float(spec.get("record_duration", 0.2))
+    settle = float(spec.get("settle_time", 0.05))
+    speed_sd = float(spec.get("speed_scatter", 0.0))
+    load_sd = float(spec.get("load_scatter", 0.0))
+    noise = float(spec.get("noise", 0.0))
+    channels = tuple(scenario.outputs or ("accel_pinion_casing",))
+    speed_input = next((n for n in scenario.inputs if n == "motor_speed_ref"), None)
+    load_input = next((n for n in scenario.inputs if n == "load_torque"), None)
+    nominal_speed = scenario.inputs[speed_input](scenario.start_time) / (2 * math.pi) if speed_input else 20.0
+    nominal_load = scenario.inputs[load_input](scenario.start_time) if load_input else 20.0
+
+    seq = np.random.SeedSequence(scenario.seed)
+    draw = np.random.default_rng(seq.spawn(1)[0])
+    record_seeds = seq.spawn(len(bounds) * per_stage + 1)[1:]
+    tasks, labels, dmg, speeds, loads = [], [], [], [], []
+    k = 0
+    for s, (lo, hi) in enumerate(zip(bounds, bounds[1:])):
+        for _ in range(per_stage):
+            d = float(draw.uniform(lo, hi))
+            f = nominal_speed * (1 + speed_sd * float(draw.standard_normal()))
+            t_load = nominal_load * (1 + load_sd * float(draw.standard_normal()))
+            p = dict(scenario.parameters)
+            p.update(interpolate_parameters(damages, params, d))
+            # start the record at its own steady operating point
+            p.update({"speed_ref_start": 2 * math.pi * f, "load_start": t_load})
+            inputs = {"motor_speed_ref": 2 * math.pi * f, "load_torque": t_load}
+            tasks.append(RecordTask(k, str(fmu_file), p, inputs, settle, duration, scenario.output_interval,
+                                    channels, noise, int(record_seeds[k].generate_state(1)[0])))
+            labels.append(s)
+            dmg.append(d)
+            speeds.append(f)
+            loads.append(t_load)
+            k += 1
+    ex = executor or make_executor(scenario.executor)
+    try:
+        results = ex.map(simulate_record, tasks, progress=progress, desc=f"{scenario.name} archive")
+    finally:
+        if executor is None:
+            ex.close()
+    failed = [(t.index, r) for t, r in zip(tasks, results) if isinstance(r, Exception)]
+    if failed:
+        i, err = failed[0]
+        raise SimulationError(f"{len(failed)} of {len(tasks)} archive records failed; first (record {i}): {err}")
+    signals = {c: np.stack([r[c] for r in results]) for c in channels}
+    kind = "pitting_density" if run.model == "pitting" else "wear_depth"
+    archive = Archive(np.array(labels), np.array(dmg), np.array(speeds), np.array(loads), signals,
+                      scenario.sample_rate, tuple(bounds), kind, path)
+    if path is not None:
+        write_archive(archive, path, scenario, run)
+    return archive
+
+
+def write_archive(archive: Archive, path: Path, scenario: Scenario, run=None) -> Path:
+    """HDF5, measurement layout: ``/records/<id>`` groups with 1-D channels and record attributes."""
+    import h5py
+
+    from twin._atomic import atomic_path
+    with atomic_path(path) as tmp:
+        with h5py.File(tmp, "w", track_order=True) as f:
+            f.attrs["format"] = ARCHIVE_FORMAT
+            f.attrs["format_version"] = 1
+            f.attrs["sample_rate"] = archive.sample_rate
+            f.attrs["damage_kind"] = archive.damage_kind
+            f.attrs["stages"] = np.asarray(archive.stages)
+            f.attrs["scenario"] = json.dumps(scenario.raw, default=str)
+            f.attrs["seed"] = scenario.seed
+            recs = f.create_group("records", track_order=True)
+            for i in range(archive.labels.size):
+                g = recs.create_group(f"{i:06d}")
+                g.attrs["label"] = int(archive.labels[i])
+                g.attrs["damage"] = float(archive.damage[i])
+                g.attrs["sample_rate"] = archive.sample_rate
+                g.attrs["nominal_speed"] = float(archive.speed[i])
+                g.attrs["load"] = float(archive.load[i])
+                for c, arr in archive.signals.items():
+                    ds = g.create_dataset(c, data=arr[i])
+                    ds.attrs["unit"] = "m/s2" if c.startswith("accel") else ""
+            if run is not None:
+                d = f.create_group("degradation")
+                d.create_dataset("cycles", data=run.cycles)
+                d.create_dataset("damage", data=run.damage)
+    return path
+
+
+def read_archive(path: str | Path) -> Archive:
+    import h5py
+    path = Path(path)
+    with h5py.File(path, "r") as f:
+        if f.attrs.get("format") != ARCHIVE_FORMAT:
+            raise SimulationError(f"{path} is not a gear-twin archive")
+        keys = list(f["records"])
+        first = f["records"][keys[0]]
+        channels = list(first)
+        signals = {c: np.stack([f["records"][k][c][:] for k in keys]) for c in channels}
+        attrs = [f["records"][k].attrs for k in keys]
+        return Archive(np.array([a["label"] for a in attrs]), np.array([a["damage"] for a in attrs]),
+                       np.array([a["nominal_speed"] for a in attrs]), np.array([a["load"] for a in attrs]),
+                       signals, float(f.attrs["sample_rate"]), tuple(f.attrs["stages"]),
+                       str(f.attrs["damage_kind"]), path)

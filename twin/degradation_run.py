@@ -1,0 +1,256 @@
+"""Degradation runs: the FMU and a degradation model coupled between co-simulation steps.
+
+At each update (stage):
+
+1. co-simulate a short window (``load_window``, default 0.1 s = two pinion revolutions at
+   20 Hz) and sample the load each tooth pair carries along the path of contact
+   (``roll[i]``, ``pair_force[i]``) and the pinion speed;
+2. record a vibration snippet (``record_duration``) for the stage;
+3. advance the wear or pitting model by a jump of pinion cycles with that load (cycle
+   jumping: the load is assumed steady over the jump). The jump is the smaller of
+   ``cycles_per_update`` and the cycles after which the largest local damage increment reaches
+   ``max_increment`` (default 3 um of wear depth or 0.01 of pitting density), so the load is
+   re-sampled as often as the damage needs;
+4. turn the damage into the FMU's mesh parameters (``k_pair``, ``profile_deviation``) and
+   set them on the FMU, so the next window runs on the degraded mesh. A wear field is then
+   projected back onto the 11 nodes the FMU sees, so that state and simulation agree.
+
+The run stops on the scenario's criterion (pitting density, wear depth or cycles) or after
+``max_updates``.  After every stage the whole record is rewritten atomically, so an
+interrupted run keeps its completed stages and ``resume=True`` continues from the last one.
+"""
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from twin.errors import ScenarioError, SimulationError
+from twin.fmu import FMU
+from twin.orchestrator import check_compatibility
+from twin.scenario import Scenario
+
+ROLL = [f"roll[{i}]" for i in (1, 2, 3)]
+FORCE = [f"pair_force[{i}]" for i in (1, 2, 3)]
+
+
+@dataclass(frozen=True)
+class Stage:
+    """One update of a degradation run."""
+
+    index: int
+    cycles: float                       # pinion cycles run so far
+    damage: float                       # pitting density (0-1) or mean wear depth [m]
+    max_damage: float                   # max over the flank: density or depth [m]
+    parameters: dict[str, float]        # mesh parameters in force during this stage's record
+    field_xi: np.ndarray                # (n,) roll positions of the damage field
+    field: np.ndarray                   # (n,) pitting density or wear depth [m]
+    truncation_error: dict[str, float]
+    vibration: dict[str, np.ndarray] = field(default_factory=dict)   # snippet per channel
+
+
+@dataclass(frozen=True)
+class DegradationRun:
+    scenario: Scenario
+    model: str                          # "pitting" or "wear"
+    stages: tuple[Stage, ...]
+    complete: bool
+    sample_rate: float
+
+    @property
+    def damage(self) -> np.ndarray:
+        return np.array([s.damage for s in self.stages])
+
+    @property
+    def cycles(self) -> np.ndarray:
+        return np.array([s.cycles for s in self.stages])
+
+    def summary(self) -> str:
+        last = self.stages[-1]
+        what = (f"pitting density {100 * last.damage:.1f} %" if self.model == "pitting"
+                else f"mean wear depth {1e6 * last.damage:.1f} um")
+        return f"{what} after {last.cycles:.3g} cycles"
+
+
+def _model(spec: dict[str, Any]):
+    from twin.degradation import ArchardWear, FatiguePitting
+    coeffs = dict(spec.get("coefficients", {}))
+    try:
+        if spec["model"] == "pitting":
+            return FatiguePitting(**coeffs)
+        return ArchardWear(**coeffs)
+    except TypeError as exc:
+        raise ScenarioError([("<scenario>", "degradation.coefficients", str(exc))]) from None
+
+
+def _damage(model_name: str, state) -> tuple[float, float, np.ndarray, np.ndarray]:
+    if model_name == "pitting":
+        return float(state.pitting_density), float(np.max(state.density)), state.xi, state.density
+    return float(state.mean_depth), float(state.max_depth), state.xi, state.depth
+
+
+def _stop_reached(spec, model_name, damage, cycles) -> bool:
+    stop = spec.get("stop", {})
+    if "cycles" in stop and cycles >= stop["cycles"]:
+        return True
+    if model_name == "pitting" and "pitting_density" in stop and damage >= stop["pitting_density"]:
+        return True
+    if model_name == "wear" and "wear_depth" in stop and damage >= stop["wear_depth"]:
+        return True
+    return False
+
+
+def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu_path: Path | None = None,
+                    progress: bool = True, resume: bool = False,
+                    channels: tuple[str, ...] | None = None) -> DegradationRun:
+    """Run the scenario's degradation block; write the stages to ``output`` (HDF5) if given."""
+    from twin.degradation import GearPair, MeshLoad, mesh_parameters, project_wear
+
+    spec = scenario.degradation
+    if spec is None:
+        raise ScenarioError([(str(scenario.source), "degradation", "the scenario has no degradation block")])
+    model_name = spec["model"]
+    model = _model(spec)
+    path = Path(output) if output is not None else None
+    if path is not None:
+        from twin.results import check_output_path
+        check_output_path(path)
+    dn_cap = float(spec.get("cycles_per_update", 1e7))
+    max_increment = float(spec.get("max_increment", 3e-6 if model_name == "wear" else 0.01))
+    max_updates = int(spec.get("max_updates", 1000))
+    window = float(spec.get("load_window", 0.1))
+    rec_dur = float(spec.get("record_duration", 0.05))
+    dt = scenario.output_interval
+    channels = channels or scenario.outputs or ("accel_pinion_casing",)
+    fmu_file = fmu_path or scenario.fmu_path()
+
+    stages: list[Stage] = []
+    complete = False
+    with FMU(fmu_file) as fmu:
+        check_compatibility(fmu, scenario)
+        geometry_values = {v.name: fmu.get(v.name) for v in fmu.parameters if "[" not in v.name}
+        geometry_values.update({k: v for k, v in scenario.parameters.items() if "[" not in k})
+        geometry = GearPair.from_parameters(geometry_values)
+        k_healthy = tuple(scenario.parameters.get(f"k_pair[{i}]", fmu.variable(f"k_pair[{i}]").start)
+                          for i in range(1, 12))
+        state = model.initial_state(geometry)
+        if resume and path is not None and path.exists():
+            stages, state = _load_for_resume(path, model, model_name, geometry)
+        t0 = scenario.start_time
+        inputs = {n: p(t0) for n, p in scenario.inputs.items()}
+        params = dict(scenario.parameters)
+        if stages:
+            params.update(stages[-1].parameters)
+        fmu.setup(t0, parameters=params, inputs=inputs)
+        fmu.capture(t0 + 0.05, dt, ["mesh_force"])        # settle the lateral static deflection
+        bar = _bar(max_updates, progress, scenario.name)
+        bar.update(len(stages))
+        try:
+            for u in range(len(stages), max_updates):
+                t = fmu.time
+                names = [*ROLL, *FORCE, "motor_speed"]
+                block = fmu.capture(t + window, dt, names)
+                load = MeshLoad.from_samples(block[:, 0:3], block[:, 3:6])
+                omega1 = float(np.mean(block[:, 6]))
+                vib = {}
+                if rec_dur > 0:
+                    snip = fmu.capture(fmu.time + rec_dur, dt, list(channels))
+                    vib = {c: snip[:, j].astype(np.float32) for j, c in enumerate(channels)}
+                damage, dmax, xi, fld = _damage(model_name, state)
+                current = {f"k_pair[{i}]": fmu.get(f"k_pair[{i}]") for i in range(1, 12)}
+                current.update({f"profile_deviation[{i}]": fmu.get(f"profile_deviation[{i}]") for i in range(1, 12)})
+                trunc = stages[-1].truncation_error if stages else {}
+                stages.append(Stage(u, float(state.cycles), damage, dmax, current, np.asarray(xi), np.asarray(fld),
+                                    trunc, vib))
+                bar.update(1)
+                if path is not None:
+                    _write(path, scenario, model_name, stages, dt, complete=False, state=state)
+                if _stop_reached(spec, model_name, damage, state.cycles):
+                    complete = True
+                    break
+                dn = min(dn_cap, model.cycles_for_increment(state, load, omega1, max_increment, max_cycles=dn_cap))
+                stop_cycles = spec.get("stop", {}).get("cycles")
+                if stop_cycles is not None:
+                    dn = min(dn, max(stop_cycles - state.cycles, 1.0))
+                state = model.advance(state, load, dn, omega1)
+                update = mesh_parameters(geometry, wear=state if model_name == "wear" else None,
+                                         pitting=state if model_name == "pitting" else None,
+                                         k_pair_healthy=k_healthy)
+                if model_name == "wear":
+                    state = project_wear(state)
+                fmu.set(update.parameters)
+                stages[-1] = Stage(**{**stages[-1].__dict__, "truncation_error": dict(update.truncation_error)})
+            else:
+                complete = not spec.get("stop")
+        except KeyboardInterrupt:
+            complete = False
+        finally:
+            bar.close()
+    run = DegradationRun(scenario, model_name, tuple(stages), complete, scenario.sample_rate)
+    if path is not None and stages:
+        _write(path, scenario, model_name, stages, dt, complete=complete, state=None)
+    return run
+
+
+def _write(path: Path, scenario: Scenario, model_name: str, stages: list[Stage], dt: float, *, complete: bool,
+           state) -> None:
+    import h5py
+
+    from twin._atomic import atomic_path
+    with atomic_path(path) as tmp:
+        with h5py.File(tmp, "w", track_order=True) as f:
+            f.attrs["format"] = "gear-twin-degradation"
+            f.attrs["format_version"] = 1
+            f.attrs["model"] = model_name
+            f.attrs["complete"] = complete
+            f.attrs["sample_rate"] = 1.0 / dt
+            f.attrs["damage_unit"] = "1" if model_name == "pitting" else "m"
+            f.create_group("scenario").attrs["json"] = json.dumps(scenario.raw, default=str)
+            f.create_dataset("cycles", data=[s.cycles for s in stages])
+            f.create_dataset("damage", data=[s.damage for s in stages])
+            f.create_dataset("max_damage", data=[s.max_damage for s in stages])
+            g = f.create_group("stages", track_order=True)
+            for s in stages:
+                sg = g.create_group(f"{s.index:05d}")
+                sg.attrs["cycles"] = s.cycles
+                sg.attrs["damage"] = s.damage
+                sg.attrs["parameters"] = json.dumps(s.parameters)
+                sg.attrs["truncation_error"] = json.dumps(s.truncation_error)
+                sg.create_dataset("field_xi", data=s.field_xi)
+                sg.create_dataset("field", data=s.field)
+                for c, v in s.vibration.items():
+                    sg.create_dataset(f"vibration/{c}", data=v, compression="gzip", compression_opts=4)
+
+
+def _load_for_resume(path: Path, model, model_name: str, geometry):
+    import h5py
+    stages = []
+    with h5py.File(path, "r") as f:
+        if f.attrs.get("format") != "gear-twin-degradation" or f.attrs.get("model") != model_name:
+            raise SimulationError(f"{path} is not a {model_name} degradation record; cannot resume from it")
+        for key in f["stages"]:
+            sg = f["stages"][key]
+            vib = {c: sg["vibration"][c][:] for c in sg.get("vibration", {})}
+            stages.append(Stage(int(key), float(sg.attrs["cycles"]), float(sg.attrs["damage"]),
+                                float(np.max(sg["field"][:])), json.loads(sg.attrs["parameters"]),
+                                sg["field_xi"][:], sg["field"][:], json.loads(sg.attrs["truncation_error"]), vib))
+    last = stages[-1]
+    state = model.state_from_field(geometry, last.cycles, last.field_xi, last.field)
+    # the last stage is re-run from its state so its update is applied again
+    return stages[:-1], state
+
+
+def _bar(total, enabled, desc):
+    if not enabled:
+        class _No:
+            def update(self, n):
+                pass
+
+            def close(self):
+                pass
+        return _No()
+    from tqdm import tqdm
+    return tqdm(total=total, desc=f"{desc} stages", unit="stage", leave=False)
