@@ -128,6 +128,27 @@ def _cmd_run(args: argparse.Namespace) -> int:
     return 0 if rec.complete else 130
 
 
+def _cmd_archive(args: argparse.Namespace) -> int:
+    scenario = _lib("twin.scenario").load_scenario(Path(args.scenario))
+    if scenario.archive is None:
+        raise _lib("twin.errors").ScenarioError([(str(args.scenario), "archive", "the scenario has no archive block")])
+    arc = dict(scenario.archive)
+    if args.records_per_stage is not None:
+        arc["records_per_stage"] = args.records_per_stage
+    executor = dict(scenario.executor)
+    if args.workers is not None:
+        executor["workers"] = args.workers
+    if args.scheduler:
+        executor = {"type": "dask", "address": args.scheduler}
+    scenario = scenario.with_overrides(archive=arc, executor=executor,
+                                       seed=args.seed if args.seed is not None else scenario.seed)
+    out = Path(args.out) if args.out else Path(f"{scenario.name}_archive.h5")
+    archive = _lib("twin.archive").build_archive(scenario, out, progress=not args.no_progress)
+    print(f"{scenario.name}: {archive.labels.size} records in {len(archive.stages) - 1} stages "
+          f"({archive.damage_kind}) -> {out}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """Return the ``twin`` argument parser (one sub-parser per command)."""
     parser = argparse.ArgumentParser(
@@ -172,6 +193,16 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--resume", action="store_true", help="degradation runs: continue from the last completed stage")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     p.set_defaults(handler=_cmd_run)
+
+    p = sub.add_parser("archive", help="simulate the labelled degradation archive of a scenario")
+    p.add_argument("scenario", metavar="SCENARIO", help="scenario .yaml with degradation and archive blocks")
+    p.add_argument("--out", help="archive HDF5 file (default: <scenario name>_archive.h5)")
+    p.add_argument("--records-per-stage", type=int, help="override archive.records_per_stage")
+    p.add_argument("--workers", type=int, help="local worker processes (default: one per core)")
+    p.add_argument("--scheduler", help="address of a dask.distributed scheduler (tcp://host:port)")
+    p.add_argument("--seed", type=int, help="override the scenario's seed")
+    p.add_argument("--no-progress", action="store_true", help="hide the progress bars")
+    p.set_defaults(handler=_cmd_archive)
 
     p = sub.add_parser("schema", help="print the JSON Schema of scenario files")
     p.set_defaults(handler=_cmd_schema)

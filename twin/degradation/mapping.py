@@ -130,7 +130,11 @@ def mesh_parameters(geometry: GearPair, *, wear: WearState | None = None, pittin
     else:
         k_local_healthy = interp_nodes(healthy, pitting.xi)
         k_field = k_local_healthy * (1.0 - pitting.density)
-        k_nodes, _ = project_on_nodes(pitting.xi, k_field, n_nodes)
+        # Fit the stiffness *loss* (>= 0), not the stiffness: the non-negative fit then cannot
+        # overshoot above the healthy stiffness next to the density jump at the start of
+        # single-tooth contact -- pitting never adds stiffness.
+        loss_nodes, _ = project_on_nodes(pitting.xi, k_local_healthy * pitting.density, n_nodes)
+        k_nodes = healthy - np.minimum(loss_nodes, healthy)
         k_err = float(np.max(np.abs(interp_nodes(k_nodes, pitting.xi) - k_field) / k_local_healthy))
     if wear is None or not np.any(wear.depth > 0):
         e_nodes, e_err = np.zeros(n_nodes), 0.0

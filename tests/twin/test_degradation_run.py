@@ -1,0 +1,81 @@
+"""twin.degradation_run: the FMU and the degradation models coupled between co-simulation steps."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+from twin.degradation_run import run_degradation
+from twin.scenario import load_scenario
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def _lubricated(stop=0.04, **deg):
+    sc = load_scenario(REPO / "scenarios" / "lubricated.yaml")
+    d = dict(sc.degradation)
+    d.update({"stop": {"pitting_density": stop}, "load_window": 0.05, "record_duration": 0.01, **deg})
+    return sc.with_overrides(degradation=d)
+
+
+def test_pitting_grows_and_lowers_mesh_stiffness(gearbox_fmu, tmp_path):
+    run = run_degradation(_lubricated(), tmp_path / "lub.h5", fmu_path=gearbox_fmu, progress=False)
+    assert run.complete
+    assert np.all(np.diff(run.damage) > 0) and np.all(np.diff(run.cycles) > 0)
+    assert run.damage[-1] >= 0.04
+    first, last = run.stages[0], run.stages[-1]
+    k0 = np.array([first.parameters[f"k_pair[{i}]"] for i in range(1, 12)])
+    k1 = np.array([last.parameters[f"k_pair[{i}]"] for i in range(1, 12)])
+    assert np.all(k1 <= k0 + 1e-6) and np.any(k1 < 0.99 * k0)    # pitting only removes stiffness
+    assert "accel_pinion_casing" in last.vibration
+    with h5py.File(tmp_path / "lub.h5") as f:
+        assert f.attrs["complete"] and f.attrs["model"] == "pitting"
+        assert len(f["stages"]) == len(run.stages)
+
+
+def test_wear_moves_the_profile(gearbox_fmu):
+    sc = load_scenario(REPO / "scenarios" / "dry.yaml")
+    d = dict(sc.degradation)
+    d.update({"stop": {"wear_depth": 1e-5}, "load_window": 0.1, "record_duration": 0.0})
+    run = run_degradation(sc.with_overrides(degradation=d), None, fmu_path=gearbox_fmu, progress=False)
+    dev = np.array([run.stages[-1].parameters[f"profile_deviation[{i}]"] for i in range(1, 12)])
+    assert run.damage[-1] >= 1e-5
+    assert dev.max() > 5e-6 and dev.min() >= 0
+    # wear is largest where sliding is largest (ends of the path), smallest near the pitch point
+    assert dev[0] > dev[5] and dev[-1] > dev[5]
+
+
+def test_resume_continues_from_last_stage(gearbox_fmu, tmp_path):
+    out = tmp_path / "r.h5"
+    part = run_degradation(_lubricated(stop=0.02), out, fmu_path=gearbox_fmu, progress=False)
+    full = run_degradation(_lubricated(stop=0.04), out, fmu_path=gearbox_fmu, progress=False, resume=True)
+    assert full.stages[0].cycles == part.stages[0].cycles
+    assert len(full.stages) > len(part.stages)
+    assert full.damage[-1] >= 0.04
+    np.testing.assert_allclose(full.damage[:len(part.stages) - 1], part.damage[:-1])
+
+
+def test_interrupt_keeps_completed_stages(gearbox_fmu, tmp_path, monkeypatch):
+    import twin.degradation_run as dr
+    calls = {"n": 0}
+    real = dr.FMU.capture
+
+    def flaky(self, *a, **k):
+        calls["n"] += 1
+        if calls["n"] == 8:
+            raise KeyboardInterrupt
+        return real(self, *a, **k)
+
+    monkeypatch.setattr(dr.FMU, "capture", flaky)
+    run = run_degradation(_lubricated(), tmp_path / "i.h5", fmu_path=gearbox_fmu, progress=False)
+    assert not run.complete and len(run.stages) >= 2
+    with h5py.File(tmp_path / "i.h5") as f:
+        assert not f.attrs["complete"] and len(f["stages"]) == len(run.stages)
+
+
+def test_bad_coefficients_are_a_scenario_error(gearbox_fmu):
+    from twin.errors import ScenarioError
+    with pytest.raises(ScenarioError, match="coefficients"):
+        run_degradation(_lubricated(coefficients={"wear_rate": 1.0}), None, fmu_path=gearbox_fmu, progress=False)
