@@ -238,3 +238,49 @@ def plot_time(
     if title:
         fig.suptitle(title)
     return _save(fig, target)
+
+
+def plot_degradation_stages(stages: Sequence[tuple[str, "SimulationResult"]], path: str | os.PathLike[str], *,
+                            stiffness: str = "mesh_stiffness", channel: str = "accel_pinion_casing",
+                            mesh_period: float | None = None, fmax: float = 3000.0,
+                            title: str | None = None) -> Path:
+    """Mesh stiffness over two mesh cycles and the PSD of ``channel``, one curve per stage.
+
+    ``stages`` is a list of (label, result); each result must hold ``stiffness`` [N/m] and
+    ``channel``. ``mesh_period`` [s] sets the stiffness window (default: 2/380 s).
+    """
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from scipy.signal import welch
+
+    target = Path(path)
+    if target.suffix.lower() != ".png":
+        raise OutputPathError(f"plot path must end in .png, got {target.suffix!r}")
+    window = 2 * (mesh_period or 1 / 380.0)
+    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(10, 8))
+    cmap = plt.get_cmap("viridis")
+    for i, (label, res) in enumerate(stages):
+        color = cmap(i / max(len(stages) - 1, 1))
+        t = res.time
+        sel = t >= t[-1] - window
+        ax1.plot(1e3 * (t[sel] - t[sel][0]), res[stiffness][sel] / 1e6, color=color, label=label)
+        f, p = welch(res[channel], fs=res.sample_rate, nperseg=min(res.time.size, int(res.sample_rate / 10)))
+        keep = f <= fmax
+        ax2.semilogy(f[keep], p[keep], color=color, lw=0.8, label=label)
+    ax1.set_xlabel("time [ms]")
+    ax1.set_ylabel("mesh stiffness [N/um]")
+    ax1.set_title("Mesh stiffness over two mesh cycles")
+    ax1.legend(fontsize=8, ncol=3)
+    ax1.grid(alpha=0.3)
+    ax2.set_xlabel("frequency [Hz]")
+    ax2.set_ylabel(f"PSD of {channel} [(m/s2)^2/Hz]")
+    ax2.grid(alpha=0.3)
+    ax2.legend(fontsize=8, ncol=3)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    with atomic_path(target) as tmp:
+        fig.savefig(tmp, format="png", dpi=110)
+    plt.close(fig)
+    return target
