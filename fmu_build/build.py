@@ -21,7 +21,7 @@ from xml.sax.saxutils import escape
 
 from twin.errors import BuildError
 
-BUILDER_VERSION = "3"
+BUILDER_VERSION = "4"
 DEFAULT_STEP_SIZE = 5e-6
 _HERE = Path(__file__).resolve().parent
 _TEMPLATE = _HERE / "templates" / "fmi2_wrapper.c"
@@ -205,6 +205,7 @@ def _generate_c(ode, src: Path, prefix: str, guid: str, step_size: float) -> Non
 #define N_Y {ny}
 #define N_P {np_}
 #define N_Q {nq}
+#define N_QALL {nq + ode.n_hidden}
 #define N_C_ {len(ode.constants)}
 #define VR_P0 {lay['p']}
 #define VR_Q0 {lay['q']}

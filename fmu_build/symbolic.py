@@ -63,6 +63,7 @@ class OdeModel:
     init: ca.Function
     derived: ca.Function
     notes: list[str] = field(default_factory=list)
+    n_hidden: int = 0          # hoisted parameter-only subexpressions appended to q (not FMU variables)
 
 
 def _is_sym(v) -> bool:
@@ -558,6 +559,16 @@ def build_ode(flat: FlatModel) -> OdeModel:
     x0.sort()
     x0_exprs = [ca.SX(v) for _, v in x0]
 
+    # Parameter-only subexpressions (sin(alpha), products of parameters, ...) are moved into the
+    # derived function, which runs once per parameter change instead of 4x per RK4 step.
+    dynamic = {s.__hash__() for s in [t, *x_syms, *u_syms]}
+    rebuilt, h_syms, h_exprs = hoist_static([*xdot, *y_exprs], dynamic)
+    xdot, y_exprs = rebuilt[:len(xdot)], rebuilt[len(xdot):]
+    if h_exprs:
+        h_in_p = ca.substitute(h_exprs, q_syms, q_final) if q_syms else h_exprs
+        q_final = [*q_final, *h_in_p]
+        q_syms = [*q_syms, *h_syms]
+
     X = ca.vertcat(*x_syms)
     U = ca.vertcat(*u_syms) if u_syms else ca.SX(0, 1)
     P = ca.vertcat(*p_syms) if p_syms else ca.SX(0, 1)
@@ -579,7 +590,64 @@ def build_ode(flat: FlatModel) -> OdeModel:
     for v, val in zip(states, np.array(init(p0, qv)).ravel()):
         v.start = float(val)
     return OdeModel(flat.name, flat.description, states, inputs, outputs, params, calc, constants,
-                    rhs, outf, init, derived, notes)
+                    rhs, outf, init, derived, notes, n_hidden=len(h_syms))
+
+
+def hoist_static(exprs: list, dynamic: set[int]) -> tuple[list, list, list]:
+    """Replace every maximal subexpression free of ``dynamic`` symbols by a new symbol.
+
+    Parameters
+    ----------
+    exprs : scalar SX expressions (the right-hand side and the outputs).
+    dynamic : hashes of the time, state and input symbols.
+
+    Returns the rewritten expressions, the new symbols and the subexpressions they stand for.
+    Leaves (symbols, constants) are never hoisted.
+    """
+    memo: dict[int, tuple[ca.SX, bool]] = {}      # hash -> (rewritten node, depends on dynamic)
+    hoisted: dict[int, ca.SX] = {}
+    h_syms: list = []
+    h_exprs: list = []
+
+    def replacement(node, is_dyn):
+        if is_dyn or node.is_leaf():
+            return node
+        key = node.__hash__()
+        if key not in hoisted:
+            sym = ca.SX.sym(f"_h{len(h_syms)}")
+            hoisted[key] = sym
+            h_syms.append(sym)
+            h_exprs.append(node)
+        return hoisted[key]
+
+    for root in exprs:
+        stack = [(ca.SX(root), False)]
+        while stack:
+            node, expanded = stack.pop()
+            key = node.__hash__()
+            if key in memo:
+                continue
+            if node.is_leaf():
+                memo[key] = (node, node.is_symbolic() and key in dynamic)
+                continue
+            deps = [node.dep(i) for i in range(node.n_dep())]
+            if not expanded:
+                stack.append((node, True))
+                stack.extend((d, False) for d in deps if d.__hash__() not in memo)
+                continue
+            parts = [memo[d.__hash__()] for d in deps]
+            is_dyn = any(dyn for _, dyn in parts)
+            if not is_dyn or node.n_dep() not in (1, 2):
+                memo[key] = (node, is_dyn)
+                continue
+            args = [replacement(d, dyn) if not dyn else r for d, (r, dyn) in zip(deps, parts)]
+            new = ca.SX.unary(node.op(), args[0]) if node.n_dep() == 1 else ca.SX.binary(node.op(), *args)
+            memo[key] = (new, True)
+    out = []
+    for root in exprs:
+        r, dyn = memo[ca.SX(root).__hash__()]
+        out.append(r if dyn else replacement(r, False))
+    return out, h_syms, h_exprs
 
 
 def _eval_with_der(node, env, der_eval):

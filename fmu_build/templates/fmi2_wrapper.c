@@ -39,7 +39,7 @@ int FN_RHSOUT_WORK(casadi_int* sz_arg, casadi_int* sz_res, casadi_int* sz_iw, ca
 #define NU_ (N_U > 0 ? N_U : 1)
 #define NY_ (N_Y > 0 ? N_Y : 1)
 #define NP_ (N_P > 0 ? N_P : 1)
-#define NQ_ (N_Q > 0 ? N_Q : 1)
+#define NQ_ (N_QALL > 0 ? N_QALL : 1)   /* exposed calculated parameters + hoisted subexpressions */
 
 enum Phase { INSTANTIATED, INITIALIZATION, STEPPING, TERMINATED };
 
