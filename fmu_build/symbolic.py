@@ -223,6 +223,8 @@ def _flatten(v):
 
 def _call(node, env: _Env):
     fname, args, named = node[1], node[2], node[3]
+    if named:
+        raise BuildError(f"named arguments in {fname}({', '.join(named)}=...) are not supported")
     if fname in ("noEvent", "smooth"):
         return evaluate(args[-1], env)
     if fname == "der":
@@ -439,7 +441,7 @@ def build_ode(flat: FlatModel) -> OdeModel:
             expanded.append(nm)
     state_names = list(dict.fromkeys(expanded))
 
-    x_syms, dx_syms, states = [], [], []
+    x_syms, states = [], []
     alg_syms, alg_names, outputs_decl = [], [], []
     sym_of: dict[str, ca.SX] = {}
     for d, dims in unknown_decls:
@@ -470,8 +472,6 @@ def build_ode(flat: FlatModel) -> OdeModel:
             else:
                 alg_syms.append(sym_of[n])
                 alg_names.append(n)
-    # keep state order = declaration order
-    order = {n: i for i, n in enumerate(v.name for v in states)}
     dx_list = [der_sym[v.name] for v in states]
 
     # der() evaluation: substitute the derivative symbols.
@@ -517,7 +517,6 @@ def build_ode(flat: FlatModel) -> OdeModel:
         if k:
             val = ca.substitute([val], subs_syms[:k], resolved)[0]
         resolved.append(val)
-    value_of = {id(s): v for s, v in zip(subs_syms, resolved)}
     idx_of = {unknowns[i].__hash__(): i for i in range(len(unknowns))}
     final = [None] * len(unknowns)
     for s, v in zip(subs_syms, resolved):

@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from twin._progress import progress_bar
 from twin.errors import ScenarioError, SimulationError
 from twin.fmu import FMU
 from twin.orchestrator import check_compatibility
@@ -146,7 +147,7 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
             params.update(stages[-1].parameters)
         fmu.setup(t0, parameters=params, inputs=inputs)
         fmu.capture(t0 + 0.05, dt, ["mesh_force"])        # settle the lateral static deflection
-        bar = _bar(max_updates, progress, scenario.name)
+        bar = progress_bar(max_updates, progress, f"{scenario.name} stages", "stage")
         bar.update(len(stages))
         try:
             for u in range(len(stages), max_updates):
@@ -241,16 +242,3 @@ def _load_for_resume(path: Path, model, model_name: str, geometry):
     state = model.state_from_field(geometry, last.cycles, last.field_xi, last.field)
     # the last stage is re-run from its state so its update is applied again
     return stages[:-1], state
-
-
-def _bar(total, enabled, desc):
-    if not enabled:
-        class _No:
-            def update(self, n):
-                pass
-
-            def close(self):
-                pass
-        return _No()
-    from tqdm import tqdm
-    return tqdm(total=total, desc=f"{desc} stages", unit="stage", leave=False)

@@ -18,6 +18,7 @@ from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from typing import Any
 
+from twin._progress import progress_bar
 from twin.errors import ScenarioError
 
 
@@ -61,7 +62,7 @@ class LocalExecutor(Executor):
         self.workers = workers or len(os.sched_getaffinity(0))
 
     def _map(self, fn, tasks, progress, desc):
-        bar = _bar(len(tasks), progress, desc)
+        bar = progress_bar(len(tasks), progress, desc, "run")
         try:
             if self.workers == 1:
                 out = []
@@ -98,7 +99,7 @@ class DaskExecutor(Executor):
         futures = self.client.map(_guarded, [fn] * len(tasks), tasks, pure=False)
         index = {f.key: i for i, f in enumerate(futures)}
         results: list[Any] = [None] * len(tasks)
-        bar = _bar(len(tasks), progress, desc)
+        bar = progress_bar(len(tasks), progress, desc, "run")
         try:
             for fut in dask_completed(futures):
                 results[index[fut.key]] = fut.result()
@@ -122,16 +123,3 @@ def make_executor(spec: Mapping[str, Any] | None) -> Executor:
     if kind == "dask":
         return DaskExecutor(spec.get("address"), spec.get("workers"))
     raise ScenarioError([("<executor>", "executor.type", f"unknown executor {kind!r}; use 'local' or 'dask'")])
-
-
-def _bar(total, enabled, desc):
-    if not enabled:
-        class _No:
-            def update(self, n):
-                pass
-
-            def close(self):
-                pass
-        return _No()
-    from tqdm import tqdm
-    return tqdm(total=total, desc=desc, unit="run", leave=False)

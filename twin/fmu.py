@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from twin._progress import progress_bar
 from twin.errors import FMUError, ParameterError, SimulationError
 from twin.results import SimulationResult
 
@@ -335,7 +336,7 @@ class FMU:
         per_step = max(1, int(round((communication_step or 0.1) / output_interval)))
         out = np.empty((n_samples + 1, len(names)))
         out[0] = self.get(names) if names else []
-        bar = _progress(n_samples, progress, self.model_name)
+        bar = progress_bar(n_samples, progress, self.model_name, "samples")
         k = 0
         try:
             while k < n_samples:
@@ -458,21 +459,6 @@ class FMU:
     def _derivative_of(unknown) -> str:
         var = unknown.variable
         return var.derivative.name if getattr(var, "derivative", None) is not None else var.name
-
-
-class _NoBar:
-    def update(self, n):
-        pass
-
-    def close(self):
-        pass
-
-
-def _progress(total: int, enabled: bool, name: str):
-    if not enabled:
-        return _NoBar()
-    from tqdm import tqdm
-    return tqdm(total=total, unit="samples", unit_scale=True, desc=name, leave=False)
 
 
 def simulate_fmu(path: str | Path, *, stop_time: float, start_time: float = 0.0, output_interval: float = 1e-5,

@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from twin._progress import progress_bar
 from twin.errors import FMUCompatibilityError
 from twin.fmu import FMU
 from twin.results import SimulationResult, write_hdf5
@@ -130,7 +131,7 @@ def run_scenario(scenario: Scenario, output: str | Path | None = None, *, fmu_pa
         biases: dict[str, float] = {}
         events = list(scenario.events)
         ctx = StepContext(fmu, scenario, t0, 0)
-        bar = _bar(n_steps * per_step, progress, scenario.name)
+        bar = progress_bar(n_steps * per_step, progress, scenario.name, "samples")
         complete = True
         try:
             for k in range(n_steps):
@@ -208,19 +209,6 @@ def _write_run_groups(f, scenario: Scenario, complete: bool, applied, store: dic
     ev.attrs["actions"] = json.dumps([a for _, a in applied])
     for key, writer in store.get("_writers", {}).items():
         writer(f)
-
-
-def _bar(total: int, enabled: bool, name: str):
-    if not enabled:
-        class _No:
-            def update(self, n):
-                pass
-
-            def close(self):
-                pass
-        return _No()
-    from tqdm import tqdm
-    return tqdm(total=total, unit="samples", unit_scale=True, desc=name, leave=False)
 
 
 def describe_scenario(scenario: Scenario) -> dict[str, Any]:
