@@ -149,6 +149,14 @@ def _cmd_archive(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_import(args: argparse.Namespace) -> int:
+    out = _lib("twin.measurements").import_csv(Path(args.csv), Path(args.out),
+                                               sidecar=Path(args.sidecar) if args.sidecar else None)
+    mset = _lib("twin.measurements").load_measurements(out)
+    print(f"{args.csv} -> {out}: {len(mset)} record(s), channels {', '.join(mset[0].channel_names)}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """Return the ``twin`` argument parser (one sub-parser per command)."""
     parser = argparse.ArgumentParser(
@@ -203,6 +211,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, help="override the scenario's seed")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bars")
     p.set_defaults(handler=_cmd_archive)
+
+    p = sub.add_parser("import", help="convert a CSV measurement (+ YAML/JSON sidecar) to HDF5")
+    p.add_argument("csv", metavar="CSV", help="CSV file with a time column and channels")
+    p.add_argument("--out", required=True, help="HDF5 file to write")
+    p.add_argument("--sidecar", help="sidecar with the record attributes (default: next to the CSV)")
+    p.set_defaults(handler=_cmd_import)
 
     p = sub.add_parser("schema", help="print the JSON Schema of scenario files")
     p.set_defaults(handler=_cmd_schema)

@@ -82,3 +82,37 @@ class FMUCompatibilityError(TwinError):
         self.mismatches = list(mismatches)
         super().__init__(f"FMU {fmu} does not fit the scenario ({len(mismatches)} mismatch"
                          f"{'es' if len(mismatches) != 1 else ''}):\n  " + "\n  ".join(mismatches))
+
+
+class MeasurementError(TwinError):
+    """A measurement file (HDF5 or CSV + sidecar) is unusable. Lists every problem found.
+
+    Attributes
+    ----------
+    file : str
+        The offending file.
+    record : str or None
+        Record the (first) problem belongs to; ``None`` for a problem of the whole file.
+    problem : str
+        What is wrong with it (the first problem when there are several).
+    problems : list of (file, record, problem)
+        Every problem found in the file, in the order they were found.
+    """
+
+    def __init__(self, file: str, record: str | None, problem: str, *,
+                 problems: list[tuple[str, str | None, str]] | None = None):
+        self.file = str(file)
+        self.record = record
+        self.problem = problem
+        self.problems = list(problems) if problems else [(self.file, record, problem)]
+
+        def where(f: str, r: str | None) -> str:
+            return f"measurement file '{f}', " + (f"record '{r}'" if r is not None else "whole file")
+
+        if len(self.problems) == 1:
+            f, r, p = self.problems[0]
+            super().__init__(f"{where(f, r)}: {p}")
+        else:
+            lines = [f"{where(f, r)}: {p}" for f, r, p in self.problems]
+            super().__init__(f"{len(self.problems)} problems in measurement file '{self.file}':\n  "
+                             + "\n  ".join(lines))
