@@ -1,0 +1,62 @@
+"""Calibration problem on the gearbox FMU: synthetic recovery, failures scored infeasible, outputs."""
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from twin.calibration.problem import (CalibrationTarget, EvalTask, ParameterSpace, calibrate, evaluate_candidate,
+                                      write_parameter_set)
+from twin.errors import ParameterError
+from twin.executor import LocalExecutor
+from twin.fmu import FMU
+from twin.linearize import natural_frequencies
+
+TRUTH = {"kt12": 1800.0, "c_mesh": 880.0}
+
+
+@pytest.fixture(scope="module")
+def target(gearbox_fmu):
+    p = {**TRUTH, "speed_ref_start": 2 * math.pi * 20, "load_start": 20.0}
+    with FMU(gearbox_fmu) as f:
+        f.setup(0.0, parameters=p, inputs={"motor_speed_ref": 2 * math.pi * 20, "load_torque": 20.0})
+        f.capture(0.1, 1e-5, ["accel_pinion_casing"])
+        x = f.capture(0.3, 1e-5, ["accel_pinion_casing"])[:, 0]
+    x = x + 0.05 * np.std(x) * np.random.default_rng(0).standard_normal(x.size)
+    return CalibrationTarget(x, 1e5, 20.0, 20.0, natural_frequencies(gearbox_fmu, n=8, parameters=TRUTH))
+
+
+def test_truth_scores_near_zero_and_defaults_do_not(gearbox_fmu, target):
+    f_true, _ = evaluate_candidate(EvalTask(str(gearbox_fmu), TRUTH, target, 0.1, 0.2, target.measured_shaft_hz))
+    f_def, _ = evaluate_candidate(EvalTask(str(gearbox_fmu), {}, target, 0.1, 0.2, target.measured_shaft_hz))
+    assert f_true[0] < 0.02 and f_true[1] < 0.02 and f_true[2] < 1.0
+    assert f_def[2] > 100 * max(f_true[2], 1e-3)
+
+
+def test_calibration_moves_towards_truth_and_survives_failures(gearbox_fmu, target, tmp_path):
+    # m5 down to -0.5 kg makes part of the space non-physical: those runs fail and must be infeasible
+    space = ParameterSpace.from_bounds({"kt12": [1000.0, 2500.0], "m5": [-0.5, 1.0]})
+    res = calibrate(gearbox_fmu, space, target, algorithm="nsga2", pop_size=6, n_gen=3, seed=1,
+                    executor=LocalExecutor(2), settle=0.1, duration=0.2, fixed={"c_mesh": TRUTH["c_mesh"]},
+                    checkpoint=tmp_path / "ckpt.json")
+    assert res.n_evals == 18
+    assert res.failed_evals >= 1
+    assert np.all(np.isfinite(res.F)) and res.F[:, 2].min() < 1e3
+    assert set(res.chosen) == {"kt12", "m5"} and res.chosen["m5"] > 0
+    ck = json.loads((tmp_path / "ckpt.json").read_text())
+    assert ck["generation"] == 3 and len(ck["history"]) == 18
+
+
+def test_parameter_sets_json_and_ssv(tmp_path):
+    from twin.scenario import read_parameter_file
+    write_parameter_set({"kt12": 1800.0, "k_pair[3]": 2.5e8}, tmp_path / "p.json")
+    write_parameter_set({"kt12": 1800.0, "k_pair[3]": 2.5e8}, tmp_path / "p.ssv")
+    assert read_parameter_file(tmp_path / "p.json") == read_parameter_file(tmp_path / "p.ssv") == \
+        {"kt12": 1800.0, "k_pair[3]": 2.5e8}
+
+
+def test_bad_bounds_are_refused():
+    with pytest.raises(ParameterError, match="kt12"):
+        ParameterSpace.from_bounds({"kt12": [2.0, 1.0]})
