@@ -157,6 +157,18 @@ def _cmd_import(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_calibrate(args: argparse.Namespace) -> int:
+    scenario = _lib("twin.scenario").load_scenario(Path(args.scenario))
+    if args.workers is not None:
+        scenario = scenario.with_overrides(executor={"type": "local", "workers": args.workers})
+    report = _lib("twin.calibration.run").run_calibration(scenario, Path(args.measurements), Path(args.out),
+                                                          progress=not args.no_progress, seed=args.seed)
+    print(report.table())
+    print(f"calibrated parameters -> {Path(args.out) / 'calibrated.json'} and calibrated.ssv; "
+          f"report -> {Path(args.out) / 'report.html'}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """Return the ``twin`` argument parser (one sub-parser per command)."""
     parser = argparse.ArgumentParser(
@@ -217,6 +229,15 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", required=True, help="HDF5 file to write")
     p.add_argument("--sidecar", help="sidecar with the record attributes (default: next to the CSV)")
     p.set_defaults(handler=_cmd_import)
+
+    p = sub.add_parser("calibrate", help="calibrate a scenario's FMU to measurements (NSGA-II or MOGOA)")
+    p.add_argument("scenario", metavar="SCENARIO", help="scenario .yaml with a calibration block")
+    p.add_argument("--measurements", required=True, help="measurement HDF5 (or CSV + sidecar)")
+    p.add_argument("--out", default="calibration", help="output directory (default: calibration)")
+    p.add_argument("--workers", type=int, help="local worker processes for the evaluations")
+    p.add_argument("--seed", type=int, help="override the scenario's seed")
+    p.add_argument("--no-progress", action="store_true", help="quiet")
+    p.set_defaults(handler=_cmd_calibrate)
 
     p = sub.add_parser("schema", help="print the JSON Schema of scenario files")
     p.set_defaults(handler=_cmd_schema)

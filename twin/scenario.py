@@ -52,6 +52,24 @@ _PROFILE = {
     ],
 }
 
+CALIBRATION_SCHEMA: dict[str, Any] = {
+    "type": "object", "additionalProperties": False, "required": ["parameters"],
+    "properties": {
+        "parameters": {"type": "object", "minProperties": 1,
+                       "additionalProperties": {"type": "array", "items": {"type": "number"}, "minItems": 2, "maxItems": 2}},
+        "algorithm": {"enum": ["mogoa", "nsga2"]},
+        "pop_size": {"type": "integer", "minimum": 2},
+        "n_gen": {"type": "integer", "minimum": 1},
+        "record": {"type": "string"},
+        "natural_frequencies": {"type": "array", "items": {"type": "number", "exclusiveMinimum": 0}, "minItems": 1},
+        "foundation_modes": {"type": "array", "items": {"type": "number", "exclusiveMinimum": 0}},
+        "record_duration": {"type": "number", "exclusiveMinimum": 0},
+        "settle_time": {"type": "number", "minimum": 0},
+        "band": {"type": "array", "items": {"type": "number", "minimum": 0}, "minItems": 2, "maxItems": 2},
+    },
+}
+
+
 SCHEMA: dict[str, Any] = {
     "$schema": "https://json-schema.org/draft/2020-12/schema",
     "$id": "https://gear-twin.invalid/schemas/scenario-v1.json",
@@ -121,6 +139,7 @@ SCHEMA: dict[str, Any] = {
                 "settle_time": {**_NONNEG, "description": "s simulated and discarded before each record"},
             },
         },
+        "calibration": CALIBRATION_SCHEMA,
         "executor": {
             "type": "object", "additionalProperties": False,
             "properties": {"type": {"enum": ["local", "dask"]},
