@@ -162,7 +162,8 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     if args.workers is not None:
         scenario = scenario.with_overrides(executor={"type": "local", "workers": args.workers})
     report = _lib("twin.calibration.run").run_calibration(scenario, Path(args.measurements), Path(args.out),
-                                                          progress=not args.no_progress, seed=args.seed)
+                                                          progress=not args.no_progress, seed=args.seed,
+                                                          resume=args.resume)
     print(report.table())
     print(f"calibrated parameters -> {Path(args.out) / 'calibrated.json'} and calibrated.ssv; "
           f"report -> {Path(args.out) / 'report.html'}")
@@ -236,6 +237,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", default="calibration", help="output directory (default: calibration)")
     p.add_argument("--workers", type=int, help="local worker processes for the evaluations")
     p.add_argument("--seed", type=int, help="override the scenario's seed")
+    p.add_argument("--resume", action="store_true", help="continue from <out>/checkpoint.json")
     p.add_argument("--no-progress", action="store_true", help="quiet")
     p.set_defaults(handler=_cmd_calibrate)
 

@@ -162,8 +162,14 @@ class CalibrationResult:
 def calibrate(fmu_path: Path, space: ParameterSpace, target: CalibrationTarget, *, algorithm: str = "mogoa",
               pop_size: int = 20, n_gen: int = 10, seed: int = 0, executor=None, checkpoint: Path | None = None,
               settle: float = 0.1, duration: float = 0.3, fixed: Mapping[str, float] | None = None,
-              verbose: bool = False) -> CalibrationResult:
-    """Calibrate ``space`` against ``target`` with MOGOA or NSGA-II (see the module docstring)."""
+              verbose: bool = False, resume: bool = False) -> CalibrationResult:
+    """Calibrate ``space`` against ``target`` with MOGOA or NSGA-II (see the module docstring).
+
+    With ``resume=True`` and an existing ``checkpoint``, the run continues: the last checkpointed
+    generation seeds the population and only the remaining generations are run. The evaluation
+    history carries over. The random stream restarts, so a resumed run is not bit-identical to an
+    uninterrupted one.
+    """
     from pymoo.algorithms.moo.nsga2 import NSGA2
     from pymoo.optimize import minimize
 
@@ -174,18 +180,31 @@ def calibrate(fmu_path: Path, space: ParameterSpace, target: CalibrationTarget, 
         raise ParameterError(f"algorithm must be 'mogoa' or 'nsga2', got {algorithm!r}")
     ex = executor or LocalExecutor(1)
     problem = make_problem(Path(fmu_path), space, target, executor=ex, settle=settle, duration=duration, fixed=fixed)
-    algo = MOGOA(pop_size=pop_size, archive_size=max(2 * pop_size, 20)) if algorithm == "mogoa" else NSGA2(pop_size=pop_size)
+    done, sampling = 0, None
+    if resume and checkpoint is not None and Path(checkpoint).exists():
+        ck = json.loads(Path(checkpoint).read_text())
+        if ck.get("names") != list(space.names) or ck.get("algorithm") != algorithm:
+            raise ParameterError(f"checkpoint {checkpoint} is for {ck.get('algorithm')} over {ck.get('names')}, "
+                                 f"not {algorithm} over {list(space.names)}")
+        done = int(ck["generation"])
+        problem.history.extend(ck["history"])
+        sampling = np.array([h["x"] for h in ck["history"][-pop_size:]])
+        if done >= n_gen:
+            log.info("checkpoint %s already holds %d generations", checkpoint, done)
+    kwargs = {"sampling": sampling} if sampling is not None else {}
+    algo = (MOGOA(pop_size=pop_size, archive_size=max(2 * pop_size, 20), **kwargs) if algorithm == "mogoa"
+            else NSGA2(pop_size=pop_size, **kwargs))
 
     def save(alg):
         if checkpoint is None:
             return
         from twin._atomic import atomic_path
-        data = {"algorithm": algorithm, "generation": int(alg.n_gen), "names": list(space.names),
+        data = {"algorithm": algorithm, "generation": done + int(alg.n_gen), "names": list(space.names),
                 "history": problem.history}
         with atomic_path(checkpoint) as tmp:
             Path(tmp).write_text(json.dumps(data))
 
-    res = minimize(problem, algo, ("n_gen", n_gen), seed=seed, callback=save, verbose=verbose)
+    res = minimize(problem, algo, ("n_gen", max(n_gen - done, 1)), seed=seed + done, callback=save, verbose=verbose)
     X = np.atleast_2d(res.X)
     F = np.atleast_2d(res.F)
     pick = least_crowded(F)

@@ -54,7 +54,7 @@ class CalibrationReport:
 
 
 def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, executor=None,
-                    progress: bool = True, seed: int | None = None) -> CalibrationReport:
+                    progress: bool = True, seed: int | None = None, resume: bool = False) -> CalibrationReport:
     """Calibrate the scenario's FMU to one measured record (see the module docstring)."""
     import jsonschema
 
@@ -111,7 +111,7 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
                            pop_size=int(spec.get("pop_size", 16)), n_gen=int(spec.get("n_gen", 8)),
                            seed=scenario.seed if seed is None else seed, executor=ex,
                            checkpoint=out_dir / "checkpoint.json", settle=settle, duration=duration, fixed=fixed,
-                           verbose=progress)
+                           verbose=progress, resume=resume)
         after, after_info = evaluate_candidate(EvalTask(str(fmu), {**fixed, **result.chosen}, target, settle,
                                                         duration, shaft))
     finally:

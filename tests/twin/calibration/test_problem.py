@@ -60,3 +60,18 @@ def test_parameter_sets_json_and_ssv(tmp_path):
 def test_bad_bounds_are_refused():
     with pytest.raises(ParameterError, match="kt12"):
         ParameterSpace.from_bounds({"kt12": [2.0, 1.0]})
+
+
+def test_resume_continues_from_the_checkpoint(gearbox_fmu, target, tmp_path):
+    space = ParameterSpace.from_bounds({"kt12": [1000.0, 2500.0]})
+    ck = tmp_path / "ck.json"
+    common = dict(algorithm="nsga2", pop_size=4, seed=0, executor=LocalExecutor(1), settle=0.05, duration=0.1,
+                  checkpoint=ck)
+    calibrate(gearbox_fmu, space, target, n_gen=2, **common)
+    assert json.loads(ck.read_text())["generation"] == 2
+    res = calibrate(gearbox_fmu, space, target, n_gen=4, resume=True, **common)
+    data = json.loads(ck.read_text())
+    assert data["generation"] == 4 and res.n_evals == 16
+    with pytest.raises(ParameterError, match="checkpoint"):
+        calibrate(gearbox_fmu, ParameterSpace.from_bounds({"I1": [3e-3, 6e-3]}), target, n_gen=3, resume=True,
+                  **common)
