@@ -42,6 +42,7 @@ def main() -> None:
     ap.add_argument("--pop", type=int, default=24)
     ap.add_argument("--gens", type=int, default=15)
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--refine", action="store_true", help="polish the pick with least squares on the modes")
     args = ap.parse_args()
 
     from pymoo.indicators.hv import HV
@@ -74,7 +75,7 @@ def main() -> None:
             for algo in ("mogoa", "nsga2"):
                 t = time.perf_counter()
                 res = calibrate(fmu, space, target, algorithm=algo, pop_size=args.pop, n_gen=args.gens, seed=seed,
-                                executor=ex, settle=0.1, duration=0.3)
+                                executor=ex, settle=0.1, duration=0.3, refine=args.refine)
                 wall = time.perf_counter() - t
                 fa, info = evaluate_candidate(EvalTask(str(fmu), res.chosen, target, 0.1, 0.3,
                                                        target.measured_shaft_hz))

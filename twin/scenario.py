@@ -66,6 +66,7 @@ CALIBRATION_SCHEMA: dict[str, Any] = {
         "record_duration": {"type": "number", "exclusiveMinimum": 0},
         "settle_time": {"type": "number", "minimum": 0},
         "band": {"type": "array", "items": {"type": "number", "minimum": 0}, "minItems": 2, "maxItems": 2},
+        "refine": {"type": "boolean", "description": "polish the pick by least squares on the modes (default true)"},
     },
 }
 

@@ -13,6 +13,7 @@ Scenario block::
       record_duration: 0.3        # s simulated per evaluation, after settle_time
       settle_time: 0.1
       band: [10, 5000]            # Hz, spectrum objective
+      refine: true                # polish the pick by least squares on the modes (default)
 
 Outputs in ``out_dir``:
 - ``calibrated.json`` and ``calibrated.ssv``: the least-crowded pick (paper Eq. 9);
@@ -111,7 +112,7 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
                            pop_size=int(spec.get("pop_size", 16)), n_gen=int(spec.get("n_gen", 8)),
                            seed=scenario.seed if seed is None else seed, executor=ex,
                            checkpoint=out_dir / "checkpoint.json", settle=settle, duration=duration, fixed=fixed,
-                           verbose=progress, resume=resume)
+                           verbose=progress, resume=resume, refine=bool(spec.get("refine", True)))
         after, after_info = evaluate_candidate(EvalTask(str(fmu), {**fixed, **result.chosen}, target, settle,
                                                         duration, shaft))
     finally:

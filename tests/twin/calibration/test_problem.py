@@ -75,3 +75,13 @@ def test_resume_continues_from_the_checkpoint(gearbox_fmu, target, tmp_path):
     with pytest.raises(ParameterError, match="checkpoint"):
         calibrate(gearbox_fmu, ParameterSpace.from_bounds({"I1": [3e-3, 6e-3]}), target, n_gen=3, resume=True,
                   **common)
+
+
+def test_refinement_recovers_the_modes(gearbox_fmu, target):
+    from twin.calibration.problem import refine_modes
+    from twin.calibration.objectives import frequency_mismatch
+    space = ParameterSpace.from_bounds({"kt12": [1000.0, 2500.0], "c_mesh": [600.0, 1600.0]})
+    x = refine_modes(gearbox_fmu, space, target, np.array([1300.0, 1100.0]), max_nfev=30)
+    assert x[0] == pytest.approx(TRUTH["kt12"], rel=0.01)
+    freqs = natural_frequencies(gearbox_fmu, n=12, parameters=space.to_dict(x))
+    assert frequency_mismatch(freqs, target.natural_frequencies) < 0.5
