@@ -170,6 +170,19 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_compare(args: argparse.Namespace) -> int:
+    scenario = _lib("twin.scenario").load_scenario(Path(args.scenario))
+    comp = _lib("twin.compare").compare(scenario, Path(args.measurements), Path(args.out), record=args.record,
+                                        duration=args.duration)
+    print(f"log-spectral distance {comp.lsd_db:.2f} dB; f1 {comp.f1:.4f}; f2 {comp.f2:.4f}")
+    if not comp.findings:
+        print("no localised discrepancy above the thresholds: nothing appears to be missing")
+    for i, f in enumerate(comp.findings, 1):
+        print(f"  {i:2d}. [{f.kind}] {f.description}  ({100 * f.share:.0f} % of the error)")
+    print(f"report -> {Path(args.out) / 'compare.html'}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """Return the ``twin`` argument parser (one sub-parser per command)."""
     parser = argparse.ArgumentParser(
@@ -240,6 +253,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--resume", action="store_true", help="continue from <out>/checkpoint.json")
     p.add_argument("--no-progress", action="store_true", help="quiet")
     p.set_defaults(handler=_cmd_calibrate)
+
+    p = sub.add_parser("compare", help="compare the model with a measurement and list where it fails")
+    p.add_argument("scenario", metavar="SCENARIO", help="scenario .yaml (FMU and parameters)")
+    p.add_argument("--measurements", required=True, help="measurement HDF5 (or CSV + sidecar)")
+    p.add_argument("--out", default="report", help="output directory (default: report)")
+    p.add_argument("--record", help="record name (default: the first)")
+    p.add_argument("--duration", type=float, help="use the last DURATION seconds of the record")
+    p.set_defaults(handler=_cmd_compare)
 
     p = sub.add_parser("schema", help="print the JSON Schema of scenario files")
     p.set_defaults(handler=_cmd_schema)

@@ -1,0 +1,70 @@
+"""twin.compare: headline metric and localised findings on data with a known discrepancy."""
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from twin.cli import main
+from twin.compare import compare_signals
+from twin.fmu import FMU
+from twin.measurements import Record, write_measurements
+
+SHAFT = 19.6116    # pinion speed at 20 Hz drive under 20 N.m (motor slip)
+
+
+def _sim(fmu, params=None, dur=1.0):
+    p = {**(params or {}), "speed_ref_start": 2 * math.pi * 20, "load_start": 20.0}
+    with FMU(fmu) as f:
+        f.setup(0.0, parameters=p, inputs={"motor_speed_ref": 2 * math.pi * 20, "load_torque": 20.0})
+        f.capture(0.1, 1e-5, ["accel_pinion_casing"])
+        return f.capture(0.1 + dur, 1e-5, ["accel_pinion_casing"])[:, 0]
+
+
+@pytest.fixture(scope="module")
+def base(gearbox_fmu):
+    return _sim(gearbox_fmu)
+
+
+def _noisy(x, seed=0):
+    return x + 0.05 * np.std(x) * np.random.default_rng(seed).standard_normal(x.size)
+
+
+def test_nothing_missing_raises_no_finding(base):
+    c = compare_signals(base, _noisy(base), 1e5, SHAFT)
+    assert c.findings == ()
+    assert c.lsd_db < 1.5
+
+
+def test_line_not_locked_to_any_shaft_is_found(base):
+    t = np.arange(base.size) / 1e5
+    c = compare_signals(base, _noisy(base + 0.3 * np.std(base) * np.sin(2 * np.pi * 247.3 * t)), 1e5, SHAFT)
+    top = c.findings[0]
+    assert top.kind == "unlocked_line" and top.frequency_hz == pytest.approx(247.3, abs=0.3)
+    assert top.share > 0.5 and "not locked to any shaft" in top.description
+
+
+def test_weak_tooth_is_impulsive_with_sidebands(gearbox_fmu, base):
+    c = compare_signals(base, _noisy(_sim(gearbox_fmu, {"tooth_stiffness_factor[5]": 0.5})), 1e5, SHAFT)
+    kinds = [f.kind for f in c.findings]
+    assert kinds[0] == "impulsive"
+    assert "sideband" in kinds
+    assert c.lsd_db > 3.0 and abs(sum(f.share for f in c.findings) - 1.0) < 0.5
+
+
+def test_cli_writes_json_html_and_signals(gearbox_fmu, base, tmp_path):
+    t = np.arange(base.size) / 1e5
+    x = _noisy(base + 0.3 * np.std(base) * np.sin(2 * np.pi * 247.3 * t))
+    write_measurements([Record("r", {"accel_pinion_casing": x}, {"accel_pinion_casing": "m/s2"}, 1e5,
+                               nominal_speed=20.0, load=20.0)], tmp_path / "m.h5")
+    (tmp_path / "s.yaml").write_text(f"version: 1\nname: cmp\nfmu: {gearbox_fmu}\nstop_time: 1.0\n"
+                                     "output: {variables: [accel_pinion_casing]}\n")
+    assert main(["compare", str(tmp_path / "s.yaml"), "--measurements", str(tmp_path / "m.h5"),
+                 "--out", str(tmp_path / "rep")]) == 0
+    data = json.loads((tmp_path / "rep" / "compare.json").read_text())
+    assert data["findings"][0]["kind"] == "unlocked_line"
+    assert data["headline"]["log_spectral_distance_db"] > 1.0
+    for name in ("compare.html", "compare.png", "simulated.h5"):
+        assert (tmp_path / "rep" / name).exists()

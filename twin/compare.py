@@ -1,0 +1,340 @@
+"""Compare the twin with a measurement and split the discrepancy into localised findings.
+
+Headline metric: the **log-spectral distance** (LSD) in dB over the analysed band. It is the RMS
+of the difference between the measured and simulated Welch PSDs in dB, with both floored at the
+measured median level, so that bins where the measurement only shows its noise floor do not
+count.
+
+The squared differences D(f)^2 are then attributed to localised findings, each with a band, a size
+in dB and a share of the total sum of D^2:
+
+* ``mesh_harmonic``: a gear-mesh harmonic k x GMF whose level differs;
+* ``sideband``: lines at k x GMF +- m x shaft speed (pinion or gear), grouped per harmonic and
+  shaft: modulation once per revolution (run-out, a local tooth fault);
+* ``shaft_order``: lines at low multiples of a shaft speed;
+* ``unlocked_line``: a measured line at no multiple of either shaft speed (motor ripple, an
+  electrical or structural source the model does not have);
+* ``resonance``: a broadband region where the measured level exceeds the model by more than
+  ``resonance_db`` after median smoothing (an unmodelled resonance in the path to the sensor), or
+  falls short of it;
+* ``impulsive``: the synchronous average over the pinion revolution is far more impulsive
+  (kurtosis) in the measurement than in the model, i.e. one event per revolution.
+
+The rules use the physics of gear vibration (orders, sidebands, resonances, synchronous against
+non-synchronous content, impulsiveness), not properties of our simulator, so they apply to
+measurements from any rig.
+"""
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+from scipy.ndimage import median_filter
+from scipy.signal import find_peaks
+from scipy.stats import kurtosis
+
+from twin.signals import shaft_angle_from_speed, synchronous_average, welch_psd
+
+
+@dataclass(frozen=True)
+class Finding:
+    kind: str                    # mesh_harmonic, sideband, shaft_order, unlocked_line, resonance, impulsive
+    description: str
+    frequency_hz: float          # centre (or the line)
+    band_hz: tuple[float, float]
+    size_db: float               # measured minus model [dB] (kurtosis difference for impulsive)
+    share: float                 # share of the total squared log-spectral difference (0..1)
+    order: float | None = None   # in pinion orders, when locked
+
+
+@dataclass(frozen=True)
+class Comparison:
+    lsd_db: float                        # headline: log-spectral distance [dB]
+    f1: float                            # 1 - corr(TSA waveforms)
+    f2: float                            # 1 - corr(dB spectra)
+    rms_measured: float
+    rms_model: float
+    shaft_hz: float                      # pinion speed used for orders [Hz]
+    findings: tuple[Finding, ...]
+    freqs: np.ndarray = field(repr=False)           # (n,) Hz
+    level_measured: np.ndarray = field(repr=False)  # (n,) dB, floored
+    level_model: np.ndarray = field(repr=False)     # (n,) dB, floored
+
+    def to_dict(self) -> dict:
+        return {"headline": {"log_spectral_distance_db": self.lsd_db,
+                             "definition": "RMS over the band of (measured - model) Welch PSD in dB, both floored "
+                                           "at the measured median level"},
+                "f1_waveform": self.f1, "f2_spectrum": self.f2,
+                "rms": {"measured": self.rms_measured, "model": self.rms_model},
+                "shaft_hz": self.shaft_hz,
+                "findings": [asdict(f) for f in self.findings]}
+
+
+def compare_signals(model: np.ndarray, measured: np.ndarray, fs: float, shaft_hz: float, *,
+                    z1: int = 19, z2: int = 52, fmin: float = 10.0, fmax: float = 5000.0,
+                    resolution: float = 2.0, line_db: float = 6.0, resonance_db: float = 6.0,
+                    max_shaft_order: int = 4, n_harmonics: int | None = None, n_sidebands: int = 3) -> Comparison:
+    """Compare a simulated and a measured signal (both (n,), same ``fs`` [Hz]) of the same operating point.
+
+    ``shaft_hz`` is the pinion (input shaft) speed [Hz]; the gear turns at shaft_hz * z1 / z2.
+    ``n_harmonics`` defaults to every mesh harmonic in the band: a resonance in the transfer path
+    that only lifts the lines near it shows up as findings on those harmonics and their sidebands.
+    """
+    from twin.calibration.objectives import spectrum_mismatch, waveform_mismatch
+
+    model = np.asarray(model, float)
+    measured = np.asarray(measured, float)
+    n = min(model.size, measured.size)
+    model, measured = model[:n], measured[:n]
+    resolution = max(resolution, 4.0 * fs / n)
+    f, pm = welch_psd(model, fs, resolution=resolution)
+    _, pp = welch_psd(measured, fs, resolution=resolution)
+    band = (f >= fmin) & (f <= min(fmax, fs / 2))
+    f, pm, pp = f[band], pm[band], pp[band]
+    floor = max(float(np.median(pp)), 1e-30)
+    lm = 10 * np.log10(np.maximum(pm, floor))
+    lp = 10 * np.log10(np.maximum(pp, floor))
+    d = lp - lm                                   # measured minus model [dB]
+    d2 = d ** 2
+    total = float(np.sum(d2)) or 1.0
+    lsd = float(np.sqrt(np.mean(d2)))
+    df = f[1] - f[0]
+    gear_hz = shaft_hz * z1 / z2
+    gmf = z1 * shaft_hz
+    tol = 1.5 * df
+
+    used = np.zeros(f.size, bool)
+    findings: list[Finding] = []
+
+    def bins_near(fc: float, width: float = tol) -> np.ndarray:
+        return np.flatnonzero(np.abs(f - fc) <= width)
+
+    def line_finding(kind, describe, fc, order=None):
+        """A finding for the line near fc if its level differs by >= line_db; describe(size) -> text."""
+        idx = bins_near(fc)
+        if idx.size == 0:
+            return
+        j = idx[np.argmax(np.abs(d[idx]))]
+        size = float(d[j])
+        if abs(size) < line_db:
+            return
+        used[idx] = True
+        findings.append(Finding(kind, describe(size), float(f[j]), (float(f[idx[0]]), float(f[idx[-1]])), size,
+                                float(np.sum(d2[idx]) / total), order))
+
+    # mesh harmonics and their sidebands (grouped per harmonic and shaft)
+    for k in range(1, (n_harmonics or int(f[-1] // gmf)) + 1):
+        fk = k * gmf
+        if fk > f[-1]:
+            break
+        line_finding("mesh_harmonic", lambda sz, k=k, fk=fk: f"{sz:+.1f} dB at {k}x GMF ({fk:.1f} Hz)", fk,
+                     order=k * z1)
+        for name, fs_hz in (("pinion", shaft_hz), ("gear", gear_hz)):
+            idx = np.concatenate([bins_near(fk + s * m * fs_hz) for m in range(1, n_sidebands + 1) for s in (-1, 1)])
+            idx = np.unique(idx[(idx >= 0)])
+            idx = idx[~used[idx]]
+            if idx.size == 0:
+                continue
+            big = idx[np.abs(d[idx]) >= line_db]
+            if big.size == 0:
+                continue
+            size = float(np.mean(d[big]))
+            used[idx] = True
+            findings.append(Finding("sideband", f"{size:+.1f} dB at {k}x GMF +- 1..{n_sidebands}x {name} speed "
+                                                f"({fs_hz:.2f} Hz)", float(fk), (float(f[idx[0]]), float(f[idx[-1]])),
+                                    size, float(np.sum(d2[idx]) / total), k * z1))
+    # low shaft orders
+    for name, fs_hz in (("pinion", shaft_hz), ("gear", gear_hz)):
+        for m in range(1, max_shaft_order + 1):
+            line_finding("shaft_order",
+                         lambda sz, m=m, name=name, fo=m * fs_hz: f"{sz:+.1f} dB at {m}x {name} speed ({fo:.1f} Hz)",
+                         m * fs_hz, order=m * fs_hz / shaft_hz)
+    # measured lines locked to no shaft. Locking is judged on the line frequency measured on a
+    # zero-padded full-length FFT, not on the Welch bins: the gear's orders are only
+    # shaft_hz * z1 / z2 apart (7 Hz at 20 Hz), so a Welch bin would make every line look locked.
+    nfft = 1 << int(np.ceil(np.log2(8 * n)))
+    fine = np.abs(np.fft.rfft((measured - measured.mean()) * np.hanning(n), n=nfft))
+    ffine = np.fft.rfftfreq(nfft, 1.0 / fs)
+    lock_tol = max(0.3, 2.0 * fs / n)          # Hz
+    prom = lp - median_filter(lp, size=max(5, int(round(30.0 / df))) | 1, mode="nearest")
+    peaks, _ = find_peaks(prom, height=10.0)
+    for j in peaks:
+        if used[j] or d[j] < line_db:
+            continue
+        win = (ffine >= f[j] - df) & (ffine <= f[j] + df)
+        fl = float(ffine[win][np.argmax(fine[win])]) if win.any() else float(f[j])
+        o1 = fl / shaft_hz
+        o2 = fl / gear_hz
+        locked = (abs(o1 - round(o1)) * shaft_hz <= lock_tol) or (abs(o2 - round(o2)) * gear_hz <= lock_tol)
+        if locked:
+            continue
+        idx = bins_near(f[j])
+        used[idx] = True
+        findings.append(Finding("unlocked_line", f"a line at {fl:.1f} Hz not locked to any shaft "
+                                                 f"({d[j]:+.1f} dB above the model)", fl,
+                                (float(f[idx[0]]), float(f[idx[-1]])), float(d[j]), float(np.sum(d2[idx]) / total)))
+    # broadband regions (lines removed, then median-smoothed over ~100 Hz)
+    dd = np.where(used, np.nan, d)
+    fill = np.interp(np.arange(f.size), np.flatnonzero(~np.isnan(dd)), dd[~np.isnan(dd)]) if np.any(~np.isnan(dd)) else d
+    smooth = median_filter(fill, size=max(3, int(round(100.0 / df))) | 1, mode="nearest")
+    for sign, word in ((1, "an unmodelled resonance or path gain near"), (-1, "the model too high near")):
+        mask = sign * smooth > resonance_db
+        start = None
+        for i in range(f.size + 1):
+            on = i < f.size and mask[i]
+            if on and start is None:
+                start = i
+            elif not on and start is not None:
+                seg = np.arange(start, i)
+                if f[seg[-1]] - f[seg[0]] >= 2 * df:
+                    c = seg[np.argmax(sign * smooth[seg])]
+                    seg_free = seg[~used[seg]]
+                    findings.append(Finding("resonance", f"{word} {f[c]:.0f} Hz ({smooth[c]:+.1f} dB over "
+                                                         f"{f[seg[0]]:.0f}-{f[seg[-1]]:.0f} Hz)", float(f[c]),
+                                            (float(f[seg[0]]), float(f[seg[-1]])), float(smooth[c]),
+                                            float(np.sum(d2[seg_free]) / total)))
+                    used[seg] = True
+                start = None
+    # impulsiveness of the synchronous average over the pinion revolution
+    angle = shaft_angle_from_speed(n, fs, shaft_hz)
+    _, tsa_p, _ = synchronous_average(measured, fs, angle, samples_per_rev=512)
+    _, tsa_m, _ = synchronous_average(model, fs, angle, samples_per_rev=512)
+    kp, km = float(kurtosis(tsa_p)), float(kurtosis(tsa_m))
+    if kp - km > 1.5 and kp > 1.0:
+        findings.append(Finding("impulsive", f"impulsive once per pinion revolution (TSA kurtosis {kp:.1f} "
+                                             f"measured vs {km:.1f} model)", float(shaft_hz), (0.0, float(f[-1])),
+                                kp - km, float(np.sum(d2[~used]) / total), 1.0))
+    findings.sort(key=lambda x: -x.share)
+    f1 = waveform_mismatch(model, measured, fs, shaft_hz)
+    f2 = spectrum_mismatch(model, measured, fs, fmin=fmin, fmax=fmax, resolution=resolution)
+    return Comparison(lsd, f1, f2, float(np.sqrt(np.mean(measured ** 2))), float(np.sqrt(np.mean(model ** 2))),
+                      float(shaft_hz), tuple(findings), f, lp, lm)
+
+
+def compare(scenario, measurements, out_dir, *, record: str | None = None, duration: float | None = None,
+            settle: float = 0.1):
+    """``twin compare``: simulate under the measured conditions and write the comparison.
+
+    The record's ``nominal_speed`` [Hz] and ``load`` [N.m] set the drive and the brake, and its
+    sample rate sets the output rate; the record is resampled to the scenario's rate if they
+    differ, and the change is reported. The parameters are the scenario's.
+
+    Writes to ``out_dir``: ``compare.json`` (headline metric, f1/f2 and the findings),
+    ``simulated.h5`` (the simulated signal), ``compare.png`` (spectra and order spectra with the
+    findings marked) and ``compare.html``. Returns the :class:`Comparison`.
+    """
+    import json
+    import math
+    from pathlib import Path
+
+    from twin.calibration.objectives import estimate_shaft_hz
+    from twin.errors import OutputPathError, ScenarioError
+    from twin.fmu import FMU
+    from twin.measurements import load_measurements
+    from twin.results import SimulationResult, write_hdf5
+
+    out_dir = Path(out_dir)
+    if not out_dir.parent.exists():
+        raise OutputPathError(f"parent directory {out_dir.parent} does not exist")
+    out_dir.mkdir(exist_ok=True)
+    channel = (scenario.outputs or ("accel_pinion_casing",))[0]
+    mset = load_measurements(measurements, channels=[channel], resample_to=scenario.sample_rate)
+    for note in mset.notes:
+        print(f"note: {note}")
+    rec = mset[record] if record else mset[0]
+    if rec.nominal_speed is None or rec.load is None:
+        raise ScenarioError([(str(measurements), f"records.{rec.name}",
+                              "comparison needs the record attributes nominal_speed [Hz] and load [N.m]")])
+    measured = np.asarray(rec[channel], float)
+    if duration is not None:
+        measured = measured[-int(round(duration * rec.sample_rate)):]
+    dur = measured.size / rec.sample_rate
+    drive = float(rec.nominal_speed)
+    params = {**scenario.parameters, "speed_ref_start": 2 * math.pi * drive, "load_start": float(rec.load)}
+    dt = 1.0 / rec.sample_rate
+    with FMU(scenario.fmu_path()) as fmu:
+        fmu.setup(0.0, parameters=params, inputs={"motor_speed_ref": 2 * math.pi * drive, "load_torque": float(rec.load)})
+        fmu.capture(settle, dt, [channel])
+        block = fmu.capture(settle + dur, dt, [channel, "motor_speed"])
+        identity = (fmu.model_name, fmu.guid, fmu.sha256, fmu.parameter_values())
+    simulated = block[:, 0]
+    shaft = estimate_shaft_hz(measured, rec.sample_rate, drive, 19)
+    z1 = int(round(params.get("z1", 19)))
+    z2 = int(round(params.get("z2", 52)))
+    comp = compare_signals(simulated, measured, rec.sample_rate, shaft, z1=z1, z2=z2)
+    from twin._atomic import atomic_path
+    with atomic_path(out_dir / "compare.json") as tmp:
+        Path(tmp).write_text(json.dumps({"scenario": scenario.name, "record": rec.name,
+                                         "measurements": str(measurements), **comp.to_dict()}, indent=2))
+    t = settle + dt * np.arange(1, simulated.size + 1)
+    write_hdf5(SimulationResult(t, {channel: simulated, "motor_speed": block[:, 1]},
+                                {channel: "m/s2", "motor_speed": "rad/s"}, rec.sample_rate, identity[3],
+                                identity[0], identity[1], identity[2]), out_dir / "simulated.h5")
+    _plot(comp, simulated, measured, rec.sample_rate, out_dir / "compare.png")
+    _html(comp, scenario, rec, out_dir / "compare.html")
+    return comp
+
+
+def _plot(comp: Comparison, simulated, measured, fs, path) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from twin._atomic import atomic_path
+    from twin.signals import order_spectrum, shaft_angle_from_speed
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(11, 8))
+    a1.plot(comp.freqs, comp.level_measured, "k", lw=0.8, label="measured")
+    a1.plot(comp.freqs, comp.level_model, "tab:blue", lw=0.8, label="model")
+    colors = {"mesh_harmonic": "tab:orange", "sideband": "tab:purple", "shaft_order": "tab:green",
+              "unlocked_line": "tab:red", "resonance": "tab:brown", "impulsive": "tab:pink"}
+    for i, fd in enumerate(comp.findings[:8]):
+        c = colors.get(fd.kind, "gray")
+        if fd.kind in ("resonance",):
+            a1.axvspan(*fd.band_hz, color=c, alpha=0.15)
+        elif fd.kind != "impulsive":
+            a1.axvline(fd.frequency_hz, color=c, ls="--", lw=0.8)
+        a1.annotate(f"{i + 1}", (fd.frequency_hz, float(np.max(comp.level_measured))), color=c, fontsize=9,
+                    ha="center")
+    a1.set_xlabel("frequency [Hz]")
+    a1.set_ylabel("PSD [dB re 1 (m/s2)^2/Hz]")
+    a1.set_title(f"Spectra; log-spectral distance {comp.lsd_db:.2f} dB; numbered: findings by share")
+    a1.legend(loc="upper right")
+    a1.grid(alpha=0.3)
+    angle = shaft_angle_from_speed(measured.size, fs, comp.shaft_hz)
+    spr = 4096
+    for x, lab, col in ((measured, "measured", "k"), (simulated, "model", "tab:blue")):
+        o, amp = order_spectrum(x, fs, angle, samples_per_rev=spr, max_order=120)
+        a2.semilogy(o, amp + 1e-12, color=col, lw=0.8, label=lab)
+    for k in range(1, 7):
+        a2.axvline(19 * k, color="0.7", ls=":", lw=0.8)
+    a2.set_xlabel("pinion order (dotted: mesh harmonics)")
+    a2.set_ylabel("amplitude [m/s2]")
+    a2.legend(loc="upper right")
+    a2.grid(alpha=0.3)
+    fig.tight_layout()
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=110)
+    plt.close(fig)
+
+
+def _html(comp: Comparison, scenario, rec, path) -> None:
+    import html
+    from pathlib import Path
+
+    from twin._atomic import atomic_path
+    rows = "".join(f"<tr><td>{i + 1}</td><td>{html.escape(f.kind)}</td><td style='text-align:left'>"
+                   f"{html.escape(f.description)}</td><td>{f.size_db:+.1f}</td><td>{100 * f.share:.1f} %</td></tr>"
+                   for i, f in enumerate(comp.findings))
+    none = "" if comp.findings else "<p>No localised discrepancy above the thresholds: nothing appears to be missing.</p>"
+    doc = f"""<!doctype html><html><head><meta charset="utf-8"><title>Compare: {html.escape(scenario.name)}</title>
+<style>body{{font-family:sans-serif;max-width:62em;margin:2em auto}}table{{border-collapse:collapse}}
+td,th{{border:1px solid #ccc;padding:.25em .6em;text-align:right}}</style></head><body>
+<h1>Model vs measurement: {html.escape(scenario.name)} / record {html.escape(rec.name)}</h1>
+<p><b>Log-spectral distance: {comp.lsd_db:.2f} dB</b> (RMS of measured minus model PSD in dB over the band, both floored
+at the measured median level). Paper objectives: f1 = {comp.f1:.4f} (waveform), f2 = {comp.f2:.4f} (spectrum).
+RMS level: measured {comp.rms_measured:.3g}, model {comp.rms_model:.3g} m/s2. Pinion speed {comp.shaft_hz:.3f} Hz.</p>
+<h2>Where the model fails</h2>{none}
+<table><tr><th>#</th><th>kind</th><th>finding</th><th>size [dB]</th><th>share of error</th></tr>{rows}</table>
+<img src="compare.png" style="max-width:100%"></body></html>"""
+    with atomic_path(path) as tmp:
+        Path(tmp).write_text(doc)
