@@ -27,6 +27,7 @@ import numpy as np
 
 from twin.errors import ScenarioError, SimulationError
 from twin.executor import make_executor
+from twin.operating import operating_point
 from twin.scenario import Scenario
 
 ARCHIVE_FORMAT = "gear-twin-archive"
@@ -136,11 +137,8 @@ def build_archive(scenario: Scenario, output: str | Path | None = None, *, progr
             d = float(draw.uniform(lo, hi))
             f = nominal_speed * (1 + speed_sd * float(draw.standard_normal()))
             t_load = nominal_load * (1 + load_sd * float(draw.standard_normal()))
-            p = dict(scenario.parameters)
-            p.update(interpolate_parameters(damages, params, d))
-            # start the record at its own steady operating point
-            p.update({"speed_ref_start": 2 * math.pi * f, "load_start": t_load})
-            inputs = {"motor_speed_ref": 2 * math.pi * f, "load_torque": t_load}
+            start, inputs = operating_point(f, t_load)   # each record starts at its own steady point
+            p = {**scenario.parameters, **interpolate_parameters(damages, params, d), **start}
             tasks.append(RecordTask(k, str(fmu_file), p, inputs, settle, duration, scenario.output_interval,
                                     channels, noise, int(record_seeds[k].generate_state(1)[0])))
             labels.append(s)

@@ -224,13 +224,13 @@ def compare(scenario, measurements, out_dir, *, record: str | None = None, durat
     findings marked) and ``compare.html``. Returns the :class:`Comparison`.
     """
     import json
-    import math
     from pathlib import Path
 
     from twin.calibration.objectives import estimate_shaft_hz
     from twin.errors import OutputPathError, ScenarioError
     from twin.fmu import FMU
     from twin.measurements import load_measurements
+    from twin.operating import operating_point
     from twin.results import SimulationResult, write_hdf5
 
     out_dir = Path(out_dir)
@@ -250,10 +250,11 @@ def compare(scenario, measurements, out_dir, *, record: str | None = None, durat
         measured = measured[-int(round(duration * rec.sample_rate)):]
     dur = measured.size / rec.sample_rate
     drive = float(rec.nominal_speed)
-    params = {**scenario.parameters, "speed_ref_start": 2 * math.pi * drive, "load_start": float(rec.load)}
+    start, inputs = operating_point(drive, float(rec.load))
+    params = {**scenario.parameters, **start}
     dt = 1.0 / rec.sample_rate
     with FMU(scenario.fmu_path()) as fmu:
-        fmu.setup(0.0, parameters=params, inputs={"motor_speed_ref": 2 * math.pi * drive, "load_torque": float(rec.load)})
+        fmu.setup(0.0, parameters=params, inputs=inputs)
         fmu.capture(settle, dt, [channel])
         block = fmu.capture(settle + dur, dt, [channel, "motor_speed"])
         identity = (fmu.model_name, fmu.guid, fmu.sha256, fmu.parameter_values())

@@ -92,17 +92,14 @@ RIG_DEFAULTS = {"kt12": 1.5e3, "I1": 4.3e-3, "kt1213": 1.5e3, "I13": 2.0e-2}
 def _calibration_demo(fmu: Path, out_dir: Path):
     """Calibrate the default model to a built-in (synthetic) measurement; print Table 2."""
     from twin.calibration.run import run_calibration
-    from twin.fmu import FMU
     from twin.linearize import natural_frequencies
     from twin.measurements import Record, write_measurements
+    from twin.operating import simulate_operating_point
     from twin.scenario import scenario_from_dict
 
     t = time.perf_counter()
-    p = {**RIG_TRUTH, "speed_ref_start": 2 * np.pi * SHAFT_HZ, "load_start": LOAD_NM}
-    with FMU(fmu) as f:
-        f.setup(0.0, parameters=p, inputs={"motor_speed_ref": 2 * np.pi * SHAFT_HZ, "load_torque": LOAD_NM})
-        f.capture(0.1, 1e-5, ["accel_pinion_casing"])
-        x = f.capture(0.5, 1e-5, ["accel_pinion_casing"])[:, 0]
+    x = simulate_operating_point(fmu, SHAFT_HZ, LOAD_NM, parameters=RIG_TRUTH, settle=0.1, duration=0.4,
+                                 channels=["accel_pinion_casing"])[:, 0]
     x = x + 0.05 * np.std(x) * np.random.default_rng(0).standard_normal(x.size)
     rig = out_dir / "rig_measurement.h5"
     write_measurements([Record("healthy", {"accel_pinion_casing": x}, {"accel_pinion_casing": "m/s2"}, 1e5,
@@ -169,21 +166,17 @@ def _tail(result, t0: float):
 
 def _compare_demo(out_dir: Path) -> None:
     """twin compare of the calibrated model against a built-in record with a damaged tooth."""
+    from fmu_build import build_fmu
     from twin.compare import compare
-    from twin.fmu import FMU
     from twin.measurements import Record, write_measurements
+    from twin.operating import simulate_operating_point
     from twin.scenario import read_parameter_file, scenario_from_dict
 
     # The same synthetic rig, now with pinion tooth 5 at 60 % stiffness (a root crack): an effect
     # the calibrated model does not have.
-    fmu_params = {**RIG_TRUTH, "tooth_stiffness_factor[5]": 0.6,
-                  "speed_ref_start": 2 * np.pi * SHAFT_HZ, "load_start": LOAD_NM}
-    from fmu_build import build_fmu
     fmu = build_fmu("GearTwin.Gearbox21", REPO / "modelica", REPO / "build")
-    with FMU(fmu) as f:
-        f.setup(0.0, parameters=fmu_params, inputs={"motor_speed_ref": 2 * np.pi * SHAFT_HZ, "load_torque": LOAD_NM})
-        f.capture(0.1, 1e-5, ["accel_pinion_casing"])
-        x = f.capture(0.6, 1e-5, ["accel_pinion_casing"])[:, 0]
+    x = simulate_operating_point(fmu, SHAFT_HZ, LOAD_NM, parameters={**RIG_TRUTH, "tooth_stiffness_factor[5]": 0.6},
+                                 settle=0.1, duration=0.5, channels=["accel_pinion_casing"])[:, 0]
     x = x + 0.05 * np.std(x) * np.random.default_rng(1).standard_normal(x.size)
     rig = out_dir / "rig_damaged_tooth.h5"
     write_measurements([Record("damaged", {"accel_pinion_casing": x}, {"accel_pinion_casing": "m/s2"}, 1e5,

@@ -61,17 +61,15 @@ class EvalTask:
 def evaluate_candidate(task: EvalTask) -> tuple[np.ndarray, dict]:
     """Objectives (f1, f2, f3) of one parameter set; shape (3,). Raises on simulation failure."""
     from twin.calibration.objectives import frequency_mismatch, spectrum_mismatch, waveform_mismatch
-    from twin.fmu import FMU
     from twin.linearize import modes, state_jacobian
+    from twin.operating import operating_point, simulate_operating_point
 
     tg = task.target
-    inputs = {"motor_speed_ref": 2 * math.pi * tg.drive_hz, "load_torque": tg.load}
-    params = {**task.parameters, "speed_ref_start": 2 * math.pi * tg.drive_hz, "load_start": tg.load}
-    dt = 1.0 / tg.sample_rate
-    with FMU(task.fmu_path) as fmu:
-        fmu.setup(0.0, parameters=params, inputs=inputs)
-        fmu.capture(task.settle, dt, [tg.channel, "motor_speed"])
-        block = fmu.capture(task.settle + task.duration, dt, [tg.channel, "motor_speed"])
+    start, inputs = operating_point(tg.drive_hz, tg.load)
+    params = {**task.parameters, **start}
+    block = simulate_operating_point(task.fmu_path, tg.drive_hz, tg.load, parameters=task.parameters,
+                                     settle=task.settle, duration=task.duration,
+                                     channels=[tg.channel, "motor_speed"], output_interval=1.0 / tg.sample_rate)
     sim, speed = block[:, 0], block[:, 1]
     model_shaft_hz = float(np.mean(speed)) / (2 * math.pi)
     n = min(sim.size, tg.signal.size)
@@ -233,16 +231,16 @@ def refine_modes(fmu_path: Path, space: ParameterSpace, target: CalibrationTarge
 
     from twin.calibration.objectives import match_modes
     from twin.linearize import modes, state_jacobian
+    from twin.operating import operating_point
 
     tg = target
-    inputs = {"motor_speed_ref": 2 * math.pi * tg.drive_hz, "load_torque": tg.load}
+    start, inputs = operating_point(tg.drive_hz, tg.load)
     span = space.upper - space.lower
     k = tg.natural_frequencies.size
 
     def residuals(z):
         x = space.lower + z * span
-        params = {**(fixed or {}), **space.to_dict(x), "speed_ref_start": 2 * math.pi * tg.drive_hz,
-                  "load_start": tg.load}
+        params = {**(fixed or {}), **space.to_dict(x), **start}
         jac, _ = state_jacobian(fmu_path, parameters=params, inputs=inputs, settle=0.02, window=2.5e-3, samples=4)
         fr, _ = modes(jac)
         fr = fr[: k + 4]

@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import csv
 import html
-import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -142,13 +141,10 @@ def _write_pareto(result, path: Path) -> None:
 
 
 def _simulate(fmu, target, params, settle, duration):
-    from twin.fmu import FMU
-    p = {**params, "speed_ref_start": 2 * math.pi * target.drive_hz, "load_start": target.load}
-    with FMU(fmu) as f:
-        f.setup(0.0, parameters=p, inputs={"motor_speed_ref": 2 * math.pi * target.drive_hz,
-                                           "load_torque": target.load})
-        f.capture(settle, 1 / target.sample_rate, [target.channel])
-        return f.capture(settle + duration, 1 / target.sample_rate, [target.channel])[:, 0]
+    from twin.operating import simulate_operating_point
+    return simulate_operating_point(fmu, target.drive_hz, target.load, parameters=params, settle=settle,
+                                    duration=duration, channels=[target.channel],
+                                    output_interval=1 / target.sample_rate)[:, 0]
 
 
 def _psd_overlay(fmu, target, fixed, chosen, settle, duration, path: Path) -> None:
