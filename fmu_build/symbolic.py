@@ -352,6 +352,17 @@ def build_ode(flat: FlatModel) -> OdeModel:
         e = d.attrs.get(key)
         return e[1] if e is not None and e[0] == "str" else ""
 
+    # Symbols for every Real parameter first: rumoca lists an extended base class before the
+    # components of the derived model, so a binding may name a parameter declared further down
+    # (``extends Base(p = effect.shape)``).
+    param_syms: dict[str, list] = {}
+    for d in flat.decls:
+        if d.prefix == "parameter" and d.type not in ("Integer", "Boolean"):
+            dims = dims_of(d)
+            syms = [ca.SX.sym(n) for n in _scalar_names(d, dims)]
+            param_syms[d.name] = syms
+            values[d.name] = syms if dims else syms[0]
+
     for d in flat.decls:
         if d.prefix in ("parameter", "constant") and d.type in ("Integer", "Boolean"):
             dims = dims_of(d)
@@ -366,8 +377,7 @@ def build_ode(flat: FlatModel) -> OdeModel:
         dims = dims_of(d)
         names = _scalar_names(d, dims)
         if d.prefix == "parameter":
-            syms = [ca.SX.sym(n) for n in names]
-            values[d.name] = syms if dims else syms[0]
+            syms = param_syms[d.name]
             if d.binding is None:
                 raise BuildError(f"parameter {d.name} has no value")
             bval = evaluate(d.binding, env)
@@ -383,7 +393,7 @@ def build_ode(flat: FlatModel) -> OdeModel:
                     val = float(ca.evalf(b)) if _is_sym(b) else float(b)
                     params.append(Variable(n, "parameter", attr_str(d, "unit"), d.description, val))
                     p_syms.append(s)
-        elif d.prefix == "input":
+        elif d.prefix == "input" and d.binding is None and "." not in d.name:
             syms = [ca.SX.sym(n) for n in names]
             values[d.name] = syms if dims else syms[0]
             start = d.attrs.get("start")
@@ -454,7 +464,9 @@ def build_ode(flat: FlatModel) -> OdeModel:
             # declaration equation, e.g. output Real y = x;
             from .flat import Equation
             flat.equations.append(Equation(("ref", d.name, []), d.binding, f"{d.name} = <binding>"))
-        if d.prefix == "output":
+        if d.prefix == "output" and "." not in d.name:
+            # outputs of sub-components (effect blocks) stay internal; the FMU interface is the
+            # top-level model's
             outputs_decl.append((d, names))
 
     for n in state_names:
@@ -537,11 +549,17 @@ def build_ode(flat: FlatModel) -> OdeModel:
                 y_exprs.append(x_syms[state_index[n]])
 
     # Calculated parameters in terms of p only.
-    q_final = []
-    for k, e in enumerate(q_exprs):
-        if k:
-            e = ca.substitute([e], q_syms[:k], q_final)[0]
-        q_final.append(e)
+    # Bindings may name calculated parameters declared later, so substitute to a fixed point;
+    # a chain can be at most len(q_syms) deep, anything longer is a cycle.
+    q_final = list(q_exprs)
+    for _ in range(len(q_syms) + 1):
+        if not q_syms or not ca.depends_on(ca.vertcat(*q_final), ca.vertcat(*q_syms)):
+            break
+        q_final = ca.substitute(q_final, q_syms, q_final)
+    else:
+        raise BuildError("parameter bindings form a cycle: "
+                         + ", ".join(v.name for v, e in zip(calc, q_final)
+                                     if ca.depends_on(e, ca.vertcat(*q_syms))))
 
     # Start values of states.
     x0 = []

@@ -208,6 +208,27 @@ class GearboxParams:
         return path / (PI * self.module * math.cos(self.alpha))
 
     @property
+    def line_of_action_length(self) -> float:
+        """Distance T1-T2 between the base-circle tangency points [m]."""
+        return 0.5 * self.module * (self.z1 + self.z2) * math.sin(self.alpha)
+
+    @property
+    def contact_path_length(self) -> float:
+        """Length of the path of contact [m]."""
+        return self.contact_ratio * PI * self.module * math.cos(self.alpha)
+
+    @property
+    def contact_start_radius(self) -> float:
+        """Distance from T1 to the start of contact [m] (gear tip circle on the line of action)."""
+        ra2 = 0.5 * self.module * self.z2 + self.addendum_coefficient * self.module
+        return self.line_of_action_length - math.sqrt(ra2 ** 2 - self.rb2 ** 2)
+
+    @property
+    def roll_pitch(self) -> float:
+        """Roll position of the pitch point [-] (0 = start, 1 = end of contact)."""
+        return (0.5 * self.module * self.z1 * math.sin(self.alpha) - self.contact_start_radius) / self.contact_path_length
+
+    @property
     def torque_out(self) -> float:
         """Static torque in the output chain [N.m]."""
         return self.load_start

@@ -106,7 +106,8 @@ def test_parameters_and_start_state_match_fmu(gearbox_fmu, tmp_path):
     finally:
         fmu.freeInstance()
     assert set(derived) == {"rb1", "rb2", "contact_ratio", "torque_out", "torque_in",
-                            "mesh_force_static", "speed_start", "k_mesh_mean"}
+                            "mesh_force_static", "speed_start", "k_mesh_mean", "line_of_action_length",
+                            "contact_path_length", "contact_start_radius", "roll_pitch"}
     for name in derived:
         assert values[name] == pytest.approx(getattr(p, name), rel=1e-12), name
     x0 = gn.initial_state(p)
