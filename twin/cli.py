@@ -262,6 +262,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--duration", type=float, help="use the last DURATION seconds of the record")
     p.set_defaults(handler=_cmd_compare)
 
+    from twin.rul import add_subcommands as add_rul
+    add_rul(sub)
+
     p = sub.add_parser("schema", help="print the JSON Schema of scenario files")
     p.set_defaults(handler=_cmd_schema)
 
