@@ -343,3 +343,62 @@ def test_builder_needs_no_per_model_code():
         text = path.read_text()
         for word in ("TwoMass", "mesh_force", "theta5"):
             assert word not in text, (path.name, word)
+
+
+HOOKED = """
+model Base
+  parameter Real k = 4.0;
+  parameter Real p[2] = {1, 2};
+  Real x(start = 1.0);
+  Real v(start = 0.0);
+  Real hook = 0 "zero here; a variant binds it";
+  output Real y;
+equation
+  der(x) = v;
+  der(v) = -k * x + hook + p[1];
+  y = x + p[2];
+end Base;
+block Ripple
+  parameter Real amplitude = 1.0;
+  parameter Real shape[2] = {amplitude, 0.5};
+  input Real angle;
+  output Real force;
+  Real z(start = 0);
+equation
+  der(z) = -z + angle;
+  force = amplitude * sin(angle) + z;
+end Ripple;
+model Variant
+  extends Base(hook = ripple.force, p = ripple.shape);
+  Ripple ripple(angle = 2 * x, amplitude = 0.5);
+end Variant;
+"""
+
+
+@pytest.mark.needs_gcc
+def test_extends_with_a_component_bound_to_hooks_and_parameters(tmp_path, write_package):
+    """A base parameter bound to a component parameter declared after it, and a component input
+    bound to a base state, build into one ODE; the component's input and output stay internal."""
+    from scipy.integrate import solve_ivp
+
+    from twin.fmu import FMU
+    write_package(tmp_path / "lib", "Hooked", HOOKED)
+    fmu = fmu_build.build_fmu("Hooked.Variant", tmp_path / "lib", tmp_path / "out")
+    kinds = {sv.get("name"): sv.get("causality") for sv in _real_variables(fmu)}
+    assert kinds["ripple.amplitude"] == "parameter"
+    assert kinds["p[1]"] == "calculatedParameter" and kinds["ripple.shape[1]"] == "calculatedParameter"
+    assert kinds["y"] == "output" and kinds.get("ripple.force") != "output"
+    assert "ripple.angle" not in kinds or kinds["ripple.angle"] != "input"
+
+    amp = 0.7
+
+    def rhs(t, s):
+        x, v, z = s
+        angle = 2 * x
+        return [v, -4.0 * x + amp * np.sin(angle) + z + amp, -z + angle]
+
+    ref = solve_ivp(rhs, (0, 1.0), [1.0, 0.0, 0.0], t_eval=np.linspace(0.1, 1.0, 10), rtol=1e-10, atol=1e-12)
+    with FMU(fmu) as f:
+        f.setup(0.0, parameters={"ripple.amplitude": amp})
+        y = f.capture(1.0, 0.1, ["y"])[:, 0]
+    np.testing.assert_allclose(y, ref.y[0] + 0.5, rtol=0, atol=1e-8)
