@@ -183,6 +183,76 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     return 0
 
 
+def _executor(workers):
+    if workers is None:
+        return None
+    return _lib("twin.executor").make_executor({"type": "local", "workers": workers})
+
+
+def _cmd_diagnose(args: argparse.Namespace) -> int:
+    scenario = _lib("twin.scenario").load_scenario(Path(args.scenario))
+    diag = _lib("twin.effects.loop").diagnose_scenario(scenario, Path(args.measurements), record=args.record,
+                                                       json_path=args.json, executor=_executor(args.workers),
+                                                       duration=args.duration)
+    print(diag.table())
+    for c in diag.candidates[:1]:
+        for e in c.evidence:
+            print(f"  explains [{e.kind}] {e.finding}: {e.reason}")
+    if args.json:
+        print(f"diagnosis -> {args.json}")
+    return 0
+
+
+def _cmd_add_effect(args: argparse.Namespace) -> int:
+    scenario = _lib("twin.scenario").load_scenario(Path(args.scenario))
+    add = _lib("twin.effects.loop").add_effect(scenario, Path(args.measurements), args.effect, Path(args.out),
+                                               record=args.record, modelica_dir=args.modelica_dir,
+                                               duration=args.duration)
+    print(f"variant {add.model} -> {add.modelica_file}")
+    print(f"FMU -> {add.fmu}")
+    print("fitted: " + ", ".join(f"{k} = {v:.4g}" for k, v in add.fitted.items()))
+    print(f"log-spectral distance {add.lsd_before_db:.2f} dB -> {add.lsd_after_db:.2f} dB "
+          f"({100 * add.reduction:.0f} % less)")
+    for desc, b, a in add.per_finding:
+        print(f"  {desc}: squared dB error {b:.0f} -> {a:.0f}")
+    print(f"scenario for the variant -> {add.scenario_file}")
+    return 0
+
+
+def _cmd_improve(args: argparse.Namespace) -> int:
+    scenario = _lib("twin.scenario").load_scenario(Path(args.scenario))
+    loop = _lib("twin.effects.loop")
+    history = loop.improve(scenario, Path(args.measurements), Path(args.out), record=args.record,
+                           max_steps=args.max_steps, executor=_executor(args.workers),
+                           modelica_dir=args.modelica_dir, duration=args.duration)
+    print(loop.history_table(history))
+    print(f"history -> {Path(args.out) / 'history.csv'}, plot -> {Path(args.out) / 'history.png'}")
+    return 0
+
+
+def _cmd_effects(args: argparse.Namespace) -> int:
+    effects = _lib("twin.effects")
+    if args.write_candidates:
+        model, path = effects.write_variant(effects.candidates_source(), args.modelica_dir)
+        print(f"{model} -> {path}")
+        return 0
+    for e in effects.CATALOGUE.values():
+        fit = ", ".join(f"{p.name} [{p.lower:g}, {p.upper:g}]" for p in e.fit)
+        print(f"{e.id:<24} {e.component:<40} fits: {fit}")
+    return 0
+
+
+def _loop_arguments(p: argparse.ArgumentParser, *, out: bool) -> None:
+    p.add_argument("scenario", help="scenario file (its model and calibrated parameters)")
+    p.add_argument("--measurements", required=True, help="measurement file (HDF5 or CSV + sidecar)")
+    p.add_argument("--record", help="record name (default: the first)")
+    p.add_argument("--duration", type=float, default=2.0, help="seconds of the record compared (default: 2)")
+    if out:
+        p.add_argument("--out", required=True, help="output directory")
+        p.add_argument("--modelica-dir", type=Path, default=None,
+                       help="Modelica root the variant is written to (default: the repository's modelica/)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """Return the ``twin`` argument parser (one sub-parser per command)."""
     parser = argparse.ArgumentParser(
@@ -261,6 +331,29 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--record", help="record name (default: the first)")
     p.add_argument("--duration", type=float, help="use the last DURATION seconds of the record")
     p.set_defaults(handler=_cmd_compare)
+
+    p = sub.add_parser("diagnose", help="rank the catalogue effects the model may be missing, by trying each")
+    _loop_arguments(p, out=False)
+    p.add_argument("--json", type=Path, help="write the diagnosis here")
+    p.add_argument("--workers", type=int, help="local worker processes (default: one per core)")
+    p.set_defaults(handler=_cmd_diagnose)
+
+    p = sub.add_parser("add-effect", help="write a model variant with an effect, build it, recalibrate, report")
+    p.add_argument("effect", help="catalogue id (see twin effects)")
+    _loop_arguments(p, out=True)
+    p.set_defaults(handler=_cmd_add_effect)
+
+    p = sub.add_parser("improve", help="diagnose -> add-effect -> recalibrate until nothing improves the fit")
+    _loop_arguments(p, out=True)
+    p.add_argument("--max-steps", type=int, default=4)
+    p.add_argument("--workers", type=int, help="local worker processes (default: one per core)")
+    p.set_defaults(handler=_cmd_improve)
+
+    p = sub.add_parser("effects", help="list the effect catalogue")
+    p.add_argument("--write-candidates", action="store_true",
+                   help="regenerate GearTwin.Variants.Gearbox21Candidates from the catalogue")
+    p.add_argument("--modelica-dir", type=Path, default=None)
+    p.set_defaults(handler=_cmd_effects)
 
     from twin.rul import add_subcommands as add_rul
     add_rul(sub)

@@ -1,9 +1,11 @@
 """Compare the twin with a measurement and split the discrepancy into localised findings.
 
-Headline metric: the **log-spectral distance** (LSD) in dB over the analysed band. It is the RMS
-of the difference between the measured and simulated Welch PSDs in dB, with both floored at the
-measured median level, so that bins where the measurement only shows its noise floor do not
-count.
+Headline metric: the **log-spectral distance** (LSD) in dB over the analysed band: the RMS of the
+difference between the measured and simulated Welch PSDs in dB (see :func:`spectral_levels`). The
+measurement is signal plus noise, so the model PSD gets the measured noise level (the median
+measured level) added, and both are floored 3 dB above it: bins where the measurement only shows
+its noise do not count. The model level is shifted by the median difference (at most 1 dB) so that
+a sensor gain error of a few percent is not reported as a discrepancy.
 
 The squared differences D(f)^2 are then attributed to localised findings, each with a band, a size
 in dB and a share of the total sum of D^2:
@@ -36,6 +38,31 @@ from scipy.stats import kurtosis
 from twin.signals import shaft_angle_from_speed, synchronous_average, welch_psd
 
 
+MAX_GAIN_DB = 1.0   # sensor sensitivity uncertainty absorbed by the level alignment (about +-12 %)
+
+
+def spectral_levels(pm: np.ndarray, pp: np.ndarray, *, max_gain_db: float = MAX_GAIN_DB
+                    ) -> tuple[np.ndarray, np.ndarray, float]:
+    """Measured and model levels [dB] on which the log-spectral distance is taken.
+
+    ``pm``, ``pp``: (n,) model and measured PSDs over the analysed band. The measurement is signal
+    plus noise, so the model is compared with its PSD plus the measured noise level (the median
+    measured level); both are floored 3 dB above that level. A sensor gain error of a few percent is not a missing
+    effect: the model level is shifted by the median dB difference over the bins above the floor,
+    limited to +-``max_gain_db``. Returns (measured dB, model dB, applied gain [dB]).
+    """
+    noise = max(float(np.median(pp)), 1e-30)
+    # floored 3 dB above the noise level: a Welch estimate of pure noise rarely gets there, so
+    # bins that only hold noise count as equal instead of adding their estimation scatter
+    floor = 2.0 * noise
+    lp = 10 * np.log10(np.maximum(pp, floor))
+    above = lp > 10 * np.log10(floor)
+    raw = 10 * np.log10(np.maximum(pm + noise, floor))
+    gain = float(np.clip(np.median((lp - raw)[above]), -max_gain_db, max_gain_db)) if above.any() else 0.0
+    lm = 10 * np.log10(np.maximum(pm * 10 ** (gain / 10) + noise, floor))
+    return lp, lm, gain
+
+
 @dataclass(frozen=True)
 class Finding:
     kind: str                    # mesh_harmonic, sideband, shaft_order, unlocked_line, resonance, impulsive
@@ -62,8 +89,10 @@ class Comparison:
 
     def to_dict(self) -> dict:
         return {"headline": {"log_spectral_distance_db": self.lsd_db,
-                             "definition": "RMS over the band of (measured - model) Welch PSD in dB, both floored "
-                                           "at the measured median level"},
+                             "definition": "RMS over the band of (measured - model) Welch PSD in dB; the model PSD "
+                                           "plus the measured noise level (median), both floored 3 dB above "
+                                           "it, the model shifted by the median dB difference (sensor gain, "
+                                           "at most 1 dB)"},
                 "f1_waveform": self.f1, "f2_spectrum": self.f2,
                 "rms": {"measured": self.rms_measured, "model": self.rms_model},
                 "shaft_hz": self.shaft_hz,
@@ -91,9 +120,7 @@ def compare_signals(model: np.ndarray, measured: np.ndarray, fs: float, shaft_hz
     _, pp = welch_psd(measured, fs, resolution=resolution)
     band = (f >= fmin) & (f <= min(fmax, fs / 2))
     f, pm, pp = f[band], pm[band], pp[band]
-    floor = max(float(np.median(pp)), 1e-30)
-    lm = 10 * np.log10(np.maximum(pm, floor))
-    lp = 10 * np.log10(np.maximum(pp, floor))
+    lp, lm, gain_db = spectral_levels(pm, pp)
     d = lp - lm                                   # measured minus model [dB]
     d2 = d ** 2
     total = float(np.sum(d2)) or 1.0
@@ -155,7 +182,9 @@ def compare_signals(model: np.ndarray, measured: np.ndarray, fs: float, shaft_hz
     nfft = 1 << int(np.ceil(np.log2(8 * n)))
     fine = np.abs(np.fft.rfft((measured - measured.mean()) * np.hanning(n), n=nfft))
     ffine = np.fft.rfftfreq(nfft, 1.0 / fs)
-    lock_tol = max(0.3, 2.0 * fs / n)          # Hz
+    # a strong line on a zero-padded FFT is located far better than 1/T: 0.3/T still separates a
+    # ripple line from a shaft order 1 Hz away in a 1 s record
+    lock_tol = max(0.1, 0.3 * fs / n)          # Hz
     prom = lp - median_filter(lp, size=max(5, int(round(30.0 / df))) | 1, mode="nearest")
     peaks, _ = find_peaks(prom, height=10.0)
     for j in peaks:

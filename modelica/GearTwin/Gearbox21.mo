@@ -15,6 +15,10 @@ model Gearbox21 "21-DOF lumped model of the UNSW spur-gear test rig (Feng et al.
   parameter Real rb1(unit = "m") = 0.5 * module * z1 * cos(alpha) "Pinion base radius";
   parameter Real rb2(unit = "m") = 0.5 * module * z2 * cos(alpha) "Gear base radius";
   parameter Real contact_ratio = (sqrt((0.5 * module * z1 + addendum_coefficient * module) ^ 2 - rb1 ^ 2) + sqrt((0.5 * module * z2 + addendum_coefficient * module) ^ 2 - rb2 ^ 2) - 0.5 * module * (z1 + z2) * sin(alpha)) / (GearTwin.pi * module * cos(alpha)) "Transverse contact ratio";
+  parameter Real line_of_action_length(unit = "m") = 0.5 * module * (z1 + z2) * sin(alpha) "Distance T1-T2 between the points where the line of action touches the base circles";
+  parameter Real contact_path_length(unit = "m") = contact_ratio * GearTwin.pi * module * cos(alpha) "Length of the path of contact";
+  parameter Real contact_start_radius(unit = "m") = line_of_action_length - sqrt((0.5 * module * z2 + addendum_coefficient * module) ^ 2 - rb2 ^ 2) "Distance from T1 to the start of contact (curvature radius of the pinion flank there)";
+  parameter Real roll_pitch = (0.5 * module * z1 * sin(alpha) - contact_start_radius) / contact_path_length "Roll position of the pitch point, where sliding reverses (0 = start, 1 = end of contact)";
 
   // ---- Mesh stiffness and profile (tunable; the degradation models write these) -------------
   parameter Integer n_profile = 11 "Number of nodes along the path of contact (structural)";
@@ -179,6 +183,21 @@ model Gearbox21 "21-DOF lumped model of the UNSW spur-gear test rig (Feng et al.
   output Real transmission_error(unit = "m") "rb1*theta5 - rb2*theta10 along the line of action";
   output Real motor_speed(unit = "rad/s") = omega1 "Motor speed";
   output Real motor_torque(unit = "N.m") "Torque delivered by the motor";
+  Real casing_acceleration_pinion(unit = "m/s2") "Acceleration of pedestal 6 along the pinion sensor axis";
+
+  // ---- Effect hooks ----------------------------------------------------------------------------
+  // Zero in this model. A variant written by `twin add-effect` (or by hand, see
+  // GearTwin/Effects/README.md) extends this model and binds a hook to the output of an effect
+  // component from GearTwin.Effects, e.g. extends Gearbox21(effect_drive_torque = ripple.torque).
+  Real effect_mesh_displacement(unit = "m") = 0 "Extra approach of the flanks along the line of action (run-out)";
+  Real effect_mesh_displacement_rate(unit = "m/s") = 0 "Time derivative of effect_mesh_displacement";
+  Real effect_mesh_force(unit = "N") = 0 "Extra force along the line of action (back-flank contact)";
+  Real effect_drive_torque(unit = "N.m") = 0 "Extra motor torque (torque ripple)";
+  Real effect_load_torque(unit = "N.m") = 0 "Extra brake torque (load fluctuation)";
+  Real effect_pinion_torque(unit = "N.m") = 0 "Extra torque on the pinion (tooth friction)";
+  Real effect_gear_torque(unit = "N.m") = 0 "Extra torque on the gear, driven direction positive (tooth friction)";
+  Real effect_off_line_force(unit = "N") = 0 "Force on the pinion across the line of action, along (cos alpha, -sin alpha); the gear takes the reaction (tooth friction)";
+  Real effect_sensor_acceleration_pinion(unit = "m/s2") = 0 "Extra acceleration seen by the pinion-side sensor (casing panel or sensor-mount mode)";
 equation
   // Tooth-pair bookkeeping without events: the mesh phase is wrapped with atan2, the tooth
   // identity is read from the angle of the last entered tooth on the unit circle.
@@ -195,14 +214,14 @@ equation
   // Piecewise-linear interpolation along the profile: hat functions on n_profile nodes.
   pair_stiffness = {mesh_stiffness_scale * window[i] * pair_tooth_factor[i] * sum(k_pair[n] * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[i]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile) for i in 1:3};
   pair_deviation = {pair_tooth_offset[i] + sum(profile_deviation[n] * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[i]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile) for i in 1:3};
-  mesh_deflection = rb1 * theta5 - rb2 * theta10 + (x5 - x10) * sin(alpha) + (y5 - y10) * cos(alpha);
-  mesh_deflection_rate = rb1 * omega5 - rb2 * omega10 + (vx5 - vx10) * sin(alpha) + (vy5 - vy10) * cos(alpha);
+  mesh_deflection = rb1 * theta5 - rb2 * theta10 + (x5 - x10) * sin(alpha) + (y5 - y10) * cos(alpha) + effect_mesh_displacement;
+  mesh_deflection_rate = rb1 * omega5 - rb2 * omega10 + (vx5 - vx10) * sin(alpha) + (vy5 - vy10) * cos(alpha) + effect_mesh_displacement_rate;
   // A pair whose flanks are apart (deviation larger than the approach) carries no load.
   pair_force = {pair_stiffness[i] * noEvent(max(0.0, mesh_deflection - pair_deviation[i])) for i in 1:3};
-  mesh_force = pair_force[1] + pair_force[2] + pair_force[3] + c_mesh * mesh_deflection_rate;
+  mesh_force = pair_force[1] + pair_force[2] + pair_force[3] + c_mesh * mesh_deflection_rate + effect_mesh_force;
   mesh_stiffness = pair_stiffness[1] + pair_stiffness[2] + pair_stiffness[3];
   transmission_error = rb1 * theta5 - rb2 * theta10;
-  motor_torque = drive_torque + c_motor * (motor_speed_ref - omega1);
+  motor_torque = drive_torque + c_motor * (motor_speed_ref - omega1) + effect_drive_torque;
 
   // ---- Torsional equations ------------------------------------------------------------------
   der(theta1) = omega1;
@@ -217,12 +236,12 @@ equation
   I1 * der(omega1) = motor_torque - kt12 * (theta1 - theta2) - ct12 * (omega1 - omega2);
   I2 * der(omega2) = kt12 * (theta1 - theta2) + ct12 * (omega1 - omega2) - kt23 * (theta2 - theta3) - ct23 * (omega2 - omega3);
   I3 * der(omega3) = kt23 * (theta2 - theta3) + ct23 * (omega2 - omega3) - kt35 * (theta3 - theta5) - ct35 * (omega3 - omega5);
-  I5 * der(omega5) = kt35 * (theta3 - theta5) + ct35 * (omega3 - omega5) - kt57 * (theta5 - theta7) - ct57 * (omega5 - omega7) - rb1 * mesh_force;
+  I5 * der(omega5) = kt35 * (theta3 - theta5) + ct35 * (omega3 - omega5) - kt57 * (theta5 - theta7) - ct57 * (omega5 - omega7) - rb1 * mesh_force + effect_pinion_torque;
   I7 * der(omega7) = kt57 * (theta5 - theta7) + ct57 * (omega5 - omega7);
   I8 * der(omega8) = kt810 * (theta10 - theta8) + ct810 * (omega10 - omega8);
-  I10 * der(omega10) = rb2 * mesh_force - kt810 * (theta10 - theta8) - ct810 * (omega10 - omega8) - kt1012 * (theta10 - theta12) - ct1012 * (omega10 - omega12);
+  I10 * der(omega10) = rb2 * mesh_force + effect_gear_torque - kt810 * (theta10 - theta8) - ct810 * (omega10 - omega8) - kt1012 * (theta10 - theta12) - ct1012 * (omega10 - omega12);
   I12 * der(omega12) = kt1012 * (theta10 - theta12) + ct1012 * (omega10 - omega12) - kt1213 * (theta12 - theta13) - ct1213 * (omega12 - omega13);
-  I13 * der(omega13) = kt1213 * (theta12 - theta13) + ct1213 * (omega12 - omega13) - load_torque;
+  I13 * der(omega13) = kt1213 * (theta12 - theta13) + ct1213 * (omega12 - omega13) - load_torque - effect_load_torque;
 
   // ---- Lateral equations --------------------------------------------------------------------
   der(x4) = vx4;
@@ -239,18 +258,19 @@ equation
   der(y11) = vy11;
   m4 * der(vx4) = -kx4 * x4 - cx4 * vx4 + kx45 * (x5 - x4) + cx45 * (vx5 - vx4);
   m4 * der(vy4) = -ky4 * y4 - cy4 * vy4 + ky45 * (y5 - y4) + cy45 * (vy5 - vy4);
-  m5 * der(vx5) = -kx45 * (x5 - x4) - cx45 * (vx5 - vx4) - kx56 * (x5 - x6) - cx56 * (vx5 - vx6) - mesh_force * sin(alpha);
-  m5 * der(vy5) = -ky45 * (y5 - y4) - cy45 * (vy5 - vy4) - ky56 * (y5 - y6) - cy56 * (vy5 - vy6) - mesh_force * cos(alpha);
+  m5 * der(vx5) = -kx45 * (x5 - x4) - cx45 * (vx5 - vx4) - kx56 * (x5 - x6) - cx56 * (vx5 - vx6) - mesh_force * sin(alpha) + effect_off_line_force * cos(alpha);
+  m5 * der(vy5) = -ky45 * (y5 - y4) - cy45 * (vy5 - vy4) - ky56 * (y5 - y6) - cy56 * (vy5 - vy6) - mesh_force * cos(alpha) - effect_off_line_force * sin(alpha);
   m6 * der(vx6) = -kx6 * x6 - cx6 * vx6 + kx56 * (x5 - x6) + cx56 * (vx5 - vx6);
   m6 * der(vy6) = -ky6 * y6 - cy6 * vy6 + ky56 * (y5 - y6) + cy56 * (vy5 - vy6);
   m9 * der(vx9) = -kx9 * x9 - cx9 * vx9 + kx910 * (x10 - x9) + cx910 * (vx10 - vx9);
   m9 * der(vy9) = -ky9 * y9 - cy9 * vy9 + ky910 * (y10 - y9) + cy910 * (vy10 - vy9);
-  m10 * der(vx10) = -kx910 * (x10 - x9) - cx910 * (vx10 - vx9) - kx1011 * (x10 - x11) - cx1011 * (vx10 - vx11) + mesh_force * sin(alpha);
-  m10 * der(vy10) = -ky910 * (y10 - y9) - cy910 * (vy10 - vy9) - ky1011 * (y10 - y11) - cy1011 * (vy10 - vy11) + mesh_force * cos(alpha);
+  m10 * der(vx10) = -kx910 * (x10 - x9) - cx910 * (vx10 - vx9) - kx1011 * (x10 - x11) - cx1011 * (vx10 - vx11) + mesh_force * sin(alpha) - effect_off_line_force * cos(alpha);
+  m10 * der(vy10) = -ky910 * (y10 - y9) - cy910 * (vy10 - vy9) - ky1011 * (y10 - y11) - cy1011 * (vy10 - vy11) + mesh_force * cos(alpha) + effect_off_line_force * sin(alpha);
   m11 * der(vx11) = -kx11 * x11 - cx11 * vx11 + kx1011 * (x10 - x11) + cx1011 * (vx10 - vx11);
   m11 * der(vy11) = -ky11 * y11 - cy11 * vy11 + ky1011 * (y10 - y11) + cy1011 * (vy10 - vy11);
 
   // ---- Sensors ------------------------------------------------------------------------------
-  accel_pinion_casing = cos(sensor_angle_pinion) * der(vy6) + sin(sensor_angle_pinion) * der(vx6);
+  casing_acceleration_pinion = cos(sensor_angle_pinion) * der(vy6) + sin(sensor_angle_pinion) * der(vx6);
+  accel_pinion_casing = casing_acceleration_pinion + effect_sensor_acceleration_pinion;
   accel_gear_casing = cos(sensor_angle_gear) * der(vy9) + sin(sensor_angle_gear) * der(vx9);
 end Gearbox21;

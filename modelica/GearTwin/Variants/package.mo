@@ -1,0 +1,3 @@
+within GearTwin;
+package Variants "Base gearbox models extended with effect components (written by twin add-effect or by hand)"
+end Variants;

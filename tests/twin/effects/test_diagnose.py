@@ -1,0 +1,47 @@
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from twin.compare import spectral_levels
+from twin.effects.diagnose import active_effects, diagnose
+from twin.errors import MeasurementError, ParameterError
+
+
+def test_spectral_levels_absorb_a_small_gain_error_but_not_a_large_one():
+    rng = np.random.default_rng(0)
+    pm = np.zeros(500)
+    pm[::5] = 10 ** rng.uniform(-3, 0, 100)      # lines over a noise-free model floor
+    pp = pm * 1.03 ** 2 + 1e-6                   # the measurement: 3 % gain and white noise
+    lp, lm, g = spectral_levels(pm, pp)
+    assert g == pytest.approx(20 * np.log10(1.03), abs=0.02)
+    assert np.sqrt(np.mean((lp - lm) ** 2)) < 0.05
+    _, _, g2 = spectral_levels(pm, pm * 10.0)        # +10 dB is not a sensor gain error
+    assert g2 == pytest.approx(1.0)
+
+
+def test_active_effects_are_read_from_parameter_names():
+    assert active_effects(["k_pair[1]", "housing_mode.frequency", "backlash.gap", "solver.step_size"]) == \
+        ["housing_mode", "backlash"]
+
+
+def test_bad_records_and_models_are_refused(gearbox_fmu, two_mass_fmu):
+    with pytest.raises(MeasurementError, match="NaN"):
+        diagnose(gearbox_fmu, np.full(20000, np.nan), 20000.0, 20.0, 20.0)
+    with pytest.raises(MeasurementError, match="at least 0.25 s"):
+        diagnose(gearbox_fmu, np.zeros(100), 20000.0, 20.0, 20.0)
+    with pytest.raises(ParameterError, match="not a GearTwin.Gearbox21 model"):
+        diagnose(two_mass_fmu, np.zeros(20000), 20000.0, 20.0, 20.0)
+
+
+def test_starting_value_of_a_ripple_is_the_unlocked_line(gearbox_fmu):
+    from twin.compare import compare_signals
+    from twin.effects.diagnose import starting_values
+    fs, shaft = 20000.0, 19.6
+    t = np.arange(int(fs)) / fs
+    gmf = 19 * shaft
+    model = np.sin(2 * np.pi * gmf * t) + 0.3 * np.sin(2 * np.pi * 2 * gmf * t)
+    measured = model + 0.05 * np.sin(2 * np.pi * 151.3 * t) + 1e-3 * np.random.default_rng(1).normal(size=t.size)
+    comp = compare_signals(model, measured, fs, shaft)
+    guess = starting_values(comp, measured, model, fs, shaft, 19, 52)
+    assert guess["motor_torque_ripple"]["frequency"] == pytest.approx(151.3, abs=0.2)

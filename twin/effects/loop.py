@@ -1,0 +1,244 @@
+"""The user's loop on scenario files: diagnose, add an effect, improve until nothing helps.
+
+* :func:`diagnose_scenario` runs :func:`twin.effects.diagnose.diagnose` on a measurement record
+  with the scenario's model and parameters, and writes ``diagnosis.json``.
+* :func:`add_effect` writes a variant ``.mo`` (the current effects plus the new one) into
+  ``modelica/GearTwin/Variants/``, builds its FMU, recalibrates the new effect's parameters on
+  that FMU, compares before and after (overall and per finding), and writes a scenario file for
+  the variant so the next step starts from it.
+* :func:`improve` repeats diagnose -> add -> recalibrate until the diagnosis finds no candidate
+  that cuts the discrepancy, and keeps a history table (CSV, JSON) and a plot.
+"""
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+
+from twin.effects.catalogue import CATALOGUE, effect as get_effect
+from twin.effects.diagnose import (Diagnosis, Operating, TrialSpec, active_effects, diagnose, fit_effect,
+                                   simulate)
+
+
+@dataclass(frozen=True)
+class MeasuredRecord:
+    name: str
+    signal: np.ndarray          # (n,) [m/s2]
+    sample_rate: float
+    nominal_speed: float
+    load: float
+
+
+def read_record(measurements, channel: str = "accel_pinion_casing", record: str | None = None) -> MeasuredRecord:
+    """One record of a measurement file, with the attributes the loop needs."""
+    from twin.errors import MeasurementError
+    from twin.measurements import load_measurements
+    mset = load_measurements(measurements, channels=[channel])
+    rec = mset[record] if record else mset[0]
+    missing = [a for a in ("nominal_speed", "load") if getattr(rec, a) is None]
+    if missing:
+        raise MeasurementError(str(measurements), rec.name, f"lacks {', '.join(missing)} (the drive speed [Hz] "
+                                                            "and brake load [N.m] the record was taken at)")
+    return MeasuredRecord(rec.name, np.asarray(rec[channel], float), float(rec.sample_rate),
+                          float(rec.nominal_speed), float(rec.load))
+
+
+def _write_json(path: Path, data: dict) -> None:
+    from twin._atomic import atomic_path
+    with atomic_path(path) as tmp:
+        Path(tmp).write_text(json.dumps(data, indent=2, default=float))
+
+
+def _out_dir(out) -> Path:
+    from twin.errors import OutputPathError
+    out = Path(out)
+    if not out.parent.exists():
+        raise OutputPathError(f"parent directory {out.parent} does not exist")
+    out.mkdir(exist_ok=True)
+    return out
+
+
+def diagnose_scenario(scenario, measurements, *, record: str | None = None, json_path=None, executor=None,
+                      duration: float = 2.0, progress: bool = True, candidates_fmu=None) -> Diagnosis:
+    """``twin diagnose``: the scenario's model against one record; writes ``json_path`` if given."""
+    from twin.errors import OutputPathError
+    if json_path is not None and not Path(json_path).parent.exists():
+        raise OutputPathError(f"parent directory of {json_path} does not exist")
+    channel = (scenario.outputs or ("accel_pinion_casing",))[0]
+    rec = read_record(measurements, channel, record)
+    diag = diagnose(scenario.fmu_path(), rec.signal, rec.sample_rate, rec.nominal_speed, rec.load,
+                    parameters=dict(scenario.parameters), channel=channel, executor=executor, record=rec.name,
+                    duration=duration, progress=progress, candidates_fmu=candidates_fmu)
+    if json_path is not None:
+        _write_json(Path(json_path), {"scenario": scenario.name, "measurements": str(measurements),
+                                      **diag.to_dict()})
+    return diag
+
+
+@dataclass(frozen=True)
+class Addition:
+    effect: str
+    model: str                          # Modelica name of the variant
+    modelica_file: Path
+    fmu: Path
+    scenario_file: Path | None
+    fitted: dict                        # effect parameters after recalibration
+    lsd_before_db: float
+    lsd_after_db: float
+    per_finding: tuple                  # (description, squared-dB error before, after)
+
+    @property
+    def reduction(self) -> float:
+        return (self.lsd_before_db - self.lsd_after_db) / self.lsd_before_db if self.lsd_before_db > 0 else 0.0
+
+
+def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str | None = None,
+               start: dict | None = None, modelica_dir=None, build_dir=None, duration: float = 2.0,
+               max_evals: int = 30) -> Addition:
+    """``twin add-effect``: variant .mo -> FMU -> recalibration -> before/after report.
+
+    ``start`` holds starting values of the effect parameters (FMU names), e.g. from a diagnosis;
+    without it the fit starts from the physics-based guesses of the diagnosis module.
+    """
+    import yaml
+    from fmu_build import build_fmu
+
+    from twin._atomic import atomic_path
+    from twin.calibration.objectives import estimate_shaft_hz
+    from twin.compare import compare_signals
+    from twin.effects.diagnose import _band_error, starting_values
+    from twin.effects.variant import _REPO_MODELICA, variant_source, write_variant
+    from twin.errors import ParameterError
+    from twin.fmu import FMU
+
+    eff = get_effect(effect_id)
+    out = _out_dir(out_dir)
+    modelica_dir = Path(modelica_dir) if modelica_dir is not None else _REPO_MODELICA
+    build_dir = Path(build_dir) if build_dir is not None else modelica_dir.parent / "build"
+    channel = (scenario.outputs or ("accel_pinion_casing",))[0]
+    rec = read_record(measurements, channel, record)
+    current_fmu = scenario.fmu_path()
+    with FMU(current_fmu) as fmu:
+        current = fmu.parameter_values()
+        z1 = int(round(float(fmu.variables["z1"].start))) if "z1" in fmu.variables else 19
+    active = active_effects(current)
+    if effect_id in active:
+        raise ParameterError(f"the model {scenario.fmu} already has {effect_id}")
+    # carry the active effects' values into the new variant so it reproduces the current model
+    values = {k: v for k, v in current.items() if any(k.startswith(a + ".") for a in active)}
+    measured = rec.signal[-int(round(min(duration, rec.signal.size / rec.sample_rate) * rec.sample_rate)):]
+    z2 = int(round(current.get("z2", 52)))
+    shaft = estimate_shaft_hz(measured, rec.sample_rate, rec.nominal_speed, z1)
+    c_motor = float(scenario.parameters.get("c_motor", current.get("c_motor", 3.0)))
+    op = Operating(shaft + rec.load * z1 / z2 / c_motor / (2 * np.pi), shaft, rec.load, rec.sample_rate)
+    base_params = dict(scenario.parameters)
+    sim0 = simulate(current_fmu, base_params, op, measured.size, channel)
+    before = compare_signals(sim0, measured, rec.sample_rate, shaft, z1=z1, z2=z2)
+
+    # 1) the variant source, with neutral values for the new effect until it is fitted
+    ids = [*active, effect_id]
+    neutral = {eff.parameter(k): v for k, v in eff.neutral.items()}
+    model, path = write_variant(variant_source(ids, {**values, **neutral}), modelica_dir)
+    fmu_path = build_fmu(model, modelica_dir, build_dir)
+    # 2) recalibrate the new effect's parameters on the variant's own FMU
+    guesses = starting_values(before, measured, sim0, rec.sample_rate, shaft, z1, z2).get(effect_id, {})
+    if start:
+        guesses.update({k.split(".", 1)[1]: v for k, v in start.items() if k.startswith(effect_id + ".")})
+    spec = TrialSpec(effect_id, str(fmu_path), channel, measured, op, {**base_params, **values, **neutral},
+                     guesses, max_evals)
+    fitted, _, _ = fit_effect(spec)
+    # 3) write the variant again with the fitted values as its defaults, rebuild (cached by source)
+    model, path = write_variant(variant_source(ids, {**values, **neutral, **fitted}), modelica_dir)
+    fmu_path = build_fmu(model, modelica_dir, build_dir)
+    sim1 = simulate(fmu_path, base_params, op, measured.size, channel)
+    after = compare_signals(sim1, measured, rec.sample_rate, shaft, z1=z1, z2=z2)
+    per = tuple((f.description, _band_error(before, f.band_hz), _band_error(after, f.band_hz))
+                for f in before.findings)
+    # 4) a scenario for the variant, so the next step (or twin run) starts from it
+    raw = dict(scenario.raw) if scenario.raw else {"version": 1, "name": scenario.name, "stop_time": 1.0}
+    raw["name"] = f"{scenario.name}+{effect_id}"
+    # the model name resolves through the repository's modelica/; a variant written elsewhere is
+    # referenced by its FMU file
+    raw["fmu"] = model if modelica_dir.resolve() == _REPO_MODELICA.resolve() else str(Path(fmu_path).resolve())
+    raw["parameters"] = {k: float(v) for k, v in scenario.parameters.items()}
+    scen_file = out / f"scenario_{effect_id}.yaml"
+    with atomic_path(scen_file) as tmp:
+        Path(tmp).write_text(yaml.safe_dump(raw, sort_keys=False))
+    add = Addition(effect_id, model, path, fmu_path, scen_file, fitted, before.lsd_db, after.lsd_db, per)
+    _write_json(out / f"add_effect_{effect_id}.json",
+                {"effect": effect_id, "model": model, "modelica_file": str(path), "fmu": str(fmu_path),
+                 "scenario": str(scen_file), "fitted_parameters": fitted,
+                 "log_spectral_distance_db": {"before": before.lsd_db, "after": after.lsd_db},
+                 "reduction": add.reduction,
+                 "per_finding": [{"finding": d, "squared_db_error_before": b, "squared_db_error_after": a}
+                                 for d, b, a in per]})
+    return add
+
+
+@dataclass(frozen=True)
+class Step:
+    step: int
+    effect: str | None
+    lsd_before_db: float
+    lsd_after_db: float
+    model: str
+    verdict: str
+
+
+def improve(scenario, measurements, out_dir, *, record: str | None = None, max_steps: int = 4, executor=None,
+            modelica_dir=None, build_dir=None, duration: float = 2.0, progress: bool = True) -> tuple[Step, ...]:
+    """``twin improve``: diagnose -> add -> recalibrate until no candidate improves the fit."""
+    from twin.scenario import load_scenario
+    out = _out_dir(out_dir)
+    history: list[Step] = []
+    for k in range(1, max_steps + 1):
+        diag = diagnose_scenario(scenario, measurements, record=record, executor=executor, duration=duration,
+                                 progress=progress, json_path=out / f"diagnosis_{k}.json")
+        if diag.verdict != "missing_effect":
+            history.append(Step(k, None, diag.lsd_db, diag.lsd_db, scenario.fmu, diag.verdict))
+            break
+        add = add_effect(scenario, measurements, diag.missing, out, record=record,
+                         start=diag.candidates[0].fitted, modelica_dir=modelica_dir, build_dir=build_dir,
+                         duration=duration)
+        history.append(Step(k, add.effect, add.lsd_before_db, add.lsd_after_db, add.model, diag.verdict))
+        if add.lsd_after_db >= add.lsd_before_db:
+            break
+        scenario = load_scenario(add.scenario_file)
+    _write_history(history, out)
+    return tuple(history)
+
+
+def history_table(history) -> str:
+    rows = [f"{'step':>4}  {'effect added':<24} {'LSD before':>10}  {'LSD after':>9}  model"]
+    for s in history:
+        rows.append(f"{s.step:>4}  {(s.effect or '(none: ' + s.verdict + ')'):<24} {s.lsd_before_db:>8.2f} dB"
+                    f"  {s.lsd_after_db:>6.2f} dB  {s.model}")
+    return "\n".join(rows)
+
+
+def _write_history(history, out: Path) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from twin._atomic import atomic_path
+    _write_json(out / "history.json", {"steps": [asdict(s) for s in history]})
+    with atomic_path(out / "history.csv") as tmp:
+        Path(tmp).write_text("step,effect,lsd_before_db,lsd_after_db,model,verdict\n" + "".join(
+            f"{s.step},{s.effect or ''},{s.lsd_before_db:.4f},{s.lsd_after_db:.4f},{s.model},{s.verdict}\n"
+            for s in history))
+    fig, ax = plt.subplots(figsize=(7, 4))
+    levels = [history[0].lsd_before_db] + [s.lsd_after_db for s in history]
+    labels = ["start"] + [s.effect or "no change" for s in history]
+    ax.plot(range(len(levels)), levels, "o-", color="tab:blue")
+    ax.set_xticks(range(len(levels)), labels, rotation=20, ha="right")
+    ax.set_ylabel("log-spectral distance [dB]")
+    ax.set_title("twin improve: discrepancy after each added effect")
+    ax.grid(alpha=0.3)
+    ax.set_ylim(bottom=0)
+    fig.tight_layout()
+    with atomic_path(out / "history.png") as tmp:
+        fig.savefig(tmp, format="png", dpi=110)
+    plt.close(fig)
