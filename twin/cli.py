@@ -355,6 +355,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--modelica-dir", type=Path, default=None)
     p.set_defaults(handler=_cmd_effects)
 
+    from twin.transfer.cli import add_subcommands as add_transfer
+    add_transfer(sub)
+
     from twin.rul import add_subcommands as add_rul
     add_rul(sub)
 

@@ -1,0 +1,54 @@
+"""Benchmark: transfer from the twin's archive to an emulated rig, CNN vs MMD vs proposed.
+
+    python bench/transfer.py [--seeds 5] [--task both] [--epochs 80] [--jobs 2] [--out bench_out/transfer]
+
+Builds (or reuses, in OUT/data) the source archives of scenarios/lubricated.yaml (6 pitting
+stages) and scenarios/dry.yaml (4 wear stages) and their "measured" target domains
+(twin.transfer.domain.make_target_domain), then trains every method with the paper's settings
+(alpha = beta = 0.1, lr 0.01, batch 20, 80 epochs) for each seed and scores the last epoch on the
+held-out second halves of the target records.  Prints the machine and a Markdown table for
+BENCHMARKS.md; figures and report.html go to OUT.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import sys
+import time
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO))
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--seeds", type=int, default=5)
+    ap.add_argument("--task", choices=("pitting", "wear", "both"), default="both")
+    ap.add_argument("--epochs", type=int, default=80)
+    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--out", default=str(REPO / "bench_out" / "transfer"))
+    ap.add_argument("--data-dir", default=None)
+    args = ap.parse_args()
+    import torch
+
+    from twin.transfer.benchmark import markdown_table, run_benchmark
+
+    out = Path(args.out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tasks = ("pitting", "wear") if args.task == "both" else (args.task,)
+    t = time.perf_counter()
+    summary = run_benchmark(out, tasks=tasks, seeds=args.seeds, epochs=args.epochs, jobs=args.jobs,
+                            data_dir=args.data_dir)
+    wall = time.perf_counter() - t
+    cpu = next((ln.split(":", 1)[1].strip() for ln in open("/proc/cpuinfo") if ln.startswith("model name")), "?")
+    print(f"Machine: {cpu}, {len(os.sched_getaffinity(0))} cores, Python {platform.python_version()}, "
+          f"torch {torch.__version__} (CPU, 1 thread per training run, {args.jobs} runs in parallel)")
+    print(f"{args.seeds} seeds x 3 methods x {len(tasks)} task(s), {args.epochs} epochs; total wall time {wall:.0f} s\n")
+    print(markdown_table(summary))
+    print(f"\nfigures and report.html -> {out}")
+
+
+if __name__ == "__main__":
+    main()

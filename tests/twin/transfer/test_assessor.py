@@ -1,0 +1,143 @@
+"""The assessor's contract: determinism, persistence, typed errors, and adaptation that helps."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from twin.errors import MeasurementError, OutputPathError
+from twin.transfer import Assessor, AssessorError
+
+from .conftest import FS, make_records, tiny_assessor
+
+
+@pytest.fixture(scope="module")
+def fitted(tiny_pre, tiny_data):
+    src, adapt, _ = tiny_data
+    return tiny_assessor("proposed", tiny_pre, seed=3).fit(src, adapt)
+
+
+def test_fit_returns_self_and_sets_learned_attributes(fitted):
+    assert isinstance(fitted, Assessor)
+    assert fitted.n_classes_ == 3
+    assert fitted.classes_.tolist() == [0, 1, 2]
+    assert len(fitted.history_) == 6
+    assert {"loss", "cls", "align", "con", "gate", "source_acc"} <= set(fitted.history_[-1])
+    # the gate opens only after the warm-up (2 epochs)
+    assert fitted.history_[0]["gate"] == 0.0 and fitted.history_[1]["gate"] == 0.0
+    assert fitted.source_scale_ > 0 and fitted.target_scale_ > 2 * fitted.source_scale_   # rig gain 3x
+
+
+def test_same_seed_same_output_other_seed_differs(tiny_pre, tiny_data, fitted):
+    src, adapt, test = tiny_data
+    again = tiny_assessor("proposed", tiny_pre, seed=3).fit(src, adapt)
+    np.testing.assert_array_equal(again.predict_proba(test), fitted.predict_proba(test))
+    other = tiny_assessor("proposed", tiny_pre, seed=4).fit(src, adapt)
+    assert not np.array_equal(other.predict_proba(test), fitted.predict_proba(test))
+
+
+def test_predict_shapes(fitted, tiny_data):
+    _, _, test = tiny_data
+    p = fitted.predict_proba(test)
+    assert p.shape == (len(test), 3)
+    np.testing.assert_allclose(p.sum(1), 1.0, rtol=1e-5)
+    assert fitted.predict(test).shape == (len(test),)
+    w = np.zeros((5, 64))
+    assert fitted.predict_proba(w).shape == (5, 3)             # arrays: one row per window
+    assert fitted.transform(test).shape[1] == 300
+    a = fitted.assess(test)
+    assert len(a.records) == len(test) and a.record_accuracy is not None
+    assert len(a.records[0].window_stages) == (384 - 64) // 32 + 1
+
+
+def test_save_load_round_trip_gives_identical_predictions(fitted, tiny_data, tmp_path):
+    _, _, test = tiny_data
+    d = fitted.save(tmp_path / "assessor")
+    cfg = json.loads((d / "config.json").read_text())
+    assert cfg["preprocessing"] == {"channel": "accel_pinion_casing", "sample_rate": FS, "window": 64, "hop": 32,
+                                    "normalise": "domain"}
+    back = Assessor.load(d)
+    assert back._pre == fitted._pre
+    assert back.target_scale_ == fitted.target_scale_
+    np.testing.assert_array_equal(back.predict_proba(test), fitted.predict_proba(test))
+    assert not list(d.glob(".*.tmp"))                          # atomic writes left no temporaries
+
+
+def test_save_to_missing_parent_is_an_output_path_error(fitted, tmp_path):
+    with pytest.raises(OutputPathError, match="nope"):
+        fitted.save(tmp_path / "nope" / "assessor")
+
+
+def test_load_bad_directory(tmp_path):
+    with pytest.raises(AssessorError, match="config.json"):
+        Assessor.load(tmp_path)
+    (tmp_path / "config.json").write_text(json.dumps({"format": "other"}))
+    (tmp_path / "weights.pt").write_bytes(b"x")
+    with pytest.raises(AssessorError, match="'other'"):
+        Assessor.load(tmp_path)
+
+
+def test_wrong_window_shape_names_the_shape(fitted):
+    with pytest.raises(AssessorError, match=r"\(n, 64\).*\(4, 50\)"):
+        fitted.predict(np.zeros((4, 50)))
+    with pytest.raises(AssessorError, match=r"\(n, 64\).*\(64,\)"):
+        fitted.predict(np.zeros(64))
+
+
+def test_missing_channel_names_record_and_channel(fitted):
+    recs = make_records(1, 1, channel="accel_gear_casing")
+    with pytest.raises(MeasurementError, match="accel_pinion_casing") as exc:
+        fitted.predict(recs)
+    assert exc.value.record == "s0r0"
+
+
+def test_bad_path_is_a_measurement_error_naming_it(fitted, tmp_path):
+    with pytest.raises(MeasurementError, match="missing.h5"):
+        fitted.predict(tmp_path / "missing.h5")
+
+
+def test_record_shorter_than_a_window(fitted):
+    with pytest.raises(AssessorError, match=r"'s0r0' has 40 samples"):
+        fitted.predict(make_records(1, 1, duration=0.04))
+
+
+def test_mismatched_stage_count(tiny_pre, tiny_data, fitted):
+    src, adapt, _ = tiny_data
+    with pytest.raises(AssessorError, match="n_stages=4"):
+        tiny_assessor("cnn", tiny_pre, n_stages=4).fit(src, adapt)
+    no_stage_1 = [r for r in src if r.label != 1]
+    with pytest.raises(AssessorError, match=r"stage\(s\) \[1\] have no record"):
+        tiny_assessor("cnn", tiny_pre).fit(no_stage_1, adapt)
+    with pytest.raises(AssessorError, match=r"label\(s\) \[3, 4\]"):
+        fitted.assess(make_records(1, 5, seed=9))
+    with pytest.raises(AssessorError, match="no stage label"):
+        tiny_assessor("cnn", tiny_pre).fit(adapt, adapt)
+
+
+def test_bad_parameters_are_named(tiny_pre, tiny_data):
+    src, adapt, _ = tiny_data
+    with pytest.raises(AssessorError, match="method='dann'"):
+        Assessor("dann", preprocessing=tiny_pre).fit(src, adapt)
+    with pytest.raises(AssessorError, match="threshold=1.5"):
+        Assessor(threshold=1.5, preprocessing=tiny_pre).fit(src, adapt)
+    with pytest.raises(AssessorError, match="not fitted"):
+        Assessor().predict(np.zeros((1, 2048)))
+    with pytest.raises(AssessorError, match="labels must have shape \\(3,\\)"):
+        Assessor(preprocessing=tiny_pre).fit(np.zeros((3, 64)), adapt, source_labels=[0, 1])
+
+
+def test_get_set_params(tiny_pre):
+    a = Assessor("mmd", preprocessing=tiny_pre)
+    assert a.get_params()["method"] == "mmd"
+    assert a.set_params(alpha=0.5).alpha == 0.5
+    with pytest.raises(AssessorError, match="'gamma'"):
+        a.set_params(gamma=1)
+
+
+def test_adaptation_beats_source_only_on_shifted_data(tiny_pre, tiny_data):
+    """The rig has a strong hum and a 3x gain the twin lacks; aligning the features must help."""
+    src, adapt, test = tiny_data
+    acc = {m: np.mean([tiny_assessor(m, tiny_pre, seed=s, epochs=15).fit(src, adapt).score(test)
+                       for s in (0, 1)]) for m in ("cnn", "proposed")}
+    assert acc["proposed"] > acc["cnn"] + 0.1, acc

@@ -1,0 +1,64 @@
+"""The three CLI handlers, on tiny synthetic files (default 2048-sample windows, 1 epoch)."""
+from __future__ import annotations
+
+import argparse
+import json
+
+import numpy as np
+import pytest
+
+from twin.measurements import Record, write_measurements
+from twin.transfer.cli import add_subcommands
+
+
+def _parser():
+    p = argparse.ArgumentParser()
+    add_subcommands(p.add_subparsers(dest="command", required=True))
+    return p
+
+
+def _file(path, shifted, labelled):
+    rng = np.random.default_rng(int(shifted))
+    recs = []
+    for k in range(2):
+        for i in range(3):
+            t = np.arange(6000) / 20000.0
+            x = (1 + k) * np.sin(2 * np.pi * (300 + 200 * k) * t) + rng.normal(0, 0.2, t.size)
+            recs.append(Record(f"s{k}r{i}", {"accel_pinion_casing": (2.0 if shifted else 1.0) * x},
+                               {"accel_pinion_casing": "m/s2"}, 20000.0, label=k if labelled else None))
+    return write_measurements(recs, path)
+
+
+def test_registers_three_commands():
+    p = _parser()
+    assert p.parse_args(["assess", "a", "m.h5"]).handler.__name__ == "_cmd_assess"
+    args = p.parse_args(["benchmark-transfer", "--out", "x"])
+    assert (args.seeds, args.task, args.epochs) == (5, "both", 80)
+    with pytest.raises(SystemExit):
+        p.parse_args(["train-assessor", "--source", "s.h5", "--target", "t.h5", "--out", "o", "--method", "dann"])
+
+
+def test_train_then_assess(tmp_path, capsys):
+    src = _file(tmp_path / "src.h5", False, True)
+    tgt = _file(tmp_path / "tgt.h5", True, True)
+    p = _parser()
+    args = p.parse_args(["train-assessor", "--source", str(src), "--target", str(tgt), "--out",
+                         str(tmp_path / "model"), "--epochs", "1", "--method", "mmd", "--no-progress"])
+    assert args.handler(args) == 0
+    args = p.parse_args(["assess", str(tmp_path / "model"), str(tgt), "--json", str(tmp_path / "stages.json")])
+    assert args.handler(args) == 0
+    out = json.loads((tmp_path / "stages.json").read_text())
+    assert out["n_stages"] == 2 and len(out["records"]) == 6
+    r = out["records"][0]
+    assert {"name", "stage", "confidence", "windows", "label"} <= set(r)
+    assert len(r["windows"]) == (6000 - 2048) // 1024 + 1      # 0.3 s at 20 kHz, hop 1024
+    assert "accuracy" in capsys.readouterr().out
+
+
+def test_train_to_missing_directory_fails_early(tmp_path):
+    from twin.errors import OutputPathError
+    p = _parser()
+    args = p.parse_args(["train-assessor", "--source", "s.h5", "--target", "t.h5", "--out",
+                         str(tmp_path / "no" / "model")])
+    with pytest.raises(OutputPathError, match="no"):
+        args.handler(args)

@@ -1,0 +1,100 @@
+"""Windowing, normalisation, record splitting, augmentation, the target-domain filters, t-SNE."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from twin.errors import ParameterError
+from twin.transfer.domain import TargetShift, resonator, runout_offsets
+from twin.transfer.preprocess import (Augmentation, Preprocessing, apply_normalisation, augmented_windows,
+                                      domain_scale, prepare, split_records, window_signal, windows_of)
+from twin.transfer.tsne import tsne
+
+from .conftest import make_records
+
+
+def test_window_signal_counts_and_content():
+    x = np.arange(10.0)
+    w = window_signal(x, 4, 3)
+    assert w.tolist() == [[0, 1, 2, 3], [3, 4, 5, 6], [6, 7, 8, 9]]
+    assert window_signal(x, 11, 1).shape == (0, 11)
+
+
+def test_window_normalisation_cancels_gain_and_domain_keeps_relative_level():
+    rng = np.random.default_rng(0)
+    w = rng.normal(size=(3, 64))
+    np.testing.assert_allclose(apply_normalisation(7.0 * w, "window"), apply_normalisation(w, "window"))
+    big = np.vstack([w, 4 * w])
+    d = apply_normalisation(big, "domain") / domain_scale(big)
+    d7 = apply_normalisation(7 * big, "domain") / domain_scale(7 * big)
+    np.testing.assert_allclose(d, d7, rtol=1e-12)              # a constant gain cancels ...
+    assert d[3:].std() == pytest.approx(4 * d[:3].std())       # ... the level between records stays
+
+
+def test_preprocessing_validates():
+    with pytest.raises(ParameterError, match="window"):
+        Preprocessing(window=100)
+    with pytest.raises(ParameterError, match="normalise"):
+        Preprocessing(normalise="record")
+
+
+def test_prepare_resamples_to_the_preprocessing_rate():
+    recs = make_records(1, 1, duration=0.4)                    # 1 kHz
+    p = prepare(recs, Preprocessing(sample_rate=500.0, window=64, hop=64))
+    assert p[0].signal.size == 200
+
+
+def test_split_records_gives_disjoint_halves():
+    recs = make_records(1, 2)
+    first, second = split_records(recs)
+    x = recs[0]["accel_pinion_casing"]
+    np.testing.assert_array_equal(np.concatenate([first[0]["accel_pinion_casing"],
+                                                  second[0]["accel_pinion_casing"]]), x)
+    assert second[0].time_start == pytest.approx(first[0].duration)
+    assert first[1].label == 1
+
+
+def test_augmentation_is_seeded_and_keeps_counts():
+    pre = Preprocessing(sample_rate=1000.0, window=64, hop=32)
+    prep = prepare(make_records(2, 2), pre)
+    a, la = augmented_windows(prep, pre, Augmentation(), np.random.default_rng(5))
+    b, lb = augmented_windows(prep, pre, Augmentation(), np.random.default_rng(5))
+    c, _ = augmented_windows(prep, pre, Augmentation(), np.random.default_rng(6))
+    np.testing.assert_array_equal(a, b)
+    assert not np.array_equal(a, c)
+    assert a.shape == windows_of(prep, pre)[0].shape and la.tolist() == lb.tolist()
+
+
+def test_resonator_unity_at_dc_and_peak_near_f0():
+    fs, f0, q = 100_000.0, 4000.0, 5.0
+    n = 20000
+    t = np.arange(n) / fs
+    dc = resonator(np.ones(n), fs, f0, q)
+    assert dc[-1] == pytest.approx(1.0, rel=1e-6)
+    tone = resonator(np.sin(2 * np.pi * f0 * t), fs, f0, q)
+    gain = tone[n // 2:].std() / np.sin(2 * np.pi * f0 * t[n // 2:]).std()
+    assert gain == pytest.approx(np.sqrt(1 + q ** 2), rel=0.02)   # |H(j w0)| = sqrt(1 + Q^2)
+    with pytest.raises(ParameterError, match="60000"):
+        resonator(np.ones(4), fs, 60000.0, q)
+
+
+def test_runout_offsets_are_a_non_negative_sinusoid():
+    d = runout_offsets(4e-6, 0.3)
+    v = np.array([d[f"tooth_deviation_offset[{i}]"] for i in range(1, 20)])
+    assert v.min() >= 0 and v.max() <= 4e-6 and v.max() - v.min() > 3.9e-6
+    with pytest.raises(ParameterError, match="noise"):
+        TargetShift(noise=-1)
+
+
+def test_tsne_separates_two_clusters():
+    rng = np.random.default_rng(0)
+    x = np.vstack([rng.normal(0, 1, (30, 10)), rng.normal(8, 1, (30, 10))])
+    y = tsne(x, perplexity=10, n_iter=300, seed=1)
+    assert y.shape == (60, 2)
+    ca, cb = y[:30].mean(0), y[30:].mean(0)
+    spread = max(np.linalg.norm(y[:30].std(0)), np.linalg.norm(y[30:].std(0)))
+    assert np.linalg.norm(ca - cb) > 2 * spread
+    d = np.linalg.norm(y[:, None] - y[None], axis=-1) + np.eye(60) * 1e9
+    nn = d.argmin(1)
+    assert np.all((nn < 30) == (np.arange(60) < 30))          # every nearest neighbour in its own cluster
+    np.testing.assert_array_equal(y, tsne(x, perplexity=10, n_iter=300, seed=1))

@@ -1,0 +1,619 @@
+"""The transfer-learning wear assessor (paper section 2.3), with its baselines in one code path.
+
+::
+
+    from twin.transfer import Assessor
+    a = Assessor(method="proposed", seed=0).fit("archive.h5", "rig.h5")   # rig labels never read
+    a.predict("rig_new.h5")            # stage per record; a.assess(...) adds confidences per window
+    a.save("assessor/"); Assessor.load("assessor/").predict(...)        # identical numbers
+
+Methods (``method=``):
+
+* ``"cnn"`` -- source only: G + C trained with the cross-entropy of Eq. 15 on the twin's data;
+  target data are not used at all (also not in the batch-norm statistics).
+* ``"mmd"`` -- Eq. 15 + ``alpha`` * multi-kernel MMD (Eq. 16) between source and target features.
+* ``"proposed"`` -- Eq. 20: Eq. 15 + ``alpha`` * MMD + ``beta`` * class-contrastive loss (Eq. 17-19)
+  on gated target pseudo-labels (see :func:`twin.transfer.losses.pseudo_label_gate`).
+* ``"coral"`` -- Eq. 15 + ``alpha`` * CORAL, a cheap extra baseline.
+
+Training (paper Table 3 defaults): SGD with momentum 0.9 and weight decay 5e-4, initial learning
+rate ``lr`` = 0.01 annealed as ``lr / (1 + 10 p)^0.75`` over the training progress ``p`` in [0, 1]
+(the usual domain-adaptation schedule), batches of ``batch_size`` = 20 source windows paired with
+20 target windows, ``epochs`` = 80 passes over the source windows.  Source and target batches go
+through G together, so batch normalisation sees both domains.  Fixed hyperparameters, no early
+stopping: the model after the last epoch is the result.
+
+Determinism: ``fit`` seeds torch and numpy from ``seed``, switches torch to deterministic
+algorithms and to ``n_threads`` threads (1 by default) for its duration, so the same seed on the
+same machine gives bit-identical weights and predictions.
+"""
+from __future__ import annotations
+
+import json
+import math
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from twin.transfer.errors import AssessorError
+from twin.transfer.preprocess import (Augmentation, Preprocessing, Prepared, augmented_windows, domain_scale, prepare,
+                                      windows_of)
+
+__all__ = ["Assessment", "Assessor", "METHODS", "RecordAssessment"]
+
+METHODS = ("cnn", "mmd", "proposed", "coral")
+SAVE_FORMAT = "gear-twin-assessor"
+SAVE_VERSION = 1
+_EVAL_BATCH = 256
+
+
+@dataclass(frozen=True)
+class RecordAssessment:
+    """The verdict on one record.
+
+    Attributes
+    ----------
+    name : str
+    stage : int
+        Stage with the highest mean window probability.
+    confidence : float
+        That mean probability, in [0, 1].
+    probabilities : tuple of float
+        Mean window probability of every stage, shape (K,).
+    window_stages : tuple of int
+        Stage of each window, shape (n_windows,).
+    window_confidences : tuple of float
+        Probability of each window's stage, shape (n_windows,).
+    label : int or None
+        The record's label if it has one (for evaluation only).
+    """
+
+    name: str
+    stage: int
+    confidence: float
+    probabilities: tuple
+    window_stages: tuple
+    window_confidences: tuple
+    label: int | None = None
+
+    def to_dict(self) -> dict:
+        return {"name": self.name, "stage": self.stage, "confidence": self.confidence,
+                "probabilities": list(self.probabilities), "label": self.label,
+                "windows": [{"index": i, "stage": s, "confidence": c}
+                            for i, (s, c) in enumerate(zip(self.window_stages, self.window_confidences))]}
+
+
+@dataclass(frozen=True)
+class Assessment:
+    """Verdicts on a set of records plus, when every record is labelled, the accuracies."""
+
+    records: tuple
+    n_stages: int
+    record_accuracy: float | None
+    window_accuracy: float | None
+
+    def to_dict(self) -> dict:
+        return {"n_stages": self.n_stages, "record_accuracy": self.record_accuracy,
+                "window_accuracy": self.window_accuracy, "records": [r.to_dict() for r in self.records]}
+
+
+class Assessor:
+    """Wear-stage assessor trained on labelled twin data and unlabelled rig data.
+
+    Parameters
+    ----------
+    method : {"proposed", "mmd", "cnn", "coral"}
+    alpha, beta : float
+        Weights of the alignment loss (MMD or CORAL) and of the class-contrastive loss (Eq. 20).
+    lr : float
+        Initial learning rate.
+    batch_size : int
+        Source windows (and as many target windows) per step.
+    epochs : int
+        Passes over the source windows.
+    threshold : float
+        Pseudo-label confidence threshold in (0, 1].
+    warmup_epochs : int
+        Epochs before any pseudo-label enters the contrastive loss.
+    margin : float
+        Contrastive margin m on squared distances of unit feature vectors, in (0, 4].
+    pairs : {"all", "diagonal"}
+        Source/target pairs of the contrastive loss (see :mod:`twin.transfer.losses`).
+    preprocessing : Preprocessing, optional
+        Channel, resampling rate, window, hop, normalisation (default :class:`Preprocessing()`).
+    augmentation : Augmentation or None, optional
+        Source-side augmentation; default :class:`Augmentation()`, ``None`` for none.
+    n_stages : int, optional
+        Expected number of stages; the source labels must cover exactly ``0 .. n_stages - 1``.
+    seed : int
+    device : str, optional
+        ``"cpu"``, ``"cuda"``; default the GPU when there is one.
+    n_threads : int
+        Torch CPU threads during ``fit`` (determinism does not depend on it, speed does).
+    progress : bool
+        Progress bars.
+
+    Attributes (after ``fit``)
+    --------------------------
+    network_ : torch.nn.Module
+    n_classes_ : int
+    classes_ : ndarray (K,)
+    history_ : list of dict, one per epoch: ``loss``, ``cls``, ``align``, ``con``, ``source_acc``,
+        ``gate`` (fraction of target windows whose pseudo-label passed), ``lr`` and, with
+        ``monitor=``, ``monitor_acc``.
+    n_source_windows_, n_target_windows_ : int
+    source_scale_, target_scale_ : float
+        The "domain" normalisation scales (1 for the other modes) [channel unit].
+    fit_time_ : float
+        Wall time of the training loop [s].
+    """
+
+    def __init__(self, method: str = "proposed", *, alpha: float = 0.1, beta: float = 0.1, lr: float = 0.01,
+                 batch_size: int = 20, epochs: int = 80, threshold: float = 0.9, warmup_epochs: int = 10,
+                 margin: float = 1.0, pairs: str = "all", preprocessing: Preprocessing | None = None,
+                 augmentation: Augmentation | None | str = "default", n_stages: int | None = None,
+                 seed: int = 0, device: str | None = None, n_threads: int = 1, progress: bool = True):
+        self.method = method
+        self.alpha = alpha
+        self.beta = beta
+        self.lr = lr
+        self.batch_size = batch_size
+        self.epochs = epochs
+        self.threshold = threshold
+        self.warmup_epochs = warmup_epochs
+        self.margin = margin
+        self.pairs = pairs
+        self.preprocessing = preprocessing
+        self.augmentation = augmentation
+        self.n_stages = n_stages
+        self.seed = seed
+        self.device = device
+        self.n_threads = n_threads
+        self.progress = progress
+
+    # ---- scikit-learn plumbing ---------------------------------------------------------------
+    _PARAMS = ("method", "alpha", "beta", "lr", "batch_size", "epochs", "threshold", "warmup_epochs", "margin",
+               "pairs", "preprocessing", "augmentation", "n_stages", "seed", "device", "n_threads", "progress")
+
+    def get_params(self, deep: bool = True) -> dict:
+        return {k: getattr(self, k) for k in self._PARAMS}
+
+    def set_params(self, **params) -> "Assessor":
+        for k, v in params.items():
+            if k not in self._PARAMS:
+                raise AssessorError(f"unknown parameter {k!r}; parameters: {', '.join(self._PARAMS)}")
+            setattr(self, k, v)
+        return self
+
+    def __repr__(self) -> str:
+        return f"Assessor(method={self.method!r}, seed={self.seed}, epochs={self.epochs})"
+
+    @property
+    def _pre(self) -> Preprocessing:
+        return self.preprocessing or Preprocessing()
+
+    def _aug(self) -> Augmentation | None:
+        if isinstance(self.augmentation, str):
+            if self.augmentation != "default":
+                raise AssessorError(f"augmentation must be an Augmentation, None or 'default', "
+                                    f"got {self.augmentation!r}")
+            return Augmentation()
+        if self.augmentation is not None and not isinstance(self.augmentation, Augmentation):
+            raise AssessorError(f"augmentation must be an Augmentation, None or 'default', got {self.augmentation!r}")
+        return self.augmentation
+
+    def _check_params(self) -> None:
+        def bad(name, rule):
+            raise AssessorError(f"{name}={getattr(self, name)!r} is invalid: {rule}")
+
+        if self.method not in METHODS:
+            bad("method", f"use one of {', '.join(METHODS)}")
+        for name in ("alpha", "beta", "lr"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0) or (name == "lr" and v == 0):
+                bad(name, "must be a finite number >= 0 (lr > 0)")
+        for name in ("batch_size", "epochs", "n_threads"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, int) or v < (2 if name == "batch_size" else 1):
+                bad(name, "must be a positive integer (batch_size >= 2 for batch normalisation)")
+        if isinstance(self.warmup_epochs, bool) or not isinstance(self.warmup_epochs, int) or self.warmup_epochs < 0:
+            bad("warmup_epochs", "must be an integer >= 0")
+        if not (isinstance(self.threshold, (int, float)) and 0 < self.threshold <= 1):
+            bad("threshold", "must be in (0, 1]")
+        if not (isinstance(self.margin, (int, float)) and 0 < self.margin <= 4):
+            bad("margin", "must be in (0, 4]")
+        if self.pairs not in ("all", "diagonal"):
+            bad("pairs", "use 'all' or 'diagonal'")
+        if self.n_stages is not None and (isinstance(self.n_stages, bool) or not isinstance(self.n_stages, int)
+                                          or self.n_stages < 2):
+            bad("n_stages", "must be an integer >= 2")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or self.seed < 0:
+            bad("seed", "must be an integer >= 0")
+        if self.preprocessing is not None and not isinstance(self.preprocessing, Preprocessing):
+            bad("preprocessing", "must be a twin.transfer.Preprocessing")
+        self._aug()
+
+    def _device(self):
+        import torch
+        if self.device is None:
+            return torch.device("cuda" if torch.cuda.is_available() else "cpu")
+        try:
+            return torch.device(self.device)
+        except RuntimeError:
+            raise AssessorError(f"device={self.device!r} is not a torch device") from None
+
+    # ---- data -----------------------------------------------------------------------------------
+    def _prepared(self, data, labels, what: str) -> list[Prepared]:
+        """Records (or raw windows ``(n, window)`` + labels) -> prepared signals."""
+        pre = self._pre
+        if isinstance(data, np.ndarray) or (isinstance(data, (list, tuple)) and data
+                                            and isinstance(data[0], np.ndarray)):
+            x = np.asarray(data, dtype=np.float64)
+            if x.ndim != 2 or x.shape[1] != pre.window:
+                raise AssessorError(f"{what}: windows must have shape (n, {pre.window}), got {x.shape}")
+            if not np.all(np.isfinite(x)):
+                raise AssessorError(f"{what}: windows contain non-finite samples")
+            if labels is None:
+                lab = [None] * x.shape[0]
+            else:
+                lab = np.asarray(labels)
+                if lab.shape != (x.shape[0],):
+                    raise AssessorError(f"{what}: labels must have shape ({x.shape[0]},), got {lab.shape}")
+                lab = [int(v) for v in lab]
+            return [Prepared(f"window{i}", x[i], lab[i]) for i in range(x.shape[0])]
+        if labels is not None:
+            raise AssessorError(f"{what}: labels are read from the records; pass labels only with window arrays")
+        return prepare(data, pre, what)
+
+    def _check_source_labels(self, prepared: Sequence[Prepared]) -> int:
+        missing = [p.name for p in prepared if p.label is None]
+        if missing:
+            raise AssessorError(f"source: {len(missing)} record(s) have no stage label, first '{missing[0]}'")
+        labels = sorted({p.label for p in prepared})
+        if labels[0] < 0:
+            raise AssessorError(f"source: stage labels must be >= 0, got {labels[0]}")
+        k = labels[-1] + 1
+        if self.n_stages is not None and k != self.n_stages:
+            raise AssessorError(f"source: labels span {k} stages (0..{k - 1}) but n_stages={self.n_stages}")
+        absent = sorted(set(range(k)) - set(labels))
+        if absent:
+            raise AssessorError(f"source: stage(s) {absent} have no record; stages must be 0..{k - 1}")
+        if k < 2:
+            raise AssessorError(f"source: need at least 2 stages, got {k}")
+        return k
+
+    # ---- training -------------------------------------------------------------------------------
+    def fit(self, source, target_unlabelled, *, source_labels=None, monitor=None) -> "Assessor":
+        """Train on labelled ``source`` and unlabelled ``target_unlabelled``; return ``self``.
+
+        Parameters
+        ----------
+        source : path, MeasurementSet, list of Record, Archive, or ndarray (n, window)
+            Labelled twin data (record ``label`` = stage); arrays need ``source_labels`` (n,).
+        target_unlabelled : same kinds (no labels needed; any label present is ignored)
+            Rig data to adapt to.  With ``method="cnn"`` it is only checked, not used.
+        monitor : (data, labels or None), optional
+            Scored after every epoch into ``history_[i]["monitor_acc"]`` for the learning curves.
+            It never influences training (no early stopping, no model selection).
+
+        Raises
+        ------
+        AssessorError, MeasurementError
+            Invalid parameters, shapes, labels, channels (the message names the value).
+        """
+        import torch
+
+        from twin._progress import progress_bar
+        from twin.transfer.losses import class_contrastive_loss, coral_loss, mmd_loss, pseudo_label_gate
+        from twin.transfer.model import Network
+
+        self._check_params()
+        pre, aug = self._pre, self._aug()
+        src = self._prepared(source, source_labels, "source")
+        k = self._check_source_labels(src)
+        tgt = self._prepared(target_unlabelled, None, "target")
+        xt, _, _ = windows_of(tgt, pre, "target")
+        xs_fixed, _, ys_fixed = windows_of(src, pre, "source")
+        # "domain" normalisation: one scale per domain, from its own (unlabelled) windows.
+        domain = pre.normalise == "domain"
+        self.source_scale_ = domain_scale(xs_fixed) if domain else 1.0
+        self.target_scale_ = domain_scale(xt) if domain else 1.0
+        xs_fixed = xs_fixed / np.float32(self.source_scale_)
+        xt = xt / np.float32(self.target_scale_)
+        mon = None
+        if monitor is not None:
+            mdata, mlabels = monitor if isinstance(monitor, tuple) else (monitor, None)
+            mx, _, my = windows_of(self._prepared(mdata, mlabels, "monitor"), pre, "monitor")
+            mon = (mx / np.float32(self.target_scale_), my)
+
+        device = self._device()
+        prev_threads = torch.get_num_threads()
+        prev_det = torch.are_deterministic_algorithms_enabled()
+        torch.set_num_threads(self.n_threads)
+        torch.use_deterministic_algorithms(True)
+        try:
+            torch.manual_seed(int(self.seed))
+            rng = np.random.default_rng(int(self.seed))
+            net = Network(k, pre.window).to(device)
+            opt = torch.optim.SGD(net.parameters(), lr=self.lr, momentum=0.9, weight_decay=5e-4)
+            n_s = xs_fixed.shape[0]
+            steps = math.ceil(n_s / self.batch_size)
+            total = steps * self.epochs
+            xt_t = torch.from_numpy(xt).unsqueeze(1).to(device)
+            adapt = self.method != "cnn"
+            history = []
+            bar = progress_bar(self.epochs, self.progress, f"train {self.method}", "epoch")
+            t_start = time.perf_counter()
+            step = 0
+            t_perm = rng.permutation(xt.shape[0])
+            t_pos = 0
+            for epoch in range(self.epochs):
+                if aug is not None:
+                    xs, ys = augmented_windows(src, pre, aug, rng)
+                    xs = xs / np.float32(self.source_scale_)
+                else:
+                    xs, ys = xs_fixed, ys_fixed
+                xs_t = torch.from_numpy(xs).unsqueeze(1).to(device)
+                ys_t = torch.from_numpy(ys.astype(np.int64)).to(device)
+                perm = rng.permutation(n_s)
+                net.train()
+                sums = dict(loss=0.0, cls=0.0, align=0.0, con=0.0, correct=0, seen=0, gated=0, tseen=0)
+                for b in range(steps):
+                    idx = torch.from_numpy(perm[b * self.batch_size:(b + 1) * self.batch_size])
+                    if idx.numel() < 2:         # a batch of one cannot be batch-normalised
+                        continue
+                    lr = self.lr / (1 + 10 * step / total) ** 0.75
+                    for group in opt.param_groups:
+                        group["lr"] = lr
+                    xb, yb = xs_t[idx], ys_t[idx]
+                    align = con = torch.zeros((), device=device)
+                    if adapt:
+                        if t_pos + idx.numel() > len(t_perm):
+                            t_perm, t_pos = rng.permutation(xt.shape[0]), 0
+                        tidx = torch.from_numpy(t_perm[t_pos:t_pos + idx.numel()])
+                        t_pos += idx.numel()
+                        g, logits = net(torch.cat([xb, xt_t[tidx]]))
+                        gs, gt = g[: idx.numel()], g[idx.numel():]
+                        ls, lt = logits[: idx.numel()], logits[idx.numel():]
+                        align = coral_loss(gs, gt) if self.method == "coral" else mmd_loss(gs, gt)
+                        if self.method == "proposed":
+                            pt = torch.softmax(lt.detach(), dim=1)
+                            yt, mask = pseudo_label_gate(pt, epoch, self.threshold, self.warmup_epochs)
+                            con = class_contrastive_loss(gs, yb, gt, yt, mask, self.margin, self.pairs)
+                            sums["gated"] += int(mask.sum())
+                            sums["tseen"] += int(mask.numel())
+                    else:
+                        _, ls = net(xb)
+                    cls = torch.nn.functional.cross_entropy(ls, yb)
+                    loss = cls + self.alpha * align + (self.beta * con if self.method == "proposed" else 0.0)
+                    opt.zero_grad(set_to_none=True)
+                    loss.backward()
+                    opt.step()
+                    step += 1
+                    n_b = idx.numel()
+                    sums["loss"] += float(loss.detach()) * n_b
+                    sums["cls"] += float(cls.detach()) * n_b
+                    sums["align"] += float(align.detach()) * n_b
+                    sums["con"] += float(con.detach()) * n_b
+                    sums["correct"] += int((ls.argmax(1) == yb).sum())
+                    sums["seen"] += n_b
+                seen = max(sums["seen"], 1)
+                rec = {"epoch": epoch + 1, "loss": sums["loss"] / seen, "cls": sums["cls"] / seen,
+                       "align": sums["align"] / seen, "con": sums["con"] / seen,
+                       "source_acc": sums["correct"] / seen,
+                       "gate": sums["gated"] / sums["tseen"] if sums["tseen"] else 0.0, "lr": lr}
+                if mon is not None:
+                    self.network_ = net
+                    self.n_classes_ = k
+                    p = self._proba_windows(mon[0])
+                    known = mon[1] >= 0
+                    rec["monitor_acc"] = (float(np.mean(p.argmax(1)[known] == mon[1][known]))
+                                          if known.any() else None)
+                history.append(rec)
+                bar.update(1)
+            bar.close()
+            self.fit_time_ = time.perf_counter() - t_start
+        finally:
+            torch.set_num_threads(prev_threads)
+            torch.use_deterministic_algorithms(prev_det)
+        net.eval()
+        self.network_ = net
+        self.n_classes_ = k
+        self.classes_ = np.arange(k)
+        self.history_ = history
+        self.n_source_windows_ = int(n_s)
+        self.n_target_windows_ = int(xt.shape[0])
+        return self
+
+    # ---- inference ------------------------------------------------------------------------------
+    def _check_fitted(self) -> None:
+        if not hasattr(self, "network_"):
+            raise AssessorError("this Assessor is not fitted yet: call fit() or Assessor.load()")
+
+    def _forward(self, x: np.ndarray):
+        import torch
+        net = self.network_
+        was_training = net.training
+        net.eval()
+        dev = next(net.parameters()).device
+        feats, probs = [], []
+        with torch.no_grad():
+            for i in range(0, x.shape[0], _EVAL_BATCH):
+                g, logits = net(torch.from_numpy(np.ascontiguousarray(x[i:i + _EVAL_BATCH])).unsqueeze(1).to(dev))
+                feats.append(g.cpu().numpy())
+                probs.append(torch.softmax(logits, 1).cpu().numpy())
+        net.train(was_training)
+        return np.concatenate(feats), np.concatenate(probs)
+
+    def _proba_windows(self, x: np.ndarray) -> np.ndarray:
+        return self._forward(x)[1]
+
+    def _windows(self, data, what: str, domain: str = "target"):
+        """(windows (n, window), record index (n,), labels (n,), prepared records, is_array).
+
+        ``domain`` picks the scale of "domain" normalisation: new data are rig (target) data.
+        """
+        if domain not in ("target", "source"):
+            raise AssessorError(f"{what}: domain must be 'target' or 'source', got {domain!r}")
+        pre = self._pre
+        is_array = isinstance(data, np.ndarray)
+        prepared = self._prepared(data, None, what)
+        x, rec, lab = windows_of(prepared, pre, what)
+        scale = self.target_scale_ if domain == "target" else self.source_scale_
+        return x / np.float32(scale), rec, lab, prepared, is_array
+
+    def transform(self, data, domain: str = "target") -> np.ndarray:
+        """High-level features G(x) of every window, shape (n_windows, 300).
+
+        ``domain="source"`` scales the windows as the twin's data were scaled in training.
+        """
+        self._check_fitted()
+        x, *_ = self._windows(data, "transform", domain)
+        return self._forward(x)[0]
+
+    def predict_proba(self, data, domain: str = "target") -> np.ndarray:
+        """Stage probabilities: (n, K) per row for an array of windows (n, window), per record
+        (mean over the record's windows) for records.  Data are taken as rig data (``domain``)."""
+        self._check_fitted()
+        x, rec, _, prepared, is_array = self._windows(data, "predict", domain)
+        p = self._proba_windows(x)
+        if is_array:
+            return p
+        return np.stack([p[rec == i].mean(0) for i in range(len(prepared))])
+
+    def predict(self, data, domain: str = "target") -> np.ndarray:
+        """Stage per window (array input) or per record (record input), shape (n,)."""
+        return self.predict_proba(data, domain).argmax(1)
+
+    def assess(self, data, domain: str = "target") -> Assessment:
+        """Stage and confidence per record and per window; accuracies when every record is labelled.
+
+        Raises
+        ------
+        AssessorError
+            A record label outside ``0 .. n_classes_ - 1`` (a different stage count).
+        """
+        self._check_fitted()
+        x, rec, lab, prepared, _ = self._windows(data, "assess", domain)
+        p = self._proba_windows(x)
+        self._check_labels([q.label for q in prepared if q.label is not None], "assess")
+        out = []
+        for i, q in enumerate(prepared):
+            pw = p[rec == i]
+            mean = pw.mean(0)
+            s = int(mean.argmax())
+            out.append(RecordAssessment(q.name, s, float(mean[s]), tuple(float(v) for v in mean),
+                                        tuple(int(v) for v in pw.argmax(1)),
+                                        tuple(float(v) for v in pw.max(1)), q.label))
+        labelled = all(q.label is not None for q in prepared)
+        rec_acc = float(np.mean([r.stage == r.label for r in out])) if labelled else None
+        win_acc = float(np.mean(p.argmax(1) == lab)) if labelled else None
+        return Assessment(tuple(out), self.n_classes_, rec_acc, win_acc)
+
+    def _check_labels(self, labels, what: str) -> None:
+        bad = sorted({int(v) for v in labels if not 0 <= int(v) < self.n_classes_})
+        if bad:
+            raise AssessorError(f"{what}: label(s) {bad} outside the model's {self.n_classes_} stages "
+                                f"(0..{self.n_classes_ - 1}); the data have a different stage count")
+
+    def score(self, data, labels=None) -> float:
+        """Window accuracy on labelled data (records with labels, or windows + ``labels``)."""
+        self._check_fitted()
+        if isinstance(data, np.ndarray):
+            if labels is None:
+                raise AssessorError("score: labels are required with an array of windows")
+            y = np.asarray(labels)
+            p = self.predict_proba(data)
+            if y.shape != (p.shape[0],):
+                raise AssessorError(f"score: labels must have shape ({p.shape[0]},), got {y.shape}")
+            self._check_labels(y, "score")
+            return float(np.mean(p.argmax(1) == y))
+        a = self.assess(data)
+        if a.window_accuracy is None:
+            raise AssessorError("score: some records have no label")
+        return a.window_accuracy
+
+    # ---- persistence ----------------------------------------------------------------------------
+    def save(self, directory: str | Path) -> Path:
+        """Write ``config.json`` (parameters, preprocessing, history) and ``weights.pt`` atomically.
+
+        The directory is created if its parent exists.  Raises :class:`~twin.errors.OutputPathError`
+        for a missing parent or a path that is a file.
+        """
+        import torch
+
+        from twin._atomic import atomic_path
+        from twin.errors import OutputPathError
+
+        self._check_fitted()
+        d = Path(directory)
+        if d.exists() and not d.is_dir():
+            raise OutputPathError(f"assessor directory '{d}' exists and is not a directory")
+        if not d.parent.is_dir():
+            raise OutputPathError(f"output directory '{d.parent}' does not exist (for '{d}')")
+        d.mkdir(exist_ok=True)
+        aug = self._aug()
+        params = {k: getattr(self, k) for k in self._PARAMS if k not in ("preprocessing", "augmentation")}
+        config = {"format": SAVE_FORMAT, "format_version": SAVE_VERSION, "params": params,
+                  "preprocessing": self._pre.to_dict(), "augmentation": aug.to_dict() if aug else None,
+                  "n_classes": self.n_classes_, "history": self.history_,
+                  "n_source_windows": self.n_source_windows_, "n_target_windows": self.n_target_windows_,
+                  "fit_time": getattr(self, "fit_time_", None),
+                  "source_scale": self.source_scale_, "target_scale": self.target_scale_}
+        with atomic_path(d / "weights.pt") as tmp:
+            torch.save({k: v.cpu() for k, v in self.network_.state_dict().items()}, tmp)
+        with atomic_path(d / "config.json") as tmp:
+            tmp.write_text(json.dumps(config, indent=1))
+        return d
+
+    @classmethod
+    def load(cls, directory: str | Path, device: str | None = None) -> "Assessor":
+        """Read an assessor written by :meth:`save`.
+
+        Raises
+        ------
+        AssessorError
+            Missing directory or file, another format or version, inconsistent weights.
+        """
+        import torch
+
+        from twin.transfer.model import Network
+
+        d = Path(directory)
+        cfg_file, w_file = d / "config.json", d / "weights.pt"
+        for f in (cfg_file, w_file):
+            if not f.is_file():
+                raise AssessorError(f"'{d}' is not a saved assessor: '{f.name}' is missing")
+        try:
+            cfg = json.loads(cfg_file.read_text())
+        except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+            raise AssessorError(f"'{cfg_file}' is not valid JSON: {exc}") from None
+        if cfg.get("format") != SAVE_FORMAT or cfg.get("format_version") != SAVE_VERSION:
+            raise AssessorError(f"'{cfg_file}' has format {cfg.get('format')!r} version "
+                                f"{cfg.get('format_version')!r}; expected {SAVE_FORMAT!r} {SAVE_VERSION}")
+        params = dict(cfg["params"])
+        if device is not None:
+            params["device"] = device
+        aug = Augmentation(**cfg["augmentation"]) if cfg["augmentation"] else None
+        a = cls(**params, preprocessing=Preprocessing(**cfg["preprocessing"]), augmentation=aug)
+        net = Network(int(cfg["n_classes"]), a._pre.window)
+        try:
+            state = torch.load(w_file, map_location="cpu", weights_only=True)
+            net.load_state_dict(state)
+        except (RuntimeError, KeyError, ValueError, OSError) as exc:   # torch reports bad files as these
+            raise AssessorError(f"'{w_file}' does not hold weights for this network: {exc}") from None
+        net.to(a._device()).eval()
+        a.network_ = net
+        a.n_classes_ = int(cfg["n_classes"])
+        a.classes_ = np.arange(a.n_classes_)
+        a.history_ = cfg["history"]
+        a.n_source_windows_ = cfg["n_source_windows"]
+        a.n_target_windows_ = cfg["n_target_windows"]
+        a.source_scale_ = float(cfg["source_scale"])
+        a.target_scale_ = float(cfg["target_scale"])
+        if cfg.get("fit_time") is not None:
+            a.fit_time_ = cfg["fit_time"]
+        return a

@@ -1,0 +1,277 @@
+"""The transfer benchmark: CNN, MMD and the proposed assessor side by side, over seeds.
+
+Data (built once per task and cached in ``data_dir``, keyed by the settings below):
+
+* **source** -- the twin's archive (:func:`twin.archive.build_archive`) of
+  ``scenarios/lubricated.yaml`` (task ``pitting``, 6 stages) or ``scenarios/dry.yaml`` (task
+  ``wear``, 4 stages), shortened for speed: ``records_per_stage`` 16 instead of 50 and
+  ``record_duration`` 0.3 s instead of 0.2 s (long enough for four 2048-sample windows at
+  20 kHz, hop 1024).  That gives 384 (pitting) / 256 (wear) source windows, about the paper's
+  400 source samples, which keeps a training run with the paper's settings under 2 minutes.
+* **target** -- :func:`twin.transfer.domain.make_target_domain` with the default
+  :class:`~twin.transfer.domain.TargetShift`, 15 records per stage of 0.4 s (data seed 1,
+  the archive uses the scenario's seed 0).  Each half record gives two windows: 180 (pitting) /
+  120 (wear) adaptation windows and as many test windows.
+
+Protocol (see ``twin/transfer/README.md``): each target record is cut in two halves; the first
+halves (unlabelled) are the adaptation set handed to ``fit``, the second halves are the test
+set.  Hyperparameters are the paper's and fixed; the model after the last epoch is scored;
+target labels are read only by the scoring code.  Each seed seeds the network initialisation,
+batch order and augmentation; the data stay the same across seeds.
+"""
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from twin.errors import ParameterError
+
+REPO = Path(__file__).resolve().parents[2]
+TASKS = {"pitting": "scenarios/lubricated.yaml", "wear": "scenarios/dry.yaml"}
+METHODS = ("cnn", "mmd", "proposed")
+
+
+@dataclass(frozen=True)
+class DataSettings:
+    """Sizes of the benchmark data (see the module docstring)."""
+
+    source_records_per_stage: int = 16
+    source_record_duration: float = 0.3     # s
+    target_records_per_stage: int = 15
+    target_record_duration: float = 0.4     # s
+    target_seed: int = 1
+
+
+def prepare_task(task: str, data_dir: str | Path, settings: DataSettings = DataSettings(), *,
+                 progress: bool = True) -> tuple[Path, Path]:
+    """Build (or reuse) the source archive and target measurements of ``task``; return their paths."""
+    from twin.archive import build_archive
+    from twin.degradation_run import run_degradation
+    from twin.scenario import load_scenario
+    from twin.transfer.domain import make_target_domain
+
+    if task not in TASKS:
+        raise ParameterError(f"unknown task {task!r}; use one of {', '.join(TASKS)}")
+    data_dir = Path(data_dir)
+    if not data_dir.is_dir():
+        from twin.errors import OutputPathError
+        raise OutputPathError(f"data directory '{data_dir}' does not exist")
+    src, tgt, key = data_dir / f"source_{task}.h5", data_dir / f"target_{task}.h5", data_dir / f"{task}.json"
+    wanted = json.dumps(asdict(settings), sort_keys=True)
+    if src.exists() and tgt.exists() and key.exists() and key.read_text() == wanted:
+        return src, tgt
+    sc = load_scenario(REPO / TASKS[task])
+    arc = {**sc.archive, "records_per_stage": settings.source_records_per_stage,
+           "record_duration": settings.source_record_duration}
+    sc = sc.with_overrides(archive=arc)
+    fmu = sc.fmu_path()
+    build_archive(sc, src, progress=progress, fmu_path=fmu)
+    run = run_degradation(sc, None, fmu_path=fmu, progress=progress, channels=("accel_pinion_casing",))
+    make_target_domain(sc, tgt, records_per_stage=settings.target_records_per_stage,
+                       record_duration=settings.target_record_duration, seed=settings.target_seed,
+                       run=run, fmu_path=fmu, progress=progress)
+    key.write_text(wanted)
+    return src, tgt
+
+
+# ---- one training run (top level: it runs in worker processes) -------------------------------------
+_DATA_CACHE: dict = {}
+
+
+def _load(task: str, src: str, tgt: str, sample_rate: float):
+    """Source records and the two halves of the target records, loaded once per process."""
+    key = (task, src, tgt, sample_rate)
+    if key not in _DATA_CACHE:
+        from twin.measurements import load_measurements
+        from twin.transfer.preprocess import split_records
+        s = load_measurements(src, channels=["accel_pinion_casing"], resample_to=sample_rate)
+        t = load_measurements(tgt, channels=["accel_pinion_casing"], resample_to=sample_rate)
+        adapt, test = split_records(t, 0.5)
+        # The adaptation half is handed to fit() without its labels, so they cannot leak.
+        from dataclasses import replace
+        adapt = [replace(r, label=None, damage=None) for r in adapt]
+        _DATA_CACHE[key] = (s, adapt, test)
+    return _DATA_CACHE[key]
+
+
+@dataclass(frozen=True)
+class RunResult:
+    """One (task, method, seed) training run, scored on the held-out target halves."""
+
+    task: str
+    method: str
+    seed: int
+    window_accuracy: float          # target test windows
+    record_accuracy: float          # target test half-records (mean window probability)
+    source_accuracy: float          # source windows, no augmentation (training data)
+    fit_time: float                 # s, training loop
+    confusion: list                 # (K, K) target test windows
+    history: list
+    embedding: dict = field(default_factory=dict)     # features for t-SNE (first seed only)
+
+
+def train_one(task: str, method: str, seed: int, source: str, target: str, epochs: int = 80,
+              with_features: bool = False, monitor: bool = True) -> RunResult:
+    """Fit one assessor with the paper's settings and score it on the target test halves."""
+    from twin.transfer.assessor import Assessor
+    from twin.transfer.report import confusion_matrix
+
+    a = Assessor(method, epochs=epochs, seed=seed, progress=False)
+    s, adapt, test = _load(task, source, target, a._pre.sample_rate)
+    a.fit(s, adapt, monitor=(test, None) if monitor else None)
+    asm = a.assess(test)
+    y = np.concatenate([[r.label] * len(r.window_stages) for r in asm.records])
+    p = np.concatenate([r.window_stages for r in asm.records])
+    src_acc = a.score(s) if a._pre.normalise != "domain" else float(np.mean(a.predict(s, domain="source")
+                                                                             == [r.label for r in s]))
+    emb = {}
+    if with_features:
+        rng = np.random.default_rng(0)
+        fs = a.transform(s, domain="source")
+        from twin.transfer.preprocess import prepare, windows_of
+        _, _, ys = windows_of(prepare(s, a._pre), a._pre)
+        pick = rng.choice(fs.shape[0], size=min(300, fs.shape[0]), replace=False)
+        emb = {"source": fs[pick], "source_stage": ys[pick], "target": a.transform(test), "target_stage": y}
+    return RunResult(task, method, seed, float(np.mean(y == p)), float(asm.record_accuracy),
+                     float(src_acc), float(a.fit_time_), confusion_matrix(y, p, a.n_classes_).tolist(),
+                     a.history_, emb)
+
+
+def _train_star(args):
+    return train_one(*args)
+
+
+# ---- the whole benchmark --------------------------------------------------------------------------
+def summarise(results: list[RunResult]) -> dict:
+    """Mean and std (ddof 1) per task and method; paired differences between methods over seeds."""
+    from scipy.stats import ttest_rel
+
+    out: dict = {}
+    for task in sorted({r.task for r in results}):
+        rows = {}
+        for m in [m for m in ("cnn", "mmd", "coral", "proposed") if any(r.method == m and r.task == task
+                                                                          for r in results)]:
+            rs = sorted((r for r in results if r.task == task and r.method == m), key=lambda r: r.seed)
+            acc = np.array([r.window_accuracy for r in rs])
+            rec = np.array([r.record_accuracy for r in rs])
+            t = np.array([r.fit_time for r in rs])
+            rows[m] = {"seeds": [r.seed for r in rs], "window_acc": acc.tolist(), "record_acc": rec.tolist(),
+                       "mean": float(acc.mean()), "std": float(acc.std(ddof=1)) if acc.size > 1 else 0.0,
+                       "record_mean": float(rec.mean()),
+                       "record_std": float(rec.std(ddof=1)) if rec.size > 1 else 0.0,
+                       "source_acc_mean": float(np.mean([r.source_accuracy for r in rs])),
+                       "fit_time_mean": float(t.mean()), "fit_time_max": float(t.max())}
+        pairs = {}
+        for a, b in (("cnn", "mmd"), ("mmd", "proposed"), ("cnn", "proposed")):
+            if a in rows and b in rows and rows[a]["seeds"] == rows[b]["seeds"]:
+                d = np.array(rows[b]["window_acc"]) - np.array(rows[a]["window_acc"])
+                p = float(ttest_rel(rows[b]["window_acc"], rows[a]["window_acc"]).pvalue) if d.size > 1 and d.std() > 0 else None
+                pairs[f"{b}-{a}"] = {"mean_diff": float(d.mean()), "wins": int((d > 0).sum()), "n": int(d.size),
+                                     "paired_t_p": p}
+        out[task] = {"methods": rows, "paired": pairs}
+    return out
+
+
+def markdown_table(summary: dict) -> str:
+    """The figures as a Markdown table (accuracy in %, mean +- std over seeds)."""
+    lines = ["| task | method | target test windows [%] | target test records [%] | source (train) [%] | "
+             "fit time mean / max [s] |", "|---|---|---|---|---|---|"]
+    for task, s in summary.items():
+        for m, r in s["methods"].items():
+            lines.append(f"| {task} | {m} | {100 * r['mean']:.1f} +- {100 * r['std']:.1f} | "
+                         f"{100 * r['record_mean']:.1f} +- {100 * r['record_std']:.1f} | "
+                         f"{100 * r['source_acc_mean']:.1f} | {r['fit_time_mean']:.0f} / {r['fit_time_max']:.0f} |")
+    lines += ["", "| task | comparison | mean gain [points] | seeds won | paired t-test p |", "|---|---|---|---|---|"]
+    for task, s in summary.items():
+        for k, d in s["paired"].items():
+            p = "n/a" if d["paired_t_p"] is None else f"{d['paired_t_p']:.2g}"
+            lines.append(f"| {task} | {k} | {100 * d['mean_diff']:+.1f} | {d['wins']}/{d['n']} | {p} |")
+    return "\n".join(lines)
+
+
+def run_benchmark(out: str | Path, *, tasks: tuple[str, ...] = ("pitting", "wear"), seeds: int = 5,
+                  methods: tuple[str, ...] = METHODS, epochs: int = 80, jobs: int = 2,
+                  data_dir: str | Path | None = None, settings: DataSettings = DataSettings(),
+                  progress: bool = True) -> dict:
+    """Run every (task, method, seed), write ``results.json``, ``summary.md``, figures and
+    ``report.html`` into ``out``; return the summary (see :func:`summarise`).
+
+    ``jobs`` training runs go in parallel, each in its own process on one torch thread (so the
+    fit times are single-core times).
+    """
+    import multiprocessing as mp
+    from concurrent.futures import ProcessPoolExecutor
+
+    from twin._progress import progress_bar
+    from twin.errors import OutputPathError
+
+    out = Path(out)
+    if not out.parent.is_dir():
+        raise OutputPathError(f"output directory '{out.parent}' does not exist (for '{out}')")
+    out.mkdir(exist_ok=True)
+    bad = [t for t in tasks if t not in TASKS] + [m for m in methods if m not in METHODS + ("coral",)]
+    if bad:
+        raise ParameterError(f"unknown task or method {bad[0]!r}; tasks: {', '.join(TASKS)}; "
+                             f"methods: cnn, mmd, proposed, coral")
+    if not isinstance(seeds, int) or seeds < 1:
+        raise ParameterError(f"seeds must be a positive integer, got {seeds!r}")
+    data_dir = Path(data_dir) if data_dir is not None else out / "data"
+    data_dir.mkdir(exist_ok=True)
+    paths = {t: prepare_task(t, data_dir, settings, progress=progress) for t in tasks}
+    # Seed 0 also returns features for the t-SNE and monitors the target test accuracy per epoch
+    # for the learning curves (monitoring only: it never feeds back into training).
+    jobs_list = [(t, m, s, str(paths[t][0]), str(paths[t][1]), epochs, s == 0, s == 0)
+                 for t in tasks for s in range(seeds) for m in methods]
+    bar = progress_bar(len(jobs_list), progress, "transfer benchmark", "run")
+    results: list[RunResult] = []
+    t0 = time.perf_counter()
+    with ProcessPoolExecutor(max_workers=jobs, mp_context=mp.get_context("spawn")) as pool:
+        for r in pool.map(_train_star, jobs_list):
+            results.append(r)
+            bar.update(1)
+    bar.close()
+    wall = time.perf_counter() - t0
+    summary = summarise(results)
+    _write_outputs(out, results, summary, epochs, wall, settings)
+    return summary
+
+
+def _write_outputs(out: Path, results: list[RunResult], summary: dict, epochs: int, wall: float,
+                   settings: DataSettings) -> None:
+    from twin._atomic import atomic_path
+    from twin.transfer import report
+    from twin.transfer.tsne import tsne
+
+    table = markdown_table(summary)
+    blocks = [("Summary (target test = second halves of the rig records; last epoch; "
+               f"{epochs} epochs; wall time {wall:.0f} s)", table)]
+    for task in summary:
+        first = {r.method: r for r in results if r.task == task and r.seed == 0}
+        cm = report.plot_confusion({m: np.array(r.confusion) for m, r in first.items()},
+                                   out / f"confusion_{task}.png", f"{task}: target test windows, seed 0")
+        lc = report.plot_learning_curves({m: r.history for m, r in first.items()}, out / f"curves_{task}.png",
+                                         f"{task}: learning curves, seed 0")
+        panels = {}
+        for m, r in first.items():
+            e = r.embedding
+            if not e:
+                continue
+            x = np.concatenate([e["source"], e["target"]])
+            emb = tsne(x, seed=0)
+            panels[m] = (emb, np.concatenate([e["source_stage"], e["target_stage"]]),
+                         np.r_[np.zeros(len(e["source"]), bool), np.ones(len(e["target"]), bool)])
+        blocks += [(f"{task}: confusion matrices", cm.name), (f"{task}: learning curves", lc.name)]
+        if panels:
+            ts = report.plot_tsne(panels, out / f"tsne_{task}.png", f"{task}: t-SNE of G features, seed 0")
+            blocks.append((f"{task}: t-SNE", ts.name))
+    report.write_html(out / "report.html", "Transfer benchmark: CNN vs MMD vs proposed", blocks)
+    payload = {"summary": summary, "epochs": epochs, "wall_time": wall, "data": asdict(settings),
+               "runs": [{k: v for k, v in asdict(r).items() if k != "embedding"} for r in results]}
+    with atomic_path(out / "results.json") as tmp:
+        Path(tmp).write_text(json.dumps(payload, indent=1))
+    with atomic_path(out / "summary.md") as tmp:
+        Path(tmp).write_text(table + "\n")

@@ -1,0 +1,91 @@
+"""Command-line handlers of the transfer-learning assessor (wired into ``twin`` by twin/cli.py).
+
+``add_subcommands(sub)`` registers ``train-assessor``, ``assess`` and ``benchmark-transfer`` on the
+``twin`` sub-parser object.  Handlers only parse and print; the work lives in
+:mod:`twin.transfer`, imported inside each handler so ``twin --help`` stays free of torch.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+from pathlib import Path
+
+
+def _lib(name: str):
+    return importlib.import_module(name)
+
+
+def _cmd_train_assessor(args: argparse.Namespace) -> int:
+    transfer = _lib("twin.transfer")
+    from twin.errors import OutputPathError
+    out = Path(args.out)
+    if not out.parent.is_dir():    # before minutes of training, not after
+        raise OutputPathError(f"output directory '{out.parent}' does not exist (for '{out}')")
+    a = transfer.Assessor(args.method, epochs=args.epochs, seed=args.seed, progress=not args.no_progress)
+    a.fit(Path(args.source), Path(args.target))
+    a.save(out)
+    last = a.history_[-1]
+    print(f"{args.method}: {a.n_classes_} stages, {a.n_source_windows_} source / {a.n_target_windows_} target "
+          f"windows, {len(a.history_)} epochs in {a.fit_time_:.0f} s; last epoch: loss {last['loss']:.3f}, "
+          f"source accuracy {100 * last['source_acc']:.1f} % -> {out}")
+    return 0
+
+
+def _cmd_assess(args: argparse.Namespace) -> int:
+    transfer = _lib("twin.transfer")
+    a = transfer.Assessor.load(Path(args.assessor))
+    res = a.assess(Path(args.measurements))
+    for r in res.records:
+        lab = "" if r.label is None else f"  (label {r.label})"
+        print(f"{r.name}: stage {r.stage}, confidence {r.confidence:.2f}, {len(r.window_stages)} windows{lab}")
+    if res.record_accuracy is not None:
+        print(f"accuracy: records {100 * res.record_accuracy:.1f} %, windows {100 * res.window_accuracy:.1f} %")
+    if args.json:
+        from twin._atomic import atomic_path
+        with atomic_path(Path(args.json)) as tmp:
+            Path(tmp).write_text(json.dumps(res.to_dict(), indent=1))
+        print(f"stages -> {args.json}")
+    return 0
+
+
+def _cmd_benchmark_transfer(args: argparse.Namespace) -> int:
+    bench = _lib("twin.transfer.benchmark")
+    tasks = ("pitting", "wear") if args.task == "both" else (args.task,)
+    summary = bench.run_benchmark(Path(args.out), tasks=tasks, seeds=args.seeds, epochs=args.epochs,
+                                  jobs=args.jobs, data_dir=Path(args.data_dir) if args.data_dir else None,
+                                  progress=not args.no_progress)
+    print(bench.markdown_table(summary))
+    print(f"report -> {Path(args.out) / 'report.html'}")
+    return 0
+
+
+def add_subcommands(sub) -> None:
+    """Register ``train-assessor``, ``assess`` and ``benchmark-transfer`` on ``sub``
+    (the object returned by ``parser.add_subparsers``)."""
+    p = sub.add_parser("train-assessor", help="train the transfer-learning wear assessor (twin -> rig)")
+    p.add_argument("--source", required=True, help="labelled source archive HDF5 (twin archive)")
+    p.add_argument("--target", required=True, help="unlabelled rig measurements HDF5 (labels are ignored)")
+    p.add_argument("--out", required=True, help="directory to save the assessor in")
+    p.add_argument("--method", choices=("proposed", "mmd", "cnn", "coral"), default="proposed",
+                   help="proposed (MMD + class contrastive, default), mmd, cnn (source only), coral")
+    p.add_argument("--seed", type=int, default=0, help="seed of initialisation, batches, augmentation")
+    p.add_argument("--epochs", type=int, default=80, help="passes over the source windows (default: 80)")
+    p.add_argument("--no-progress", action="store_true", help="hide the progress bars")
+    p.set_defaults(handler=_cmd_train_assessor)
+
+    p = sub.add_parser("assess", help="assess the wear stage of measurements with a trained assessor")
+    p.add_argument("assessor", metavar="ASSESSOR", help="directory written by train-assessor")
+    p.add_argument("measurements", metavar="MEASUREMENTS", help="measurement HDF5 (or CSV + sidecar)")
+    p.add_argument("--json", help="write stage and confidence per record and per window to this JSON file")
+    p.set_defaults(handler=_cmd_assess)
+
+    p = sub.add_parser("benchmark-transfer", help="CNN vs MMD vs proposed on twin -> emulated rig, over seeds")
+    p.add_argument("--out", required=True, help="output directory (results.json, summary.md, report.html)")
+    p.add_argument("--seeds", type=int, default=5, help="seeds per method (default: 5)")
+    p.add_argument("--task", choices=("pitting", "wear", "both"), default="both")
+    p.add_argument("--epochs", type=int, default=80, help="epochs per training run (default: 80)")
+    p.add_argument("--jobs", type=int, default=2, help="training runs in parallel (default: 2)")
+    p.add_argument("--data-dir", help="where the simulated source/target data are cached (default: OUT/data)")
+    p.add_argument("--no-progress", action="store_true", help="hide the progress bars")
+    p.set_defaults(handler=_cmd_benchmark_transfer)
