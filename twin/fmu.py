@@ -16,8 +16,10 @@ from __future__ import annotations
 
 import ctypes
 import hashlib
+import itertools
 import shutil
 import tempfile
+import weakref
 import zipfile
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
@@ -32,6 +34,43 @@ from twin.results import SimulationResult
 _STATUS = ["fmi2OK", "fmi2Warning", "fmi2Discard", "fmi2Error", "fmi2Fatal", "fmi2Pending"]
 STEP_SIZE = "solver.step_size"
 OUTPUT_INTERVAL = "solver.output_interval"
+
+
+# fmpy's logger proxy (which formats the printf arguments of FMU messages) keeps ONE target
+# logger per process. Registering a proxy per instance would redirect every other FMU's messages,
+# fmpy's own included, to that instance's callback, and to freed memory once it is closed. So one
+# proxy is registered, once, for a dispatcher that forwards by componentEnvironment to the live
+# instance, and prints like fmpy for anything else.
+_LOG_KEYS = itertools.count(1)
+_LOG_TARGETS: dict[int, "weakref.WeakMethod"] = {}
+_SHARED: dict[str, object] = {}
+
+
+def _dispatch_log(env, instance, status, category, message):
+    target = _LOG_TARGETS.get(int(env)) if env else None
+    method = target() if target is not None else None
+    if method is not None:
+        method(env, instance, status, category, message)
+    else:
+        from fmpy.fmi1 import printLogMessage
+        printLogMessage(env, instance, status, category, message)
+
+
+def _shared_logger():
+    """The proxied logger function pointer shared by every instance (registered on first use)."""
+    if "logger" not in _SHARED:
+        from fmpy.fmi2 import fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
+        cb = fmi2CallbackFunctions()
+        cb.logger = fmi2CallbackLoggerTYPE(_dispatch_log)
+        _SHARED["python_logger"] = cb.logger          # kept alive for the life of the process
+        try:
+            from fmpy.logging import addLoggerProxy
+            addLoggerProxy(ctypes.byref(cb))           # replaces cb.logger by the C proxy
+        except Exception:  # without the proxy, messages arrive unformatted but still arrive
+            pass
+        _SHARED["callbacks"] = cb
+        _SHARED["logger"] = cb.logger
+    return _SHARED["logger"]
 
 
 @dataclass(frozen=True)
@@ -155,17 +194,15 @@ class FMU:
 
     def _make_callbacks(self):
         from fmpy import calloc, free
-        from fmpy.fmi2 import (fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE, fmi2CallbackFunctions,
-                               fmi2CallbackLoggerTYPE)
+        from fmpy.fmi2 import fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE, fmi2CallbackFunctions
+        key = next(_LOG_KEYS)
+        _LOG_TARGETS[key] = weakref.WeakMethod(self._logger)
         cb = fmi2CallbackFunctions()
-        cb.logger = fmi2CallbackLoggerTYPE(self._logger)
+        cb.logger = _shared_logger()
         cb.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
         cb.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
-        try:
-            from fmpy.logging import addLoggerProxy
-            addLoggerProxy(ctypes.byref(cb))
-        except Exception:  # the proxy only formats printf arguments; messages stay readable without it
-            pass
+        # the logger finds this instance again through componentEnvironment
+        cb.componentEnvironment = ctypes.c_void_p(key)
         return cb
 
     def _call(self, what: str, fn, *args):

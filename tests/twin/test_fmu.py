@@ -129,3 +129,26 @@ def test_not_an_fmu(tmp_path):
 def test_describe_lists_variables(gearbox_fmu):
     text = describe(gearbox_fmu)
     assert "GearTwin.Gearbox21" in text and "accel_pinion_casing" in text and "N.s/m" in text
+
+
+def test_fmu_messages_reach_their_instance_and_fmpy_after_an_instance_closed(gearbox_fmu, capsys):
+    """fmpy keeps one logger proxy per process; closing an instance must not leave it dangling."""
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave
+
+    from twin.errors import TwinError
+    with FMU(gearbox_fmu) as first:
+        first.setup(0.0)
+    with FMU(gearbox_fmu) as second:
+        second.setup(0.0)
+        with pytest.raises(TwinError, match="solver.step_size must be > 0"):
+            second.set({"solver.step_size": -1.0})
+    md = read_model_description(str(gearbox_fmu))
+    slave = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(gearbox_fmu)),
+                      modelIdentifier=md.coSimulation.modelIdentifier, instanceName="plain")
+    slave.instantiate()
+    vr = next(v.valueReference for v in md.modelVariables if v.name == "solver.step_size")
+    with pytest.raises(Exception):
+        slave.setReal([vr], [-1.0])
+    slave.freeInstance()
+    assert "solver.step_size must be > 0" in capsys.readouterr().out
