@@ -138,6 +138,12 @@ SCHEMA: dict[str, Any] = {
                 "load_scatter": {**_NONNEG, "description": "relative standard deviation of the load"},
                 "noise": {**_NONNEG, "description": "measurement noise, relative to the signal RMS"},
                 "settle_time": {**_NONNEG, "description": "s simulated and discarded before each record"},
+                "damage_sampling": {"enum": ["uniform", "snapshot"],
+                                    "description": "uniform: damage drawn uniformly within each stage; snapshot: "
+                                                   "around the stage centre, like records taken at inspection "
+                                                   "points of an endurance test (the paper's stages)"},
+                "damage_scatter": {**_NONNEG, "description": "snapshot sampling: standard deviation of the damage "
+                                                            "as a fraction of the stage width (default 0.1)"},
             },
         },
         "calibration": CALIBRATION_SCHEMA,

@@ -70,3 +70,16 @@ def test_stage_beyond_the_degradation_run_is_refused(gearbox_fmu):
     arc["stages"] = [0.0, 0.03, 0.5]
     with pytest.raises(SimulationError, match="short of the last stage boundary"):
         build_archive(sc.with_overrides(archive=arc), None, fmu_path=gearbox_fmu, progress=False)
+
+
+def test_snapshot_sampling_centres_records_on_their_stage():
+    import numpy as np
+
+    from twin.archive import stage_damage
+    rng = np.random.default_rng(0)
+    snap = np.array([stage_damage(rng, 0.1, 0.2, {"damage_sampling": "snapshot", "damage_scatter": 0.1})
+                     for _ in range(2000)])
+    assert np.all((snap >= 0.1) & (snap < 0.2))
+    assert abs(snap.mean() - 0.15) < 1e-3 and abs(snap.std() - 0.01) < 1e-3
+    uni = np.array([stage_damage(rng, 0.1, 0.2, {}) for _ in range(2000)])
+    assert abs(uni.std() - 0.1 / np.sqrt(12)) < 2e-3

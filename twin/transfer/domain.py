@@ -2,8 +2,8 @@
 twin does not model.
 
 :func:`make_target_domain` simulates records of the same damage stages as the source archive
-(``scenario.archive.stages``; the damage is drawn uniformly within each stage, as the archive
-does) on a *variant* of the model, then passes the acceleration through a measurement chain
+(``scenario.archive.stages``; the damage is drawn within each stage by the archive's own rule,
+:func:`twin.archive.stage_damage`) on a *variant* of the model, then passes the acceleration through a measurement chain
 that the source simulation does not have.  Every effect is physically motivated and none of
 them is known to the assessor:
 
@@ -150,7 +150,7 @@ def make_target_domain(source_scenario, output: str | Path, *, records_per_stage
         scenario's sample rate, attributes ``label`` (stage), ``damage``, ``nominal_speed``, ``load``
         (evaluation only), file metadata ``stages``, ``damage_kind``, ``target_shift`` (JSON).
     """
-    from twin.archive import RecordTask, interpolate_parameters, simulate_record
+    from twin.archive import RecordTask, interpolate_parameters, simulate_record, stage_damage
     from twin.executor import make_executor
     from twin.measurements import MeasurementSet, Record, write_measurements
     from twin.measurements.write import _check_h5_path
@@ -193,7 +193,7 @@ def make_target_domain(source_scenario, output: str | Path, *, records_per_stage
     tasks, meta = [], []
     for s, (lo, hi) in enumerate(zip(bounds, bounds[1:])):
         for _ in range(records_per_stage):
-            d = float(draw.uniform(lo, hi))
+            d = stage_damage(draw, lo, hi, source_scenario.archive or {})
             f = nominal_speed * (1 + shift.speed_scatter * float(draw.standard_normal()))
             t_load = nominal_load * (1 + shift.load_scatter * float(draw.standard_normal()))
             phase = float(draw.uniform(0, 2 * np.pi))
