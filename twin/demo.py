@@ -45,10 +45,10 @@ def run_demo(out_dir: Path | str = "demo_out", *, stop_time: float = 10.0,
 
     t = time.perf_counter()
     fmu = build_fmu("GearTwin.Gearbox21", modelica_dir, REPO / "build")
-    print(f"[1/8] FMU      {fmu}  ({time.perf_counter() - t:.1f} s, cached builds are instant)")
+    print(f"[1/9] FMU      {fmu}  ({time.perf_counter() - t:.1f} s, cached builds are instant)")
 
     freqs = natural_frequencies(fmu, n=len(MEASURED_MODES_HZ))
-    print("[2/8] Natural frequencies of the default (uncalibrated) model vs the rig (paper Table 2):")
+    print("[2/9] Natural frequencies of the default (uncalibrated) model vs the rig (paper Table 2):")
     print("      mode   measured [Hz]   model [Hz]   difference")
     for i, (m, f) in enumerate(zip(MEASURED_MODES_HZ, freqs), 1):
         print(f"      {i:4d}   {m:13.0f}   {f:10.1f}   {100 * (f - m) / m:+9.1f} %")
@@ -58,7 +58,7 @@ def run_demo(out_dir: Path | str = "demo_out", *, stop_time: float = 10.0,
                           inputs={"motor_speed_ref": 2 * np.pi * SHAFT_HZ, "load_torque": LOAD_NM},
                           progress=True)
     wall = time.perf_counter() - t
-    print(f"[3/8] Simulated {stop_time:g} s of the healthy rig at {SHAFT_HZ:g} Hz / {LOAD_NM:g} N.m, "
+    print(f"[3/9] Simulated {stop_time:g} s of the healthy rig at {SHAFT_HZ:g} Hz / {LOAD_NM:g} N.m, "
           f"100 kHz output: {result.time.size} samples in {wall:.2f} s")
 
     h5 = write_result(result, out_dir / "healthy.h5") or out_dir / "healthy.h5"
@@ -72,14 +72,15 @@ def run_demo(out_dir: Path | str = "demo_out", *, stop_time: float = 10.0,
                         f"(shaft {pinion_hz:.2f} Hz with motor slip, GMF = {mesh_hz:.1f} Hz)")
     accel = result["accel_pinion_casing"]
     steady = accel[result.time >= min(0.5, stop_time / 2)]
-    print(f"[4/8] Wrote {h5} and {png}")
+    print(f"[4/9] Wrote {h5} and {png}")
     print(f"      B&K 4396 channel: RMS {np.sqrt(np.mean(steady ** 2)):.3g} m/s^2; "
           f"mean mesh force {np.mean(result['mesh_force']):.1f} N (static estimate {LOAD_NM / 0.0733:.1f} N)")
     stages_png, stage_rows = _degradation_demo(fmu, out_dir)
     report = _calibration_demo(fmu, out_dir)
     _compare_demo(out_dir)
     history = _loop_demo(out_dir)
-    return {"loop": history, "fmu": fmu, "hdf5": Path(h5), "png": Path(png), "natural_frequencies": freqs,
+    transfer = _transfer_demo(out_dir)
+    return {"loop": history, "transfer": transfer, "fmu": fmu, "hdf5": Path(h5), "png": Path(png), "natural_frequencies": freqs,
             "simulation_wall_time": wall, "stages_png": stages_png, "stages": stage_rows,
             "calibration": report}
 
@@ -114,7 +115,7 @@ def _calibration_demo(fmu: Path, out_dir: Path):
                         "natural_frequencies": modes.tolist(), "record_duration": 0.3}})
     report = run_calibration(scenario, rig, out_dir / "calibration", progress=False)
     r = report.result
-    print(f"[6/8] Calibration (MOGOA, {r.n_evals} evaluations, {time.perf_counter() - t:.1f} s) of 4 drive-train "
+    print(f"[6/9] Calibration (MOGOA, {r.n_evals} evaluations, {time.perf_counter() - t:.1f} s) of 4 drive-train "
           f"parameters to the built-in measurement {rig.name}:")
     print("      " + report.table().replace("\n", "\n      "))
     ob, oa = report.objectives_before, report.objectives_after
@@ -133,7 +134,7 @@ def _degradation_demo(fmu: Path, out_dir: Path):
     scenario = load_scenario(REPO / "scenarios" / "lubricated.yaml")
     t = time.perf_counter()
     run = run_degradation(scenario, out_dir / "lubricated_degradation.h5", fmu_path=fmu, progress=True)
-    print(f"[5/8] Lubricated endurance test: {len(run.stages)} co-simulation updates, {run.summary()} "
+    print(f"[5/9] Lubricated endurance test: {len(run.stages)} co-simulation updates, {run.summary()} "
           f"({time.perf_counter() - t:.1f} s); stages written to {out_dir / 'lubricated_degradation.h5'}")
     print("      stage   cycles      pitting density   min k_pair [N/um]   accel RMS [m/s^2]")
     picked, rows = [], []
@@ -188,7 +189,7 @@ def _compare_demo(out_dir: Path) -> None:
                                    "parameters": calibrated})
     healthy = compare(scenario, out_dir / "rig_measurement.h5", out_dir / "compare_healthy", duration=0.3)
     damaged = compare(scenario, rig, out_dir / "compare_damaged", duration=0.5)
-    print(f"[7/8] twin compare, calibrated model vs the rig: healthy record {healthy.lsd_db:.2f} dB, "
+    print(f"[7/9] twin compare, calibrated model vs the rig: healthy record {healthy.lsd_db:.2f} dB, "
           f"{len(healthy.findings)} findings; record with a cracked tooth {damaged.lsd_db:.2f} dB, "
           f"{len(damaged.findings)} findings:")
     for i, f in enumerate(damaged.findings[:4], 1):
@@ -224,8 +225,46 @@ def _loop_demo(out_dir: Path):
     shutil.copytree(REPO / "modelica", modelica, ignore=shutil.ignore_patterns("Variants"))
     history = improve(load_scenario(scen), meas, out_dir / "loop", max_steps=2, modelica_dir=modelica,
                       build_dir=out_dir / "build")
-    print(f"[8/8] twin improve on a record with a hidden effect ({time.perf_counter() - t:.0f} s): "
+    print(f"[8/9] twin improve on a record with a hidden effect ({time.perf_counter() - t:.0f} s): "
           f"the loop diagnoses, adds the effect, recalibrates, and stops when nothing helps")
     print("      " + history_table(history).replace("\n", "\n      "))
     print(f"      history: {out_dir / 'loop' / 'history.png'}; diagnosis: {out_dir / 'loop' / 'diagnosis_1.json'}")
     return history
+
+
+def _transfer_demo(out_dir: Path, epochs: int = 15):
+    """Wear-stage assessment of built-in rig records: CNN, MMD and the proposed method side by side.
+
+    A short version of ``twin benchmark-transfer`` (one seed, ``epochs`` epochs, fewer records), so
+    the demo stays within minutes; the figures over 5 seeds with the paper's 80 epochs are in
+    BENCHMARKS.md.
+    """
+    from twin.transfer.assessor import Assessor
+    from twin.transfer.benchmark import DataSettings, _load, prepare_task
+
+    t = time.perf_counter()
+    data = out_dir / "transfer_data"
+    data.mkdir(exist_ok=True)
+    settings = DataSettings(source_records_per_stage=8, target_records_per_stage=6)
+    src, tgt = prepare_task("pitting", data, settings, progress=False)
+    accuracy, assessed = {}, None
+    for method in ("cnn", "mmd", "proposed"):
+        a = Assessor(method, epochs=epochs, seed=0, progress=False)
+        source, adapt, test = _load("pitting", str(src), str(tgt), a._pre.sample_rate)
+        a.fit(source, adapt)
+        asm = a.assess(test)
+        windows = [(r.label, w) for r in asm.records for w in r.window_stages]
+        accuracy[method] = float(np.mean([y == w for y, w in windows]))
+        if method == "proposed":
+            assessed = (asm, test)
+            a.save(out_dir / "assessor")
+    print(f"[9/9] Wear-stage assessment of rig records (6 pitting stages; the rig has a mount resonance, "
+          f"run-out and another sensor the twin lacks; {epochs} epochs, one seed: "
+          f"{time.perf_counter() - t:.0f} s)")
+    print("      target test accuracy: " + ", ".join(f"{m} {100 * v:.0f} %" for m, v in accuracy.items()))
+    asm, _ = assessed
+    print("      record        true stage   assessed stage   confidence")
+    for r in asm.records[::max(1, len(asm.records) // 6)]:
+        print(f"      {r.name:<12}  {r.label:10d}   {r.stage:14d}   {r.confidence:10.2f}")
+    print(f"      assessor saved to {out_dir / 'assessor'} (twin assess {out_dir / 'assessor'} <measurements.h5>)")
+    return accuracy
