@@ -322,7 +322,7 @@ def active_effects(parameter_names: Sequence[str]) -> list[str]:
 def diagnose(fmu_path, measured: np.ndarray, sample_rate: float, nominal_speed: float, load: float, *,
              parameters: Mapping[str, float] | None = None, channel: str = "accel_pinion_casing",
              effects: Sequence[str] | None = None, executor=None, record: str = "record",
-             candidates_fmu=None, duration: float = 1.0, max_evals: int = 30,
+             candidates_fmu=None, duration: float = 2.0, max_evals: int = 30,
              min_cut: float = MIN_CUT, min_db: float = MIN_DB, solver_step: float | None = 1e-5,
              progress: bool = False) -> Diagnosis:
     """Diagnose one record (see the module docstring).
@@ -330,7 +330,9 @@ def diagnose(fmu_path, measured: np.ndarray, sample_rate: float, nominal_speed: 
     Parameters
     ----------
     fmu_path : the current model's FMU (the base gearbox or a variant of it).
-    measured : (n,) measured acceleration [m/s2] at ``sample_rate`` [Hz]; the last ``duration`` s are used.
+    measured : (n,) measured acceleration [m/s2] at ``sample_rate`` [Hz]; the last ``duration`` s are used
+        (2 s give 2 Hz bins, which separate sidebands at the gear speed, 7 Hz at 20 Hz input, from
+        their mesh harmonic).
     nominal_speed, load : drive setting [Hz] and brake torque [N.m] of the record.
     parameters : the current model's (calibrated) parameters.
     effects : candidate ids (default: every catalogue effect the current model lacks).
