@@ -26,21 +26,24 @@ def case_files(tmp_path, gearbox_fmu, candidates_fmu):
 
 
 @pytest.mark.slow
-def test_improve_adds_the_missing_effect_and_stops(case_files, tmp_path, executor):
+def test_improve_adds_the_missing_effect_and_stops(case_files, tmp_path, capsys):
+    import json
+
     from twin.cli import main
-    from twin.effects.loop import improve
     from twin.scenario import load_scenario
     scen, meas, modelica = case_files
-    history = improve(load_scenario(scen), meas, tmp_path / "loop", max_steps=2, executor=executor,
-                      modelica_dir=modelica, build_dir=tmp_path / "build", progress=False)
+    assert main(["improve", str(scen), "--measurements", str(meas), "--out", str(tmp_path / "loop"),
+                 "--max-steps", "2", "--workers", "2", "--modelica-dir", str(modelica)]) == 0
+    assert "local_tooth_damage" in capsys.readouterr().out
+    history = json.loads((tmp_path / "loop" / "history.json").read_text())["steps"]
     first = history[0]
-    assert first.effect == "local_tooth_damage"
-    assert first.lsd_after_db <= 0.5 * first.lsd_before_db
+    assert first["effect"] == "local_tooth_damage"
+    assert first["lsd_after_db"] <= 0.5 * first["lsd_before_db"]
     # the variant is a readable Modelica file that extends the base with the component
     src = (modelica / "GearTwin" / "Variants" / "Gearbox21_local_tooth_damage.mo").read_text()
     assert "extends GearTwin.Gearbox21(" in src and "GearTwin.Effects.LocalToothDamage local_tooth_damage(" in src
     # the loop stopped: the next diagnosis found nothing that helps
-    assert len(history) <= 2 and (len(history) == 1 or history[1].effect is None)
+    assert len(history) <= 2 and (len(history) == 1 or history[1]["effect"] is None)
     for f in ("history.csv", "history.json", "history.png", "diagnosis_1.json", "add_effect_local_tooth_damage.json",
               "scenario_local_tooth_damage.yaml"):
         assert (tmp_path / "loop" / f).exists(), f
