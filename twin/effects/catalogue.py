@@ -31,6 +31,7 @@ class FitParameter:
     upper: float
     log: bool = False            # search on a log scale (amplitudes spanning decades)
     guess: str | None = None     # start from the spectrum: "unlocked_line", "slow_sideband", "resonance"
+    grid: int = 7                # points of the coarse search before the local polish
 
 
 @dataclass(frozen=True)

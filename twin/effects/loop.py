@@ -132,7 +132,8 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
     z2 = int(round(current.get("z2", 52)))
     shaft = estimate_shaft_hz(measured, rec.sample_rate, rec.nominal_speed, z1)
     c_motor = float(scenario.parameters.get("c_motor", current.get("c_motor", 3.0)))
-    op = Operating(shaft + rec.load * z1 / z2 / c_motor / (2 * np.pi), shaft, rec.load, rec.sample_rate)
+    op = Operating(shaft + rec.load * z1 / z2 / c_motor / (2 * np.pi), shaft, rec.load, rec.sample_rate,
+                   teeth=z1)
     base_params = dict(scenario.parameters)
     sim0 = simulate(current_fmu, base_params, op, measured.size, channel)
     before = compare_signals(sim0, measured, rec.sample_rate, shaft, z1=z1, z2=z2)
