@@ -54,29 +54,26 @@ class Effect:
 _GEOMETRY = {"roll_pitch": "roll_pitch", "contact_start_radius": "contact_start_radius",
              "contact_path_length": "contact_path_length", "line_of_action_length": "line_of_action_length"}
 
+def _eccentricity(gear: str) -> Effect:
+    """Run-out of the pinion or the gear: one component, on that gear's shaft."""
+    shaft = {"pinion": ("theta5", "omega5"), "gear": ("theta10", "omega10")}[gear]
+    return Effect(
+        f"{gear}_eccentricity", "GearTwin.Effects.ShaftEccentricity", f"{gear.capitalize()} run-out",
+        inputs={"shaft_angle": shaft[0], "shaft_speed": shaft[1]},
+        hooks={"effect_mesh_displacement": "mesh_displacement",
+               "effect_mesh_displacement_rate": "mesh_displacement_rate"},
+        fit=(FitParameter("eccentricity", 2e-7, 2e-4, log=True),),
+        neutral={"eccentricity": 0.0},
+        evidence={"sideband": f"run-out of the {gear} modulates the mesh approach once per {gear} revolution, "
+                              f"which puts sidebands at {gear}-speed spacing around the mesh harmonics",
+                  "shaft_order": f"the once-per-revolution approach change excites the first {gear} orders",
+                  "mesh_harmonic": "the modulation moves energy between the mesh harmonics and their sidebands",
+                  "resonance": "sideband families fill the region around resonances"})
+
+
 CATALOGUE: dict[str, Effect] = {e.id: e for e in (
-    Effect("pinion_eccentricity", "GearTwin.Effects.ShaftEccentricity", "Pinion run-out",
-           inputs={"shaft_angle": "theta5", "shaft_speed": "omega5"},
-           hooks={"effect_mesh_displacement": "mesh_displacement",
-                  "effect_mesh_displacement_rate": "mesh_displacement_rate"},
-           fit=(FitParameter("eccentricity", 2e-7, 2e-4, log=True),),
-           neutral={"eccentricity": 0.0},
-           evidence={"sideband": "run-out of the pinion modulates the mesh approach once per pinion revolution, "
-                                 "which puts sidebands at pinion-speed spacing around the mesh harmonics",
-                     "shaft_order": "the once-per-revolution approach change excites the first pinion orders",
-                     "mesh_harmonic": "the modulation moves energy between the mesh harmonics and their sidebands",
-                     "resonance": "sideband families fill the region around resonances"}),
-    Effect("gear_eccentricity", "GearTwin.Effects.ShaftEccentricity", "Gear run-out",
-           inputs={"shaft_angle": "theta10", "shaft_speed": "omega10"},
-           hooks={"effect_mesh_displacement": "mesh_displacement",
-                  "effect_mesh_displacement_rate": "mesh_displacement_rate"},
-           fit=(FitParameter("eccentricity", 2e-7, 2e-4, log=True),),
-           neutral={"eccentricity": 0.0},
-           evidence={"sideband": "run-out of the gear modulates the mesh approach once per gear revolution, "
-                                 "which puts sidebands at gear-speed spacing around the mesh harmonics",
-                     "shaft_order": "the once-per-revolution approach change excites the first gear orders",
-                     "mesh_harmonic": "the modulation moves energy between the mesh harmonics and their sidebands",
-                     "resonance": "sideband families fill the region around resonances"}),
+    _eccentricity("pinion"),
+    _eccentricity("gear"),
     Effect("motor_torque_ripple", "GearTwin.Effects.MotorTorqueRipple", "Drive motor torque ripple",
            hooks={"effect_drive_torque": "torque"},
            fit=(FitParameter("frequency", 20.0, 400.0, guess="unlocked_line"),

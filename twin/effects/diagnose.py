@@ -177,22 +177,25 @@ def simulate(fmu_path, parameters: Mapping[str, float], op: Operating, n: int, c
     return x
 
 
-def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int]:
-    """Fit one effect's parameters; returns (FMU parameters, LSD [dB], evaluations)."""
+def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int, np.ndarray]:
+    """Fit one effect's parameters.
+
+    Returns (FMU parameters, LSD [dB], evaluations, the simulated signal (n,) at the fit), so the
+    caller compares the fitted model without simulating it again.
+    """
     from scipy.optimize import minimize, minimize_scalar
 
     eff = CATALOGUE[spec.effect]
     objective = _Objective(spec.measured, spec.operating.sample_rate)
     n = spec.measured.size
-    fixed = {k: v for k, v in spec.parameters.items()}
-    # an effect whose neutral value is not its fitted amplitude (e.g. material_loss) stays neutral
+    fixed = dict(spec.parameters)
     params = list(eff.fit)
     free = [p for p in params if p.guess is None]
     guessed = {p.name: float(np.clip(spec.guesses.get(p.name, math.sqrt(p.lower * p.upper) if p.log
                                                       else 0.5 * (p.lower + p.upper)), p.lower, p.upper))
                for p in params if p.guess is not None}
     count = 0
-    cache: dict[tuple, float] = {}
+    cache: dict[tuple, tuple[float, np.ndarray | None]] = {}   # values -> (LSD, simulated signal)
 
     def to_x(p: FitParameter, v: float) -> float:
         return (math.log(v / p.lower) / math.log(p.upper / p.lower)) if p.log else (v - p.lower) / (p.upper - p.lower)
@@ -201,20 +204,21 @@ def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int]:
         z = min(max(z, 0.0), 1.0)
         return p.lower * (p.upper / p.lower) ** z if p.log else p.lower + z * (p.upper - p.lower)
 
+    def key_of(values: Mapping[str, float]) -> tuple:
+        return tuple(sorted((k, round(v, 12)) for k, v in values.items()))
+
     def lsd(values: Mapping[str, float]) -> float:
         nonlocal count
-        key = tuple(sorted((k, round(v, 12)) for k, v in values.items()))
-        if key in cache:
-            return cache[key]
-        count += 1
-        try:
-            sim = simulate(spec.fmu_path, {**fixed, **{eff.parameter(k): v for k, v in values.items()}},
-                           spec.operating, n, spec.channel)
-            val = objective(sim)
-        except Exception:  # a diverging trial scores badly; it does not end the diagnosis
-            val = 1e3
-        cache[key] = val
-        return val
+        key = key_of(values)
+        if key not in cache:
+            count += 1
+            try:
+                sim = simulate(spec.fmu_path, {**fixed, **{eff.parameter(k): v for k, v in values.items()}},
+                               spec.operating, n, spec.channel)
+                cache[key] = (objective(sim), sim)
+            except Exception:  # a diverging trial scores badly; it does not end the diagnosis
+                cache[key] = (1e3, None)
+        return cache[key][0]
 
     # 1) amplitude-like parameters on a coarse grid with the guessed ones held, then Brent
     values = dict(guessed)
@@ -236,7 +240,8 @@ def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int]:
                                                                      for i in range(len(params))])})
         if res.fun < lsd(values):
             values = {p.name: from_x(p, zi) for p, zi in zip(params, res.x)}
-    return {eff.parameter(k): float(v) for k, v in values.items()}, lsd(values), count
+    val = lsd(values)
+    return {eff.parameter(k): float(v) for k, v in values.items()}, val, count, cache[key_of(values)][1]
 
 
 def _guarded_fit(spec: TrialSpec):
@@ -337,6 +342,54 @@ def active_effects(parameter_names: Sequence[str]) -> list[str]:
     return [e for e in CATALOGUE if e in ids]
 
 
+@dataclass(frozen=True)
+class Conditions:
+    """A record in model terms: what both the diagnosis and add-effect simulate against."""
+
+    measured: np.ndarray = field(repr=False)   # (n,) the compared stretch [m/s2]
+    current: dict                               # Real parameters of the current model's FMU
+    z1: int                                     # pinion teeth
+    z2: int                                     # gear teeth
+    operating: Operating
+
+
+def record_conditions(fmu_path, measured: np.ndarray, sample_rate: float, nominal_speed: float, load: float,
+                      parameters: Mapping[str, float], *, record: str = "record", duration: float = 2.0,
+                      solver_step: float | None = 1e-5) -> Conditions:
+    """Check the record and the model, keep the last ``duration`` s, and find the operating point.
+
+    Raises :class:`MeasurementError` for a record that is not 1-D, shorter than 0.25 s or not
+    finite, and :class:`ParameterError` for a model that is not ``GearTwin.Gearbox21`` or a
+    variant of it.
+    """
+    from twin.calibration.objectives import estimate_shaft_hz
+    from twin.errors import MeasurementError, ParameterError
+    from twin.fmu import FMU
+
+    measured = np.asarray(measured, float)
+    if measured.ndim != 1 or measured.size < int(0.25 * sample_rate):
+        raise MeasurementError("<array>", record, f"diagnosis needs a 1-D record of at least 0.25 s, got shape "
+                                                  f"{measured.shape} at {sample_rate} Hz")
+    if not np.all(np.isfinite(measured)):
+        raise MeasurementError("<array>", record, "the measured signal holds NaN or Inf values")
+    measured = measured[-int(round(min(duration, measured.size / sample_rate) * sample_rate)):]
+    with FMU(fmu_path) as fmu:
+        current = fmu.parameter_values()
+        z1_var = fmu.variables.get("z1")
+    missing = (["z1"] if z1_var is None else []) + [h for h in ("z2", "c_motor") if h not in current]
+    if missing:
+        raise ParameterError(f"{fmu_path} is not a GearTwin.Gearbox21 model (no parameter(s) "
+                             f"{', '.join(missing)}); the effect catalogue extends that model")
+    z1, z2 = int(round(float(z1_var.start))), int(round(current["z2"]))
+    c_motor = float(parameters.get("c_motor", current["c_motor"]))
+    shaft = estimate_shaft_hz(measured, sample_rate, nominal_speed, z1)
+    # the motor slips by the transmitted torque over the slope of its torque-slip line
+    drive_hz = shaft + load * z1 / z2 / c_motor / (2 * math.pi)
+    op = Operating(drive_hz, shaft, float(load), float(sample_rate),
+                   solver_step=solver_step if "solver.step_size" in current else None, teeth=z1)
+    return Conditions(measured, current, z1, z2, op)
+
+
 def diagnose(fmu_path, measured: np.ndarray, sample_rate: float, nominal_speed: float, load: float, *,
              parameters: Mapping[str, float] | None = None, channel: str = "accel_pinion_casing",
              effects: Sequence[str] | None = None, executor=None, record: str = "record",
@@ -356,40 +409,18 @@ def diagnose(fmu_path, measured: np.ndarray, sample_rate: float, nominal_speed: 
     effects : candidate ids (default: every catalogue effect the current model lacks).
     candidates_fmu : the built ``Gearbox21Candidates`` FMU (built on demand when None).
     """
-    from twin.calibration.objectives import estimate_shaft_hz
-    from twin.errors import MeasurementError, ParameterError
     from twin.executor import LocalExecutor
-    from twin.fmu import FMU
 
     t0 = time.perf_counter()
-    measured = np.asarray(measured, float)
-    if measured.ndim != 1 or measured.size < int(0.25 * sample_rate):
-        raise MeasurementError("<array>", record, f"diagnosis needs a 1-D record of at least 0.25 s, got shape "
-                                                  f"{measured.shape} at {sample_rate} Hz")
-    if not np.all(np.isfinite(measured)):
-        raise MeasurementError("<array>", record, "the measured signal holds NaN or Inf values")
-    measured = measured[-int(round(min(duration, measured.size / sample_rate) * sample_rate)):]
     parameters = dict(parameters or {})
-    with FMU(fmu_path) as fmu:
-        current = fmu.parameter_values()
-        z1_var = fmu.variables.get("z1")
-    missing_hooks = [h for h in ("z2", "c_motor") if h not in current]
-    if z1_var is None:
-        missing_hooks.insert(0, "z1")
-    if missing_hooks:
-        raise ParameterError(f"{fmu_path} is not a GearTwin.Gearbox21 model (no parameter(s) "
-                             f"{', '.join(missing_hooks)}); the effect catalogue extends that model")
+    cond = record_conditions(fmu_path, measured, sample_rate, nominal_speed, load, parameters, record=record,
+                             duration=duration, solver_step=solver_step)
+    measured, current, z1, z2, op = cond.measured, cond.current, cond.z1, cond.z2, cond.operating
+    shaft = op.shaft_hz
     active = active_effects(current)
     ids = [e for e in (effects or CATALOGUE) if e not in active]
     for e in ids:
         get_effect(e)
-    z1, z2 = int(round(float(z1_var.start))), int(round(current["z2"]))
-    c_motor = float(parameters.get("c_motor", current["c_motor"]))
-    shaft = estimate_shaft_hz(measured, sample_rate, nominal_speed, z1)
-    # the motor slips by the transmitted torque over the slope of its torque-slip line
-    drive_hz = shaft + load * z1 / z2 / c_motor / (2 * math.pi)
-    op = Operating(drive_hz, shaft, float(load), float(sample_rate),
-                   solver_step=solver_step if "solver.step_size" in current else None, teeth=z1)
     base_model = simulate(fmu_path, parameters, op, measured.size, channel)
     before = compare_signals(base_model, measured, sample_rate, shaft, z1=z1, z2=z2)
 
@@ -418,12 +449,15 @@ def diagnose(fmu_path, measured: np.ndarray, sample_rate: float, nominal_speed: 
         if isinstance(r, Exception):
             cands.append(Candidate(eff.id, eff.title, 0.0, before.lsd_db, {}, (), (), 0, str(r)))
             continue
-        fitted, lsd_after, n_eval = r
-        sim = simulate(candidates_fmu, {**probe, **fitted}, op, measured.size, channel)
+        fitted, _, n_eval, sim = r
+        if sim is None:
+            cands.append(Candidate(eff.id, eff.title, 0.0, before.lsd_db, fitted, (), (), n_eval,
+                                   "every trial of this effect failed to simulate"))
+            continue
         after = compare_signals(sim, measured, sample_rate, shaft, z1=z1, z2=z2)
         score = max(0.0, (before.lsd_db - after.lsd_db) / before.lsd_db) if before.lsd_db > 0 else 0.0
         cands.append(Candidate(eff.id, eff.title, score, after.lsd_db, fitted, _explained(before, after, eff),
-                               after.findings, n_eval + 1))
+                               after.findings, n_eval))
     cands.sort(key=lambda c: -c.score)
 
     best = cands[0] if cands else None

@@ -17,9 +17,9 @@ from pathlib import Path
 
 import numpy as np
 
-from twin.effects.catalogue import CATALOGUE, effect as get_effect
-from twin.effects.diagnose import (Diagnosis, Operating, TrialSpec, active_effects, diagnose, fit_effect,
-                                   simulate)
+from twin.effects.catalogue import effect as get_effect
+from twin.effects.diagnose import (Diagnosis, TrialSpec, active_effects, diagnose, fit_effect,
+                                   record_conditions, simulate)
 
 
 @dataclass(frozen=True)
@@ -106,35 +106,28 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
     from fmu_build import build_fmu
 
     from twin._atomic import atomic_path
-    from twin.calibration.objectives import estimate_shaft_hz
     from twin.compare import compare_signals
     from twin.effects.diagnose import _band_error, starting_values
-    from twin.effects.variant import _REPO_MODELICA, variant_source, write_variant
+    from twin.effects.variant import _REPO_MODELICA, modelica_root, variant_source, write_variant
     from twin.errors import ParameterError
-    from twin.fmu import FMU
 
     eff = get_effect(effect_id)
+    modelica_dir = modelica_root(modelica_dir)       # a bad directory fails before anything is written
     out = _out_dir(out_dir)
-    modelica_dir = Path(modelica_dir) if modelica_dir is not None else _REPO_MODELICA
     build_dir = Path(build_dir) if build_dir is not None else modelica_dir.parent / "build"
     channel = (scenario.outputs or ("accel_pinion_casing",))[0]
     rec = read_record(measurements, channel, record)
     current_fmu = scenario.fmu_path()
-    with FMU(current_fmu) as fmu:
-        current = fmu.parameter_values()
-        z1 = int(round(float(fmu.variables["z1"].start))) if "z1" in fmu.variables else 19
+    base_params = dict(scenario.parameters)
+    cond = record_conditions(current_fmu, rec.signal, rec.sample_rate, rec.nominal_speed, rec.load, base_params,
+                             record=rec.name, duration=duration)
+    measured, current, z1, z2, op = cond.measured, cond.current, cond.z1, cond.z2, cond.operating
+    shaft = op.shaft_hz
     active = active_effects(current)
     if effect_id in active:
         raise ParameterError(f"the model {scenario.fmu} already has {effect_id}")
     # carry the active effects' values into the new variant so it reproduces the current model
     values = {k: v for k, v in current.items() if any(k.startswith(a + ".") for a in active)}
-    measured = rec.signal[-int(round(min(duration, rec.signal.size / rec.sample_rate) * rec.sample_rate)):]
-    z2 = int(round(current.get("z2", 52)))
-    shaft = estimate_shaft_hz(measured, rec.sample_rate, rec.nominal_speed, z1)
-    c_motor = float(scenario.parameters.get("c_motor", current.get("c_motor", 3.0)))
-    op = Operating(shaft + rec.load * z1 / z2 / c_motor / (2 * np.pi), shaft, rec.load, rec.sample_rate,
-                   teeth=z1)
-    base_params = dict(scenario.parameters)
     sim0 = simulate(current_fmu, base_params, op, measured.size, channel)
     before = compare_signals(sim0, measured, rec.sample_rate, shaft, z1=z1, z2=z2)
 
@@ -149,7 +142,7 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
         guesses.update({k.split(".", 1)[1]: v for k, v in start.items() if k.startswith(effect_id + ".")})
     spec = TrialSpec(effect_id, str(fmu_path), channel, measured, op, {**base_params, **values, **neutral},
                      guesses, max_evals)
-    fitted, _, _ = fit_effect(spec)
+    fitted, _, _, _ = fit_effect(spec)
     # 3) write the variant again with the fitted values as its defaults, rebuild (cached by source)
     model, path = write_variant(variant_source(ids, {**values, **neutral, **fitted}), modelica_dir)
     fmu_path = build_fmu(model, modelica_dir, build_dir)

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -103,7 +104,7 @@ def _bounds(effect: str, name: str) -> tuple[float, float]:
     return -np.inf, np.inf
 
 
-def write_case(case: HiddenCase, path, name: str = "record") -> "Path":
+def write_case(case: HiddenCase, path, name: str = "record") -> Path:
     """Write the case as a one-record measurement file (HDF5, atomically); returns the path."""
     from twin.measurements import Record, write_measurements
     rec = Record(name, {"accel_pinion_casing": case.signal}, {"accel_pinion_casing": "m/s2"}, case.sample_rate,
