@@ -107,6 +107,37 @@ def stage_damage(draw: np.random.Generator, lo: float, hi: float, spec) -> float
     return float(draw.uniform(lo, hi))
 
 
+def nominal_operating_point(scenario: Scenario) -> tuple[float, float]:
+    """Drive speed [Hz] and brake load [N.m] at the scenario's start (20 Hz / 20 N.m if not given)."""
+    t0 = scenario.start_time
+    speed = scenario.inputs["motor_speed_ref"](t0) / (2 * math.pi) if "motor_speed_ref" in scenario.inputs else 20.0
+    load = scenario.inputs["load_torque"](t0) if "load_torque" in scenario.inputs else 20.0
+    return speed, load
+
+
+def check_stages_reached(damages: np.ndarray, bounds: list[float]) -> None:
+    """Raise :class:`SimulationError` if the degradation run stops short of the last stage boundary."""
+    if bounds[-1] > damages[-1] * (1 + 1e-9):
+        raise SimulationError(f"the degradation run reached {damages[-1]:.4g}, short of the last stage boundary "
+                              f"{bounds[-1]:.4g}; raise its stop criterion or max_updates")
+
+
+def simulate_records(tasks: list[RecordTask], scenario: Scenario, *, executor=None, progress: bool = True,
+                     what: str = "archive") -> list[dict]:
+    """Simulate record tasks on ``executor`` (default: the scenario's); raise if any failed."""
+    ex = executor or make_executor(scenario.executor)
+    try:
+        results = ex.map(simulate_record, tasks, progress=progress, desc=f"{scenario.name} {what}")
+    finally:
+        if executor is None:
+            ex.close()
+    failed = [(t.index, r) for t, r in zip(tasks, results) if isinstance(r, Exception)]
+    if failed:
+        i, err = failed[0]
+        raise SimulationError(f"{len(failed)} of {len(tasks)} {what} records failed; first (record {i}): {err}")
+    return results
+
+
 def build_archive(scenario: Scenario, output: str | Path | None = None, *, progress: bool = True,
                   fmu_path: Path | None = None, executor=None) -> Archive:
     """Build the archive described by ``scenario.archive`` (see the module docstring)."""
@@ -126,9 +157,7 @@ def build_archive(scenario: Scenario, output: str | Path | None = None, *, progr
         raise SimulationError("the damage measure decreased during the degradation run")
     params = [s.parameters for s in run.stages]
     bounds = [float(b) for b in spec["stages"]]
-    if bounds[-1] > damages[-1] * (1 + 1e-9):
-        raise SimulationError(f"the degradation run reached {damages[-1]:.4g}, short of the last stage boundary "
-                              f"{bounds[-1]:.4g}; raise its stop criterion or max_updates")
+    check_stages_reached(damages, bounds)
     per_stage = int(spec.get("records_per_stage", 50))
     duration = float(spec.get("record_duration", 0.2))
     settle = float(spec.get("settle_time", 0.05))
@@ -136,10 +165,7 @@ def build_archive(scenario: Scenario, output: str | Path | None = None, *, progr
     load_sd = float(spec.get("load_scatter", 0.0))
     noise = float(spec.get("noise", 0.0))
     channels = tuple(scenario.outputs or ("accel_pinion_casing",))
-    speed_input = next((n for n in scenario.inputs if n == "motor_speed_ref"), None)
-    load_input = next((n for n in scenario.inputs if n == "load_torque"), None)
-    nominal_speed = scenario.inputs[speed_input](scenario.start_time) / (2 * math.pi) if speed_input else 20.0
-    nominal_load = scenario.inputs[load_input](scenario.start_time) if load_input else 20.0
+    nominal_speed, nominal_load = nominal_operating_point(scenario)
 
     seq = np.random.SeedSequence(scenario.seed)
     draw = np.random.default_rng(seq.spawn(1)[0])
@@ -160,16 +186,7 @@ def build_archive(scenario: Scenario, output: str | Path | None = None, *, progr
             speeds.append(f)
             loads.append(t_load)
             k += 1
-    ex = executor or make_executor(scenario.executor)
-    try:
-        results = ex.map(simulate_record, tasks, progress=progress, desc=f"{scenario.name} archive")
-    finally:
-        if executor is None:
-            ex.close()
-    failed = [(t.index, r) for t, r in zip(tasks, results) if isinstance(r, Exception)]
-    if failed:
-        i, err = failed[0]
-        raise SimulationError(f"{len(failed)} of {len(tasks)} archive records failed; first (record {i}): {err}")
+    results = simulate_records(tasks, scenario, executor=executor, progress=progress)
     signals = {c: np.stack([r[c] for r in results]) for c in channels}
     kind = "pitting_density" if run.model == "pitting" else "wear_depth"
     archive = Archive(np.array(labels), np.array(dmg), np.array(speeds), np.array(loads), signals,

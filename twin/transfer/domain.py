@@ -48,7 +48,7 @@ from pathlib import Path
 
 import numpy as np
 
-from twin.errors import ParameterError, ScenarioError, SimulationError
+from twin.errors import ParameterError, ScenarioError
 
 __all__ = ["TargetShift", "make_target_domain", "resonator", "runout_offsets"]
 
@@ -150,8 +150,9 @@ def make_target_domain(source_scenario, output: str | Path, *, records_per_stage
         scenario's sample rate, attributes ``label`` (stage), ``damage``, ``nominal_speed``, ``load``
         (evaluation only), file metadata ``stages``, ``damage_kind``, ``target_shift`` (JSON).
     """
-    from twin.archive import RecordTask, interpolate_parameters, simulate_record, stage_damage
-    from twin.executor import make_executor
+    from twin.archive import (RecordTask, check_stages_reached, interpolate_parameters, nominal_operating_point,
+                              simulate_records, stage_damage)
+    from twin.fmu import FMU
     from twin.measurements import MeasurementSet, Record, write_measurements
     from twin.measurements.write import _check_h5_path
     from twin.operating import operating_point
@@ -173,20 +174,15 @@ def make_target_domain(source_scenario, output: str | Path, *, records_per_stage
     damages = run.damage
     params = [s.parameters for s in run.stages]
     bounds = [float(b) for b in spec["stages"]]
-    if bounds[-1] > damages[-1] * (1 + 1e-9):
-        raise SimulationError(f"the degradation run reached {damages[-1]:.4g}, short of the last stage "
-                              f"boundary {bounds[-1]:.4g}")
+    check_stages_reached(damages, bounds)
     settle = float(spec.get("settle_time", 0.05))
     sample_rate = float(source_scenario.sample_rate)
-    speed_input = "motor_speed_ref" if "motor_speed_ref" in source_scenario.inputs else None
-    load_input = "load_torque" if "load_torque" in source_scenario.inputs else None
-    t0 = source_scenario.start_time
-    nominal_speed = source_scenario.inputs[speed_input](t0) / (2 * math.pi) if speed_input else 20.0
-    nominal_load = source_scenario.inputs[load_input](t0) if load_input else 20.0
+    nominal_speed, nominal_load = nominal_operating_point(source_scenario)
+    with FMU(fmu_file) as fmu:
+        defaults = fmu.parameter_values()
     variant = {"sensor_angle_pinion": shift.sensor_angle}
     for k in ("kx6", "ky6"):
-        base = source_scenario.parameters.get(k, {"kx6": 3.0e7, "ky6": 5.0e7}[k])
-        variant[k] = base * shift.pedestal_stiffness_factor
+        variant[k] = source_scenario.parameters.get(k, defaults[k]) * shift.pedestal_stiffness_factor
 
     seq = np.random.SeedSequence(seed)
     draw = np.random.default_rng(seq.spawn(1)[0])
@@ -206,16 +202,7 @@ def make_target_domain(source_scenario, output: str | Path, *, records_per_stage
             tasks.append(RecordTask(k, str(fmu_file), p, inputs, settle, float(record_duration),
                                     source_scenario.output_interval, ("accel_pinion_casing",), 0.0, k))
             meta.append((s, d, f, t_load, gain))
-    ex = executor or make_executor(source_scenario.executor)
-    try:
-        results = ex.map(simulate_record, tasks, progress=progress, desc=f"{source_scenario.name} target domain")
-    finally:
-        if executor is None:
-            ex.close()
-    failed = [(t.index, r) for t, r in zip(tasks, results) if isinstance(r, Exception)]
-    if failed:
-        i, err = failed[0]
-        raise SimulationError(f"{len(failed)} of {len(tasks)} target records failed; first (record {i}): {err}")
+    results = simulate_records(tasks, source_scenario, executor=executor, progress=progress, what="target domain")
     noise_rng = np.random.default_rng(seq.spawn(2)[1])
     records = []
     for k, (res, (s, d, f, t_load, gain)) in enumerate(zip(results, meta)):
