@@ -195,6 +195,8 @@ class FMU:
     def _make_callbacks(self):
         from fmpy import calloc, free
         from fmpy.fmi2 import fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE, fmi2CallbackFunctions
+        for dead in [k for k, ref in _LOG_TARGETS.items() if ref() is None]:
+            del _LOG_TARGETS[dead]          # instances collected since the last registration
         key = next(_LOG_KEYS)
         _LOG_TARGETS[key] = weakref.WeakMethod(self._logger)
         cb = fmi2CallbackFunctions()

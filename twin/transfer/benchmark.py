@@ -88,7 +88,7 @@ def prepare_task(task: str, data_dir: str | Path, settings: DataSettings = DataS
 _DATA_CACHE: dict = {}
 
 
-def _load(task: str, src: str, tgt: str, sample_rate: float):
+def load_task_data(task: str, src: str, tgt: str, sample_rate: float):
     """Source records and the two halves of the target records, loaded once per process."""
     key = (task, src, tgt, sample_rate)
     if key not in _DATA_CACHE:
@@ -127,7 +127,7 @@ def train_one(task: str, method: str, seed: int, source: str, target: str, epoch
     from twin.transfer.report import confusion_matrix
 
     a = Assessor(method, epochs=epochs, seed=seed, progress=False)
-    s, adapt, test = _load(task, source, target, a._pre.sample_rate)
+    s, adapt, test = load_task_data(task, source, target, a._pre.sample_rate)
     a.fit(s, adapt, monitor=(test, None) if monitor else None)
     asm = a.assess(test)
     y = np.concatenate([[r.label] * len(r.window_stages) for r in asm.records])
