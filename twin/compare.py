@@ -270,6 +270,9 @@ def compare(scenario, measurements, out_dir, *, record: str | None = None, durat
     mset = load_measurements(measurements, channels=[channel], resample_to=scenario.sample_rate)
     for note in mset.notes:
         print(f"note: {note}")
+    if record and record not in mset.names:
+        from twin.errors import MeasurementError
+        raise MeasurementError(str(measurements), record, f"no such record; the file has: {', '.join(mset.names)}")
     rec = mset[record] if record else mset[0]
     if rec.nominal_speed is None or rec.load is None:
         raise ScenarioError([(str(measurements), f"records.{rec.name}",

@@ -36,6 +36,8 @@ def read_record(measurements, channel: str = "accel_pinion_casing", record: str 
     from twin.errors import MeasurementError
     from twin.measurements import load_measurements
     mset = load_measurements(measurements, channels=[channel])
+    if record and record not in mset.names:
+        raise MeasurementError(str(measurements), record, f"no such record; the file has: {', '.join(mset.names)}")
     rec = mset[record] if record else mset[0]
     missing = [a for a in ("nominal_speed", "load") if getattr(rec, a) is None]
     if missing:

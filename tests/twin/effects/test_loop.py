@@ -73,3 +73,19 @@ def test_diagnose_cli_reports_a_missing_measurement_attribute(tmp_path, gearbox_
     scen.write_text(yaml.safe_dump({"version": 1, "name": "s", "fmu": str(gearbox_fmu), "stop_time": 1.0}))
     assert main(["diagnose", str(scen), "--measurements", str(tmp_path / "m.h5")]) == 2
     assert "nominal_speed" in capsys.readouterr().err
+
+
+def test_unknown_record_name_is_a_typed_error_naming_the_records(tmp_path, gearbox_fmu, capsys):
+    import numpy as np
+    import yaml
+
+    from twin.cli import main
+    from twin.measurements import Record, write_measurements
+    write_measurements([Record("run1", {"accel_pinion_casing": np.zeros(20000)}, {"accel_pinion_casing": "m/s2"},
+                               20000.0, nominal_speed=20.0, load=20.0)], tmp_path / "m.h5")
+    scen = tmp_path / "s.yaml"
+    scen.write_text(yaml.safe_dump({"version": 1, "name": "s", "fmu": str(gearbox_fmu), "stop_time": 1.0}))
+    for command in (["diagnose"], ["compare", "--out", str(tmp_path / "c")]):
+        assert main([*command, str(scen), "--measurements", str(tmp_path / "m.h5"), "--record", "run9"]) == 2
+        err = capsys.readouterr().err
+        assert "run9" in err and "run1" in err
