@@ -39,14 +39,15 @@ from pathlib import Path
 import numpy as np
 
 from twin.transfer.errors import AssessorError
-from twin.transfer.preprocess import (Augmentation, Preprocessing, Prepared, augmented_windows, domain_scale, prepare,
-                                      windows_of)
+from twin.transfer.preprocess import (Augmentation, DomainNormaliser, Preprocessing, Prepared,
+                                      augmented_windows, domain_normaliser, prepare, windows_of)
 
 __all__ = ["Assessment", "Assessor", "METHODS", "RecordAssessment"]
 
 METHODS = ("cnn", "mmd", "proposed", "coral")
 SAVE_FORMAT = "gear-twin-assessor"
-SAVE_VERSION = 1
+SAVE_VERSION = 2
+_READABLE_VERSIONS = (1, 2)     # version 1: waveform only, one scale per domain
 _EVAL_BATCH = 256
 
 
@@ -145,8 +146,9 @@ class Assessor:
         ``gate`` (fraction of target windows whose pseudo-label passed), ``lr`` and, with
         ``monitor=``, ``monitor_acc``.
     n_source_windows_, n_target_windows_ : int
-    source_scale_, target_scale_ : float
-        The "domain" normalisation scales (1 for the other modes) [channel unit].
+    source_normaliser_, target_normaliser_ : DomainNormaliser
+        The per-domain part of the normalisation (identity unless ``normalise="domain"``): the
+        waveform scale [channel unit], or the mean log spectrum (window,) and the shared scale.
     fit_time_ : float
         Wall time of the training loop [s].
     """
@@ -317,17 +319,16 @@ class Assessor:
         tgt = self._prepared(target_unlabelled, None, "target")
         xt, _, _ = windows_of(tgt, pre, "target")
         xs_fixed, _, ys_fixed = windows_of(src, pre, "source")
-        # "domain" normalisation: one scale per domain, from its own (unlabelled) windows.
-        domain = pre.normalise == "domain"
-        self.source_scale_ = domain_scale(xs_fixed) if domain else 1.0
-        self.target_scale_ = domain_scale(xt) if domain else 1.0
-        xs_fixed = xs_fixed / np.float32(self.source_scale_)
-        xt = xt / np.float32(self.target_scale_)
+        # "domain" normalisation: one normaliser per domain, from its own (unlabelled) windows.
+        self.source_normaliser_ = domain_normaliser(xs_fixed, pre)
+        self.target_normaliser_ = domain_normaliser(xt, pre, reference=self.source_normaliser_)
+        xs_fixed = self.source_normaliser_(xs_fixed)
+        xt = self.target_normaliser_(xt)
         mon = None
         if monitor is not None:
             mdata, mlabels = monitor if isinstance(monitor, tuple) else (monitor, None)
             mx, _, my = windows_of(self._prepared(mdata, mlabels, "monitor"), pre, "monitor")
-            mon = (mx / np.float32(self.target_scale_), my)
+            mon = (self.target_normaliser_(mx), my)
 
         device = self._device()
         prev_threads = torch.get_num_threads()
@@ -353,7 +354,7 @@ class Assessor:
             for epoch in range(self.epochs):
                 if aug is not None:
                     xs, ys = augmented_windows(src, pre, aug, rng)
-                    xs = xs / np.float32(self.source_scale_)
+                    xs = self.source_normaliser_(xs)
                 else:
                     xs, ys = xs_fixed, ys_fixed
                 xs_t = torch.from_numpy(xs).unsqueeze(1).to(device)
@@ -462,8 +463,8 @@ class Assessor:
         is_array = isinstance(data, np.ndarray)
         prepared = self._prepared(data, None, what)
         x, rec, lab = windows_of(prepared, pre, what)
-        scale = self.target_scale_ if domain == "target" else self.source_scale_
-        return x / np.float32(scale), rec, lab, prepared, is_array
+        norm = self.target_normaliser_ if domain == "target" else self.source_normaliser_
+        return norm(x), rec, lab, prepared, is_array
 
     def transform(self, data, domain: str = "target") -> np.ndarray:
         """High-level features G(x) of every window, shape (n_windows, 300).
@@ -562,7 +563,8 @@ class Assessor:
                   "n_classes": self.n_classes_, "history": self.history_,
                   "n_source_windows": self.n_source_windows_, "n_target_windows": self.n_target_windows_,
                   "fit_time": getattr(self, "fit_time_", None),
-                  "source_scale": self.source_scale_, "target_scale": self.target_scale_}
+                  "source_normaliser": self.source_normaliser_.to_dict(),
+                  "target_normaliser": self.target_normaliser_.to_dict()}
         with atomic_path(d / "weights.pt") as tmp:
             torch.save({k: v.cpu() for k, v in self.network_.state_dict().items()}, tmp)
         with atomic_path(d / "config.json") as tmp:
@@ -591,14 +593,17 @@ class Assessor:
             cfg = json.loads(cfg_file.read_text())
         except (json.JSONDecodeError, UnicodeDecodeError) as exc:
             raise AssessorError(f"'{cfg_file}' is not valid JSON: {exc}") from None
-        if cfg.get("format") != SAVE_FORMAT or cfg.get("format_version") != SAVE_VERSION:
+        if cfg.get("format") != SAVE_FORMAT or cfg.get("format_version") not in _READABLE_VERSIONS:
             raise AssessorError(f"'{cfg_file}' has format {cfg.get('format')!r} version "
                                 f"{cfg.get('format_version')!r}; expected {SAVE_FORMAT!r} {SAVE_VERSION}")
         params = dict(cfg["params"])
         if device is not None:
             params["device"] = device
         aug = Augmentation(**cfg["augmentation"]) if cfg["augmentation"] else None
-        a = cls(**params, preprocessing=Preprocessing(**cfg["preprocessing"]), augmentation=aug)
+        version = cfg["format_version"]
+        # version 1 predates the log-spectrum representation: its networks were trained on waveforms
+        pre_cfg = {"representation": "waveform", **cfg["preprocessing"]} if version == 1 else cfg["preprocessing"]
+        a = cls(**params, preprocessing=Preprocessing(**pre_cfg), augmentation=aug)
         net = Network(int(cfg["n_classes"]), a._pre.window)
         try:
             state = torch.load(w_file, map_location="cpu", weights_only=True)
@@ -612,8 +617,12 @@ class Assessor:
         a.history_ = cfg["history"]
         a.n_source_windows_ = cfg["n_source_windows"]
         a.n_target_windows_ = cfg["n_target_windows"]
-        a.source_scale_ = float(cfg["source_scale"])
-        a.target_scale_ = float(cfg["target_scale"])
+        if version == 1:
+            a.source_normaliser_ = DomainNormaliser(0.0, float(cfg["source_scale"]))
+            a.target_normaliser_ = DomainNormaliser(0.0, float(cfg["target_scale"]))
+        else:
+            a.source_normaliser_ = DomainNormaliser.from_dict(cfg["source_normaliser"])
+            a.target_normaliser_ = DomainNormaliser.from_dict(cfg["target_normaliser"])
         if cfg.get("fit_time") is not None:
             a.fit_time_ = cfg["fit_time"]
         return a

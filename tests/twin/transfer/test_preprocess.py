@@ -7,7 +7,8 @@ import pytest
 from twin.errors import ParameterError
 from twin.transfer.domain import TargetShift, resonator, runout_offsets
 from twin.transfer.preprocess import (Augmentation, Preprocessing, apply_normalisation, augmented_windows,
-                                      domain_scale, prepare, split_records, window_signal, windows_of)
+                                      domain_normaliser, domain_scale, prepare, represent, split_records,
+                                      window_signal, windows_of)
 from twin.transfer.tsne import tsne
 
 from .conftest import make_records
@@ -31,11 +32,41 @@ def test_window_normalisation_cancels_gain_and_domain_keeps_relative_level():
     assert d[3:].std() == pytest.approx(4 * d[:3].std())       # ... the level between records stays
 
 
+def test_log_spectrum_cancels_gain_and_domain_centring_cancels_a_transfer_path():
+    """A rig that sees the same vibration through another linear path (a mount resonance and a
+    3x gain) gives, after the domain centring, nearly the features of the twin."""
+    from twin.transfer.domain import resonator
+    rng = np.random.default_rng(0)
+    fs, n = 20000.0, 256
+    t = np.arange(40 * n) / fs
+    # stages: the amplitude of a 2 kHz line relative to a 1 kHz one; broadband noise underneath
+    stage_amp = rng.choice([0.2, 0.6, 1.2], size=40)
+    x = np.concatenate([np.sin(2 * np.pi * 1000 * t[:n] + rng.uniform(0, 6)) +
+                        a * np.sin(2 * np.pi * 2000 * t[:n] + rng.uniform(0, 6)) for a in stage_amp])
+    x = x + rng.normal(0, 0.05, x.size)
+    y = 3.0 * resonator(x, fs, 3000.0, 5.0)
+    pre = Preprocessing(sample_rate=fs, window=n, hop=n)
+    ws, wt = window_signal(x, n, n)[1:], window_signal(y, n, n)[1:]     # skip the filter's transient
+    np.testing.assert_allclose(represent(7.0 * ws, pre), represent(ws, pre), atol=1e-9)   # gain cancels
+    fs_, ft = represent(ws, pre), represent(wt, pre)
+    src = domain_normaliser(fs_, pre)
+    tgt = domain_normaliser(ft, pre, reference=src)
+    assert tgt.scale == src.scale
+    gap_raw = np.abs(fs_ - ft).mean()
+    gap = np.abs(src(fs_) - tgt(ft)).mean() * src.scale             # in log units, like gap_raw
+    assert gap < 0.2 * gap_raw, (gap, gap_raw)
+    # ... while the stage information (the 2 kHz line) is still there
+    line = round(2000 / (fs / (2 * n)))
+    assert np.corrcoef(tgt(ft)[:, line], stage_amp[1:])[0, 1] > 0.9
+
+
 def test_preprocessing_validates():
     with pytest.raises(ParameterError, match="window"):
         Preprocessing(window=100)
     with pytest.raises(ParameterError, match="normalise"):
         Preprocessing(normalise="record")
+    with pytest.raises(ParameterError, match="representation.*'cepstrum'"):
+        Preprocessing(representation="cepstrum")
 
 
 def test_prepare_resamples_to_the_preprocessing_rate():
