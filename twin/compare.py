@@ -240,6 +240,45 @@ def compare_signals(model: np.ndarray, measured: np.ndarray, fs: float, shaft_hz
                       float(shaft_hz), tuple(findings), f, lp, lm)
 
 
+@dataclass(frozen=True)
+class MeasuredRecord:
+    """One measured record with the operating conditions it was taken at."""
+
+    name: str
+    signal: np.ndarray          # (n,) [channel unit, m/s2 for accelerations]
+    sample_rate: float          # Hz
+    nominal_speed: float        # drive setting [Hz]
+    load: float                 # brake load [N.m]
+
+
+def read_record(measurements, channel: str = "accel_pinion_casing", record: str | None = None, *,
+                resample_to: float | None = None) -> MeasuredRecord:
+    """One record of a measurement file (the first unless ``record`` names one).
+
+    ``resample_to`` [Hz] resamples it (the loader prints what it changed).
+
+    Raises
+    ------
+    MeasurementError
+        An unknown ``record`` (the message lists the file's records), or a record without the
+        ``nominal_speed`` [Hz] and ``load`` [N.m] it was taken at.
+    """
+    from twin.errors import MeasurementError
+    from twin.measurements import load_measurements
+    mset = load_measurements(measurements, channels=[channel], resample_to=resample_to)
+    for note in mset.notes:
+        print(f"note: {note}")
+    if record and record not in mset.names:
+        raise MeasurementError(str(measurements), record, f"no such record; the file has: {', '.join(mset.names)}")
+    rec = mset[record] if record else mset[0]
+    missing = [a for a in ("nominal_speed", "load") if getattr(rec, a) is None]
+    if missing:
+        raise MeasurementError(str(measurements), rec.name, f"lacks {', '.join(missing)} (the drive speed [Hz] "
+                                                            "and brake load [N.m] the record was taken at)")
+    return MeasuredRecord(rec.name, np.asarray(rec[channel], float), float(rec.sample_rate),
+                          float(rec.nominal_speed), float(rec.load))
+
+
 def compare(scenario, measurements, out_dir, *, record: str | None = None, duration: float | None = None,
             settle: float = 0.1):
     """``twin compare``: simulate under the measured conditions and write the comparison.
@@ -256,9 +295,8 @@ def compare(scenario, measurements, out_dir, *, record: str | None = None, durat
     from pathlib import Path
 
     from twin.calibration.objectives import estimate_shaft_hz
-    from twin.errors import OutputPathError, ScenarioError
+    from twin.errors import OutputPathError
     from twin.fmu import FMU
-    from twin.measurements import load_measurements
     from twin.operating import operating_point
     from twin.results import SimulationResult, write_hdf5
 
@@ -267,17 +305,8 @@ def compare(scenario, measurements, out_dir, *, record: str | None = None, durat
         raise OutputPathError(f"parent directory {out_dir.parent} does not exist")
     out_dir.mkdir(exist_ok=True)
     channel = (scenario.outputs or ("accel_pinion_casing",))[0]
-    mset = load_measurements(measurements, channels=[channel], resample_to=scenario.sample_rate)
-    for note in mset.notes:
-        print(f"note: {note}")
-    if record and record not in mset.names:
-        from twin.errors import MeasurementError
-        raise MeasurementError(str(measurements), record, f"no such record; the file has: {', '.join(mset.names)}")
-    rec = mset[record] if record else mset[0]
-    if rec.nominal_speed is None or rec.load is None:
-        raise ScenarioError([(str(measurements), f"records.{rec.name}",
-                              "comparison needs the record attributes nominal_speed [Hz] and load [N.m]")])
-    measured = np.asarray(rec[channel], float)
+    rec = read_record(measurements, channel, record, resample_to=scenario.sample_rate)
+    measured = rec.signal
     if duration is not None:
         measured = measured[-int(round(duration * rec.sample_rate)):]
     dur = measured.size / rec.sample_rate

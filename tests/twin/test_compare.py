@@ -68,3 +68,17 @@ def test_cli_writes_json_html_and_signals(gearbox_fmu, base, tmp_path):
     assert data["headline"]["log_spectral_distance_db"] > 1.0
     for name in ("compare.html", "compare.png", "simulated.h5"):
         assert (tmp_path / "rep" / name).exists()
+
+
+def test_record_without_load_is_a_measurement_error_naming_it(gearbox_fmu, tmp_path):
+    from twin.compare import compare
+    from twin.errors import MeasurementError
+    from twin.scenario import load_scenario
+    x = np.random.default_rng(0).normal(size=20000)
+    write_measurements([Record("r1", {"accel_pinion_casing": x}, {"accel_pinion_casing": "m/s2"}, 1e5,
+                               nominal_speed=20.0)], tmp_path / "m.h5")
+    (tmp_path / "s.yaml").write_text(f"version: 1\nname: cmp\nfmu: {gearbox_fmu}\nstop_time: 1.0\n"
+                                     "output: {variables: [accel_pinion_casing]}\n")
+    with pytest.raises(MeasurementError, match="r1.*lacks load"):
+        compare(load_scenario(tmp_path / "s.yaml"), tmp_path / "m.h5", tmp_path / "rep")
+    assert not (tmp_path / "rep" / "compare.json").exists()

@@ -17,34 +17,10 @@ from pathlib import Path
 
 import numpy as np
 
+from twin.compare import MeasuredRecord, read_record  # noqa: F401  (part of this module's API)
 from twin.effects.catalogue import effect as get_effect
 from twin.effects.diagnose import (Diagnosis, TrialSpec, active_effects, diagnose, fit_effect,
                                    record_conditions, simulate)
-
-
-@dataclass(frozen=True)
-class MeasuredRecord:
-    name: str
-    signal: np.ndarray          # (n,) [m/s2]
-    sample_rate: float
-    nominal_speed: float
-    load: float
-
-
-def read_record(measurements, channel: str = "accel_pinion_casing", record: str | None = None) -> MeasuredRecord:
-    """One record of a measurement file, with the attributes the loop needs."""
-    from twin.errors import MeasurementError
-    from twin.measurements import load_measurements
-    mset = load_measurements(measurements, channels=[channel])
-    if record and record not in mset.names:
-        raise MeasurementError(str(measurements), record, f"no such record; the file has: {', '.join(mset.names)}")
-    rec = mset[record] if record else mset[0]
-    missing = [a for a in ("nominal_speed", "load") if getattr(rec, a) is None]
-    if missing:
-        raise MeasurementError(str(measurements), rec.name, f"lacks {', '.join(missing)} (the drive speed [Hz] "
-                                                            "and brake load [N.m] the record was taken at)")
-    return MeasuredRecord(rec.name, np.asarray(rec[channel], float), float(rec.sample_rate),
-                          float(rec.nominal_speed), float(rec.load))
 
 
 def _write_json(path: Path, data: dict) -> None:
