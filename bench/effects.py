@@ -46,18 +46,19 @@ def main() -> None:
                 params = calibrate_base(case, base)
                 t0 = time.perf_counter()
                 d = diagnose(base, case.signal, case.sample_rate, case.nominal_speed, case.load, parameters=params,
-                             candidates_fmu=cand, executor=ex, duration=2.0)
+                             candidates_fmu=cand, executor=ex, duration=case.duration)
                 wall = time.perf_counter() - t0
                 top = d.candidates[0]
                 rows.append({"effect": eff or "none", "seed": seed, "verdict": d.verdict, "missing": d.missing,
                              "top": top.effect, "lsd_before": d.lsd_db, "lsd_after_top": top.lsd_after_db,
-                             "score_top": top.score, "unexplained": list(d.unexplained), "wall_s": wall})
+                             "score_top": top.score, "unexplained": list(d.unexplained), "wall_s": wall,
+                             "load_nm": case.load, "record_s": case.duration})
                 print(json.dumps(rows[-1]), flush=True)
     (args.out.with_suffix(".json")).write_text(json.dumps(rows, indent=1))
     lines = [f"Machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
-             f"{args.workers} workers; {args.seeds} seeds per case; records 2 s at 20 kHz.", "",
-             "| hidden effect | top-1 correct | verdict (per seed) | LSD before [dB] | LSD after adding the top candidate [dB] | reduction | diagnose wall time [s] |",
-             "|---|---|---|---|---|---|---|"]
+             f"{args.workers} workers; {args.seeds} seeds per case; records at 20 kHz.", "",
+             "| hidden effect | record | top-1 correct | verdict (per seed) | LSD before [dB] | LSD after adding the top candidate [dB] | reduction | diagnose wall time [s] |",
+             "|---|---|---|---|---|---|---|---|"]
     for eff in cases:
         name = eff or "none"
         rs = [r for r in rows if r["effect"] == name]
@@ -68,7 +69,7 @@ def main() -> None:
         else:
             ok = sum(r["verdict"] == "unexplained" for r in rs)
         red = [100 * (r["lsd_before"] - r["lsd_after_top"]) / r["lsd_before"] for r in rs]
-        lines.append(f"| {name} | {ok}/{len(rs)} | {', '.join(r['verdict'] if r['verdict'] != 'missing_effect' else r['missing'] for r in rs)} "
+        lines.append(f"| {name} | {rs[0]['record_s']:g} s, {rs[0]['load_nm']:g} N.m | {ok}/{len(rs)} | {', '.join(r['verdict'] if r['verdict'] != 'missing_effect' else r['missing'] for r in rs)} "
                      f"| {np.mean([r['lsd_before'] for r in rs]):.2f} | {np.mean([r['lsd_after_top'] for r in rs]):.2f} "
                      f"| {np.mean(red):.0f} % | {np.mean([r['wall_s'] for r in rs]):.0f} (max {max(r['wall_s'] for r in rs):.0f}) |")
     args.out.write_text("\n".join(lines) + "\n")

@@ -30,6 +30,7 @@ model Gearbox21 "21-DOF lumped model of the UNSW spur-gear test rig (Feng et al.
   parameter Integer tooth_next[z1] = {if j == z1 then 1 else j + 1 for j in 1:z1} "Index of the tooth behind tooth j (structural)";
   parameter Real mesh_stiffness_scale = 1.0 "Calibration multiplier of all pair stiffnesses";
   parameter Real c_mesh(unit = "N.s/m") = 1.1e3 "Mesh damping along the line of action";
+  parameter Real contact_damping_width(unit = "m") = 1e-8 "Approach over which the mesh damping engages when the flanks touch";
   parameter Real mesh_phase0(unit = "rad") = 0.0 "Mesh phase at theta5 = 0";
   parameter Real contact_smoothing = 0.01 "Half-width of the entry/exit ramp of a tooth pair, as a fraction of the path of contact";
 
@@ -175,6 +176,7 @@ model Gearbox21 "21-DOF lumped model of the UNSW spur-gear test rig (Feng et al.
   Real mesh_deflection(unit = "m") "Approach of the flanks along the line of action";
   Real mesh_deflection_rate(unit = "m/s") "Time derivative of mesh_deflection";
   output Real mesh_force(unit = "N") "Dynamic mesh force along the line of action";
+  Real mesh_contact "Share of the mesh damping that acts: 1 while a pair of flanks touches, 0 while they are apart";
   output Real mesh_stiffness(unit = "N/m") "Instantaneous mesh stiffness (sum over pairs in contact)";
   output Real accel_pinion_casing(unit = "m/s2") "Casing acceleration at the B&K 4396 (near the pinion)";
   output Real accel_gear_casing(unit = "m/s2") "Casing acceleration at the B&K 4394 (near the gear)";
@@ -186,9 +188,13 @@ model Gearbox21 "21-DOF lumped model of the UNSW spur-gear test rig (Feng et al.
   Real casing_acceleration_pinion(unit = "m/s2") "Acceleration of pedestal 6 along the pinion sensor axis";
 
   // ---- Effect hooks ----------------------------------------------------------------------------
-  // Zero in this model. A variant written by `twin add-effect` (or by hand, see
+  // Neutral in this model (zero; one for the stiffness multiplier). A variant written by
+  // `twin add-effect` (or by hand, see
   // GearTwin/Effects/README.md) extends this model and binds a hook to the output of an effect
   // component from GearTwin.Effects, e.g. extends Gearbox21(effect_drive_torque = ripple.torque).
+  parameter Real effect_tooth_stiffness_factor[z1] = {1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1} "Per-pinion-tooth stiffness multiplier from an effect (local tooth damage); multiplies tooth_stiffness_factor";
+  parameter Real effect_tooth_offset[z1](each unit = "m") = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0} "Per-pinion-tooth material loss from an effect (spall); added to tooth_deviation_offset";
+  parameter Real effect_profile_deviation[n_profile](each unit = "m") = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0} "Material missing along the profile from an effect (distributed wear); added to profile_deviation";
   Real effect_mesh_displacement(unit = "m") = 0 "Extra approach of the flanks along the line of action (run-out)";
   Real effect_mesh_displacement_rate(unit = "m/s") = 0 "Time derivative of effect_mesh_displacement";
   Real effect_mesh_force(unit = "N") = 0 "Extra force along the line of action (back-flank contact)";
@@ -209,16 +215,19 @@ equation
   // Nearest-tooth selection on the unit circle (hat of radius half a chord around each tooth);
   // the leading and next pairs use the same weights on the cyclically shifted tooth arrays.
   tooth_weight = {noEvent(max(0.0, 1 - ((cos(tooth_angle) - cos(2 * GearTwin.pi * (j - 1) / z1)) ^ 2 + (sin(tooth_angle) - sin(2 * GearTwin.pi * (j - 1) / z1)) ^ 2) / sin(GearTwin.pi / z1) ^ 2)) for j in 1:z1};
-  pair_tooth_factor = {sum(tooth_stiffness_factor[tooth_prev[j]] * tooth_weight[j] for j in 1:z1), sum(tooth_stiffness_factor[j] * tooth_weight[j] for j in 1:z1), sum(tooth_stiffness_factor[tooth_next[j]] * tooth_weight[j] for j in 1:z1)};
-  pair_tooth_offset = {sum(tooth_deviation_offset[tooth_prev[j]] * tooth_weight[j] for j in 1:z1), sum(tooth_deviation_offset[j] * tooth_weight[j] for j in 1:z1), sum(tooth_deviation_offset[tooth_next[j]] * tooth_weight[j] for j in 1:z1)};
+  pair_tooth_factor = {sum(tooth_stiffness_factor[tooth_prev[j]] * effect_tooth_stiffness_factor[tooth_prev[j]] * tooth_weight[j] for j in 1:z1), sum(tooth_stiffness_factor[j] * effect_tooth_stiffness_factor[j] * tooth_weight[j] for j in 1:z1), sum(tooth_stiffness_factor[tooth_next[j]] * effect_tooth_stiffness_factor[tooth_next[j]] * tooth_weight[j] for j in 1:z1)};
+  pair_tooth_offset = {sum((tooth_deviation_offset[tooth_prev[j]] + effect_tooth_offset[tooth_prev[j]]) * tooth_weight[j] for j in 1:z1), sum((tooth_deviation_offset[j] + effect_tooth_offset[j]) * tooth_weight[j] for j in 1:z1), sum((tooth_deviation_offset[tooth_next[j]] + effect_tooth_offset[tooth_next[j]]) * tooth_weight[j] for j in 1:z1)};
   // Piecewise-linear interpolation along the profile: hat functions on n_profile nodes.
   pair_stiffness = {mesh_stiffness_scale * window[i] * pair_tooth_factor[i] * sum(k_pair[n] * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[i]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile) for i in 1:3};
-  pair_deviation = {pair_tooth_offset[i] + sum(profile_deviation[n] * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[i]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile) for i in 1:3};
+  pair_deviation = {pair_tooth_offset[i] + sum((profile_deviation[n] + effect_profile_deviation[n]) * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[i]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile) for i in 1:3};
   mesh_deflection = rb1 * theta5 - rb2 * theta10 + (x5 - x10) * sin(alpha) + (y5 - y10) * cos(alpha) + effect_mesh_displacement;
   mesh_deflection_rate = rb1 * omega5 - rb2 * omega10 + (vx5 - vx10) * sin(alpha) + (vy5 - vy10) * cos(alpha) + effect_mesh_displacement_rate;
   // A pair whose flanks are apart (deviation larger than the approach) carries no load.
   pair_force = {pair_stiffness[i] * noEvent(max(0.0, mesh_deflection - pair_deviation[i])) for i in 1:3};
-  mesh_force = pair_force[1] + pair_force[2] + pair_force[3] + c_mesh * mesh_deflection_rate + effect_mesh_force;
+  // The flanks damp each other only while they touch (oil film, material damping); apart, the
+  // gears fly freely across the clearance.
+  mesh_contact = noEvent(min(1.0, sum(window[i] * noEvent(min(1.0, max(0.0, (mesh_deflection - pair_deviation[i]) / contact_damping_width))) for i in 1:3)));
+  mesh_force = pair_force[1] + pair_force[2] + pair_force[3] + mesh_contact * c_mesh * mesh_deflection_rate + effect_mesh_force;
   mesh_stiffness = pair_stiffness[1] + pair_stiffness[2] + pair_stiffness[3];
   transmission_error = rb1 * theta5 - rb2 * theta10;
   motor_torque = drive_torque + c_motor * (motor_speed_ref - omega1) + effect_drive_torque;

@@ -6,7 +6,10 @@ of ``GearTwin.Gearbox21`` wires it in:
 * ``inputs``: modifiers that feed the component from the gearbox (``shaft_angle = theta5``);
 * ``hooks``: which effect hook of the base model each component output adds to
   (``effect_drive_torque`` += ``<id>.torque``); several effects on one hook are summed;
-* ``base_bindings``: base parameters the component takes over (``tooth_stiffness_factor``).
+* ``base_bindings``: parameter hooks of the base model the component binds
+  (``effect_tooth_stiffness_factor = <id>.tooth_factor``).  They compose with the base model's
+  own degradation parameters (``tooth_stiffness_factor``, ``profile_deviation``), so a variant
+  still takes the degradation state a scenario or a degradation run gives it.
 
 ``fit`` lists the component parameters :func:`twin.effects.diagnose` refits, with bounds and
 whether they are searched on a log scale; ``neutral`` holds values that switch the effect off, so
@@ -104,7 +107,7 @@ CATALOGUE: dict[str, Effect] = {e.id: e for e in (
                      "sideband": "sidebands inside the band of the mode are amplified"}),
     Effect("local_tooth_damage", "GearTwin.Effects.LocalToothDamage", "Local damage of one pinion tooth",
            inputs={"z1": "z1"},
-           base_bindings={"tooth_stiffness_factor": "tooth_factor", "tooth_deviation_offset": "tooth_offset"},
+           base_bindings={"effect_tooth_stiffness_factor": "tooth_factor", "effect_tooth_offset": "tooth_offset"},
            fit=(FitParameter("stiffness_loss", 0.0, 0.9),),
            neutral={"stiffness_loss": 0.0, "material_loss": 0.0},
            evidence={"impulsive": "a weak tooth gives one short change of mesh stiffness per pinion revolution, "
@@ -131,7 +134,7 @@ CATALOGUE: dict[str, Effect] = {e.id: e for e in (
                      "resonance": "the off-line force excites modes the line-of-action force does not"}),
     Effect("distributed_wear", "GearTwin.Effects.DistributedWear", "Distributed wear of all pinion teeth",
            inputs={"n_profile": "n_profile", "roll_pitch": "roll_pitch"},
-           base_bindings={"profile_deviation": "deviation"},
+           base_bindings={"effect_profile_deviation": "deviation"},
            fit=(FitParameter("wear_depth", 1e-8, 3e-5, log=True),),
            neutral={"wear_depth": 0.0},
            evidence={"mesh_harmonic": "wear removes material away from the pitch point on every tooth, which "

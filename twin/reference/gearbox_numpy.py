@@ -65,7 +65,8 @@ DEFAULT_INPUTS: dict[str, float] = {
     "load_torque": 20.0,              # N.m
 }
 
-_ARRAY_FIELDS = ("k_pair", "profile_deviation", "tooth_stiffness_factor", "tooth_deviation_offset")
+_ARRAY_FIELDS = ("k_pair", "profile_deviation", "tooth_stiffness_factor", "tooth_deviation_offset",
+                 "effect_tooth_stiffness_factor", "effect_tooth_offset", "effect_profile_deviation")
 
 
 @dataclass(frozen=True)
@@ -94,8 +95,13 @@ class GearboxParams:
     profile_deviation: tuple[float, ...] = (0.0,) * 11                          # m
     tooth_stiffness_factor: tuple[float, ...] = (1.0,) * 19                     # -
     tooth_deviation_offset: tuple[float, ...] = (0.0,) * 19                     # m
+    # parameter hooks of the effect catalogue (neutral here; they compose with the three above)
+    effect_tooth_stiffness_factor: tuple[float, ...] = (1.0,) * 19              # -
+    effect_tooth_offset: tuple[float, ...] = (0.0,) * 19                        # m
+    effect_profile_deviation: tuple[float, ...] = (0.0,) * 11                   # m
     mesh_stiffness_scale: float = 1.0
     c_mesh: float = 1.1e3                # N.s/m, along the line of action
+    contact_damping_width: float = 1e-8  # m, approach over which the mesh damping engages
     mesh_phase0: float = 0.0             # rad, mesh phase at theta5 = 0
     contact_smoothing: float = 0.01      # fraction of the path of contact
     # ---- inertias [kg.m2] and masses [kg]
@@ -173,11 +179,12 @@ class GearboxParams:
         for name in _ARRAY_FIELDS:
             value = tuple(float(v) for v in np.asarray(getattr(self, name), dtype=float).ravel())
             object.__setattr__(self, name, value)
-        for name in ("k_pair", "profile_deviation"):
+        for name in ("k_pair", "profile_deviation", "effect_profile_deviation"):
             if len(getattr(self, name)) != self.n_profile:
                 raise ValueError(f"{name} needs n_profile={self.n_profile} entries, "
                                  f"got {len(getattr(self, name))}")
-        for name in ("tooth_stiffness_factor", "tooth_deviation_offset"):
+        for name in ("tooth_stiffness_factor", "tooth_deviation_offset", "effect_tooth_stiffness_factor",
+                     "effect_tooth_offset"):
             if len(getattr(self, name)) != self.z1:
                 raise ValueError(f"{name} needs z1={self.z1} entries, got {len(getattr(self, name))}")
         if self.n_profile < 2:
@@ -285,10 +292,10 @@ class _Constants:
         self.sin_a = math.sin(p.alpha)
         self.cos_a = math.cos(p.alpha)
         self.k_pair = p.mesh_stiffness_scale * np.asarray(p.k_pair)          # (n_profile,)
-        self.profile_deviation = np.asarray(p.profile_deviation)              # (n_profile,)
+        self.profile_deviation = np.asarray(p.profile_deviation) + np.asarray(p.effect_profile_deviation)
         self.node_index = np.arange(p.n_profile, dtype=float)                # (n_profile,)
-        self.tooth_factor = np.asarray(p.tooth_stiffness_factor)             # (z1,)
-        self.tooth_offset = np.asarray(p.tooth_deviation_offset)             # (z1,)
+        self.tooth_factor = np.asarray(p.tooth_stiffness_factor) * np.asarray(p.effect_tooth_stiffness_factor)
+        self.tooth_offset = np.asarray(p.tooth_deviation_offset) + np.asarray(p.effect_tooth_offset)
         tooth_node = 2 * PI * np.arange(p.z1) / p.z1
         self.tooth_node_cos = np.cos(tooth_node)                              # (z1,)
         self.tooth_node_sin = np.sin(tooth_node)                              # (z1,)
@@ -389,11 +396,13 @@ def _mesh(c: _Constants, x: np.ndarray) -> dict[str, np.ndarray]:
                        + (x[_I["vy5"]] - x[_I["vy10"]]) * c.cos_a)
     # A pair whose flanks are apart (deviation larger than the approach) carries no load.
     pair_force = pair_stiffness * np.maximum(0.0, deflection - pair_deviation)
-    force = pair_force.sum(axis=0) + p.c_mesh * deflection_rate
+    # The flanks damp each other only while they touch; apart, the gears fly across the clearance.
+    contact = np.minimum(1.0, (window * _clip01((deflection - pair_deviation) / p.contact_damping_width)).sum(axis=0))
+    force = pair_force.sum(axis=0) + contact * p.c_mesh * deflection_rate
     return {
         "cycle_fraction": cycle, "roll": roll, "window": window, "pair_stiffness": pair_stiffness,
         "pair_deviation": pair_deviation, "pair_force": pair_force, "mesh_deflection": deflection,
-        "mesh_deflection_rate": deflection_rate, "mesh_force": force,
+        "mesh_deflection_rate": deflection_rate, "mesh_force": force, "mesh_contact": contact,
         "mesh_stiffness": pair_stiffness.sum(axis=0),
     }
 

@@ -10,9 +10,9 @@ model Gearbox21Candidates "GearTwin.Gearbox21 with every catalogue effect, switc
     effect_pinion_torque = tooth_friction.pinion_torque,
     effect_gear_torque = tooth_friction.gear_torque,
     effect_off_line_force = tooth_friction.off_line_force,
-    tooth_stiffness_factor = local_tooth_damage.tooth_factor,
-    tooth_deviation_offset = local_tooth_damage.tooth_offset,
-    profile_deviation = distributed_wear.deviation);
+    effect_tooth_stiffness_factor = local_tooth_damage.tooth_factor,
+    effect_tooth_offset = local_tooth_damage.tooth_offset,
+    effect_profile_deviation = distributed_wear.deviation);
   GearTwin.Effects.ShaftEccentricity pinion_eccentricity(
     shaft_angle = theta5,
     shaft_speed = omega5,

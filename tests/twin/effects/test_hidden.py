@@ -12,14 +12,14 @@ from twin.effects.diagnose import diagnose
 from twin.effects.synthetic import OUT_OF_CATALOGUE_HZ, calibrate_base, make_case
 
 OBSERVABLE = ["pinion_eccentricity", "gear_eccentricity", "motor_torque_ripple", "load_torque_fluctuation",
-              "housing_mode", "local_tooth_damage", "tooth_friction", "distributed_wear"]
+              "housing_mode", "local_tooth_damage", "backlash", "tooth_friction", "distributed_wear"]
 
 
-def _diagnose(effect, gearbox_fmu, candidates_fmu, executor, seed=0):
-    case = make_case(effect, seed, candidates_fmu=candidates_fmu)
+def _diagnose(effect, gearbox_fmu, candidates_fmu, executor, seed=0, **conditions):
+    case = make_case(effect, seed, candidates_fmu=candidates_fmu, **conditions)
     params = calibrate_base(case, gearbox_fmu)
     return diagnose(gearbox_fmu, case.signal, case.sample_rate, case.nominal_speed, case.load, parameters=params,
-                    candidates_fmu=candidates_fmu, executor=executor)
+                    candidates_fmu=candidates_fmu, executor=executor, duration=case.duration)
 
 
 @pytest.mark.slow
@@ -50,9 +50,9 @@ def test_effect_outside_the_catalogue_is_reported_unexplained(gearbox_fmu, candi
 
 @pytest.mark.slow
 def test_backlash_that_never_acts_is_not_blamed_on_another_effect(gearbox_fmu, candidates_fmu, executor):
-    """Backlash only acts when the flanks separate. In steady running at 20 N.m the dynamic mesh
-    force stays within about +-35 % of its mean, so a hidden backlash leaves no trace; the
-    diagnosis must then not invent a different effect."""
-    d = _diagnose("backlash", gearbox_fmu, candidates_fmu, executor)
-    assert d.verdict == "nothing_missing", d.table()
-
+    """Backlash only acts when the flanks separate. At the rig's test load (20 N.m) the worn
+    flanks stay close enough that a 10 um clearance is never crossed, and the hidden backlash
+    leaves no trace (its light-load case above is where it shows); the diagnosis must then not
+    invent a different effect."""
+    d = _diagnose("backlash", gearbox_fmu, candidates_fmu, executor, load=20.0, duration=2.0)
+    assert d.missing in (None, "backlash"), d.table()
