@@ -12,7 +12,9 @@ of ``GearTwin.Gearbox21`` wires it in:
   still takes the degradation state a scenario or a degradation run gives it.
 
 ``fit`` lists the component parameters :func:`twin.effects.diagnose` refits, with bounds and
-whether they are searched on a log scale; ``neutral`` holds values that switch the effect off, so
+whether they are searched on a log scale; ``related`` names the base parameters whose value
+shapes the same signature, refitted with the effect within +-:data:`RELATED_SPAN` of their
+calibrated values (the leading candidates of a diagnosis, and ``twin add-effect``); ``neutral`` holds values that switch the effect off, so
 one candidate model carrying every effect reproduces the base model exactly.
 ``evidence`` maps finding kinds (see :mod:`twin.compare`) to the physical reason the effect
 explains them.
@@ -44,8 +46,9 @@ class Effect:
     title: str
     inputs: dict[str, str] = field(default_factory=dict)
     hooks: dict[str, str] = field(default_factory=dict)          # base hook -> component output
-    base_bindings: dict[str, str] = field(default_factory=dict)  # base parameter -> component parameter
+    base_bindings: dict[str, str] = field(default_factory=dict)  # parameter hook -> component parameter
     fit: tuple[FitParameter, ...] = ()
+    related: tuple[str, ...] = ()                               # base parameters refitted with it
     neutral: dict[str, float] = field(default_factory=dict)
     evidence: dict[str, str] = field(default_factory=dict)       # finding kind -> physical reason
 
@@ -53,6 +56,9 @@ class Effect:
         """FMU name of a component parameter, e.g. ``pinion_eccentricity.eccentricity``."""
         return f"{self.id}.{name}"
 
+
+#: Relative band [-] in which a related base parameter moves around its calibrated value.
+RELATED_SPAN = 0.1
 
 _GEOMETRY = {"roll_pitch": "roll_pitch", "contact_start_radius": "contact_start_radius",
              "contact_path_length": "contact_path_length", "line_of_action_length": "line_of_action_length"}
@@ -66,6 +72,8 @@ def _eccentricity(gear: str) -> Effect:
         hooks={"effect_mesh_displacement": "mesh_displacement",
                "effect_mesh_displacement_rate": "mesh_displacement_rate"},
         fit=(FitParameter("eccentricity", 2e-7, 2e-4, log=True),),
+        # the mesh force of a run-out approach scales with the mesh stiffness
+        related=("mesh_stiffness_scale",),
         neutral={"eccentricity": 0.0},
         evidence={"sideband": f"run-out of the {gear} modulates the mesh approach once per {gear} revolution, "
                               f"which puts sidebands at {gear}-speed spacing around the mesh harmonics",
@@ -81,6 +89,7 @@ CATALOGUE: dict[str, Effect] = {e.id: e for e in (
            hooks={"effect_drive_torque": "torque"},
            fit=(FitParameter("frequency", 20.0, 400.0, guess="unlocked_line"),
                 FitParameter("amplitude", 1e-3, 2.0, log=True)),
+           related=("kt35",),              # the input coupling carries the ripple to the pinion
            neutral={"amplitude": 0.0},
            evidence={"unlocked_line": "an electrical torque ripple vibrates the drive train at its own frequency, "
                                       "which is locked to neither shaft",
@@ -89,6 +98,7 @@ CATALOGUE: dict[str, Effect] = {e.id: e for e in (
            hooks={"effect_load_torque": "torque"},
            fit=(FitParameter("frequency", 0.5, 15.0, guess="slow_sideband"),
                 FitParameter("amplitude", 1e-2, 10.0, log=True)),
+           related=("c_motor",),           # the motor's torque-slip slope sets the slow speed response
            neutral={"amplitude": 0.0},
            evidence={"unlocked_line": "a slow load fluctuation modulates the mesh force and the speed, giving "
                                       "lines beside the mesh harmonics at a spacing locked to no shaft",
@@ -100,6 +110,7 @@ CATALOGUE: dict[str, Effect] = {e.id: e for e in (
            fit=(FitParameter("frequency", 300.0, 4800.0, guess="resonance"),
                 FitParameter("participation", 0.02, 3.0, log=True),
                 FitParameter("damping_ratio", 0.005, 0.1, log=True)),
+           related=("ky6",),               # the pedestal sets the casing motion the mode filters
            neutral={"participation": 0.0},
            evidence={"resonance": "a structural mode in the path to the sensor amplifies a band of frequencies "
                                   "whatever excites it",
@@ -109,6 +120,7 @@ CATALOGUE: dict[str, Effect] = {e.id: e for e in (
            inputs={"z1": "z1"},
            base_bindings={"effect_tooth_stiffness_factor": "tooth_factor", "effect_tooth_offset": "tooth_offset"},
            fit=(FitParameter("stiffness_loss", 0.0, 0.9),),
+           related=("mesh_stiffness_scale",),
            neutral={"stiffness_loss": 0.0, "material_loss": 0.0},
            evidence={"impulsive": "a weak tooth gives one short change of mesh stiffness per pinion revolution, "
                                   "an impulse in the synchronous average",
@@ -119,6 +131,7 @@ CATALOGUE: dict[str, Effect] = {e.id: e for e in (
            inputs={"mesh_deflection": "mesh_deflection", "mesh_stiffness": "mesh_stiffness"},
            hooks={"effect_mesh_force": "back_force"},
            fit=(FitParameter("gap", 1e-6, 2e-4, log=True),),
+           related=("c_mesh",),            # the mesh damping absorbs the impacts
            neutral={"gap": 2e-4},
            evidence={"resonance": "when the teeth separate, back-flank impacts excite broadband resonances",
                      "mesh_harmonic": "loss of contact and impacts raise the higher mesh harmonics",
@@ -128,6 +141,7 @@ CATALOGUE: dict[str, Effect] = {e.id: e for e in (
            hooks={"effect_pinion_torque": "pinion_torque", "effect_gear_torque": "gear_torque",
                   "effect_off_line_force": "off_line_force"},
            fit=(FitParameter("friction_coefficient", 0.0, 0.15),),
+           related=("c_mesh",),            # friction and mesh damping both dissipate per mesh cycle
            neutral={"friction_coefficient": 0.0},
            evidence={"mesh_harmonic": "friction reverses at the pitch point once per mesh cycle; the resulting "
                                       "force across the line of action adds to every mesh harmonic",
@@ -136,6 +150,7 @@ CATALOGUE: dict[str, Effect] = {e.id: e for e in (
            inputs={"n_profile": "n_profile", "roll_pitch": "roll_pitch"},
            base_bindings={"effect_profile_deviation": "deviation"},
            fit=(FitParameter("wear_depth", 1e-8, 3e-5, log=True),),
+           related=("mesh_stiffness_scale",),   # the profile error acts against the mesh stiffness
            neutral={"wear_depth": 0.0},
            evidence={"mesh_harmonic": "wear removes material away from the pitch point on every tooth, which "
                                       "changes the transmission error once per mesh cycle and so the mesh harmonics",

@@ -12,7 +12,12 @@ For one measured record:
    unlocked line gives a ripple frequency, a lifted band a resonance, a slow sideband spacing a
    load fluctuation period. Amplitudes are searched on a log grid, then polished (bounded Brent
    or Nelder-Mead).
-3. **Judge.** A candidate's score is the relative cut of the LSD it achieves. A baseline finding
+3. **Refit the related base parameters.** The ``related_leaders`` leading candidates (2 by
+   default) are fitted once more together with the base parameters that shape the same
+   signature (``Effect.related``, e.g. the mesh stiffness for a run-out), each within +-10 % of
+   its calibrated value. The result replaces the candidate's when it lowers the LSD, and the
+   moved base values are reported with the fitted parameters.
+4. **Judge.** A candidate's score is the relative cut of the LSD it achieves. A baseline finding
    is *explained* by a candidate when the squared dB error in its band falls by at least half
    (an ``impulsive`` finding: when it is gone). The top candidate is reported as missing only if
    it cuts the LSD by at least ``min_cut`` and by ``min_db`` dB; findings it does not explain
@@ -126,6 +131,11 @@ class TrialSpec:
     parameters: dict                            # base + active effects + neutral candidates
     guesses: dict                               # fit parameter name -> starting value
     max_evals: int = 30
+    # related base parameters (FMU name -> calibrated value) refitted jointly with the effect, and
+    # the evaluations that joint step may take; ``polish_only`` starts it from ``guesses`` directly
+    related: dict = field(default_factory=dict)
+    related_evals: int = 12
+    polish_only: bool = False
 
 
 class _Objective:
@@ -178,12 +188,20 @@ def simulate(fmu_path, parameters: Mapping[str, float], op: Operating, n: int, c
 
 
 def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int, np.ndarray]:
-    """Fit one effect's parameters.
+    """Fit one effect's parameters, then (with ``spec.related``) them and the related base ones.
 
-    Returns (FMU parameters, LSD [dB], evaluations, the simulated signal (n,) at the fit), so the
-    caller compares the fitted model without simulating it again.
+    1. amplitude-like parameters on a coarse grid, then Brent;
+    2. all effect parameters together (Nelder-Mead);
+    3. the effect parameters and the related base parameters together (Nelder-Mead, the base
+       ones within +-``RELATED_SPAN`` of their calibrated values), kept only if it lowers the LSD.
+
+    Returns (FMU parameters: the effect's and any moved base ones, LSD [dB], evaluations, the
+    simulated signal (n,) at the fit), so the caller compares the fitted model without
+    simulating it again.
     """
     from scipy.optimize import minimize, minimize_scalar
+
+    from twin.effects.catalogue import RELATED_SPAN
 
     eff = CATALOGUE[spec.effect]
     objective = _Objective(spec.measured, spec.operating.sample_rate)
@@ -191,11 +209,12 @@ def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int, np.ndarra
     fixed = dict(spec.parameters)
     params = list(eff.fit)
     free = [p for p in params if p.guess is None]
-    guessed = {p.name: float(np.clip(spec.guesses.get(p.name, math.sqrt(p.lower * p.upper) if p.log
-                                                      else 0.5 * (p.lower + p.upper)), p.lower, p.upper))
-               for p in params if p.guess is not None}
     count = 0
     cache: dict[tuple, tuple[float, np.ndarray | None]] = {}   # values -> (LSD, simulated signal)
+
+    def start(p: FitParameter) -> float:
+        default = math.sqrt(p.lower * p.upper) if p.log else 0.5 * (p.lower + p.upper)
+        return float(np.clip(spec.guesses.get(p.name, default), p.lower, p.upper))
 
     def to_x(p: FitParameter, v: float) -> float:
         return (math.log(v / p.lower) / math.log(p.upper / p.lower)) if p.log else (v - p.lower) / (p.upper - p.lower)
@@ -204,44 +223,71 @@ def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int, np.ndarra
         z = min(max(z, 0.0), 1.0)
         return p.lower * (p.upper / p.lower) ** z if p.log else p.lower + z * (p.upper - p.lower)
 
-    def key_of(values: Mapping[str, float]) -> tuple:
-        return tuple(sorted((k, round(v, 12)) for k, v in values.items()))
+    def key_of(values: Mapping[str, float], base: Mapping[str, float]) -> tuple:
+        return tuple(sorted((k, round(v, 12)) for k, v in values.items())) + \
+            tuple(sorted((k, round(v, 12)) for k, v in base.items()))
 
-    def lsd(values: Mapping[str, float]) -> float:
+    def lsd(values: Mapping[str, float], base: Mapping[str, float] | None = None) -> float:
         nonlocal count
-        key = key_of(values)
+        base = base or {}
+        key = key_of(values, base)
         if key not in cache:
             count += 1
             try:
-                sim = simulate(spec.fmu_path, {**fixed, **{eff.parameter(k): v for k, v in values.items()}},
+                sim = simulate(spec.fmu_path, {**fixed, **base, **{eff.parameter(k): v for k, v in values.items()}},
                                spec.operating, n, spec.channel)
                 cache[key] = (objective(sim), sim)
             except Exception:  # a diverging trial scores badly; it does not end the diagnosis
                 cache[key] = (1e3, None)
         return cache[key][0]
 
-    # 1) amplitude-like parameters on a coarse grid with the guessed ones held, then Brent
-    values = dict(guessed)
-    for p in free:
-        grid = np.linspace(0.0, 1.0, p.grid)
-        scores = [lsd({**values, p.name: from_x(p, z)}) for z in grid]
-        j = int(np.argmin(scores))
-        lo, hi = grid[max(j - 1, 0)], grid[min(j + 1, grid.size - 1)]
-        res = minimize_scalar(lambda z: lsd({**values, p.name: from_x(p, z)}), bounds=(lo, hi), method="bounded",
-                              options={"xatol": 0.01, "maxiter": 8})
-        best_z = res.x if res.fun < scores[j] else grid[j]
-        values[p.name] = from_x(p, best_z)
-    # 2) all parameters together (frequency-like ones move within +-5 % of their range)
-    if len(params) > 1 and count < spec.max_evals:
-        z0 = np.array([to_x(p, values[p.name]) for p in params])
-        res = minimize(lambda z: lsd({p.name: from_x(p, zi) for p, zi in zip(params, z)}), z0, method="Nelder-Mead",
-                       options={"maxfev": max(spec.max_evals - count, 4), "xatol": 2e-3, "fatol": 0.01,
-                                "initial_simplex": np.vstack([z0] + [z0 + 0.05 * np.eye(len(params))[i]
-                                                                     for i in range(len(params))])})
-        if res.fun < lsd(values):
-            values = {p.name: from_x(p, zi) for p, zi in zip(params, res.x)}
-    val = lsd(values)
-    return {eff.parameter(k): float(v) for k, v in values.items()}, val, count, cache[key_of(values)][1]
+    values = {p.name: start(p) for p in params} if spec.polish_only else \
+        {p.name: start(p) for p in params if p.guess is not None}
+    if not spec.polish_only:
+        # 1) amplitude-like parameters on a coarse grid with the guessed ones held, then Brent
+        for p in free:
+            grid = np.linspace(0.0, 1.0, p.grid)
+            scores = [lsd({**values, p.name: from_x(p, z)}) for z in grid]
+            j = int(np.argmin(scores))
+            lo, hi = grid[max(j - 1, 0)], grid[min(j + 1, grid.size - 1)]
+            res = minimize_scalar(lambda z: lsd({**values, p.name: from_x(p, z)}), bounds=(lo, hi),
+                                  method="bounded", options={"xatol": 0.01, "maxiter": 8})
+            best_z = res.x if res.fun < scores[j] else grid[j]
+            values[p.name] = from_x(p, best_z)
+        # 2) all parameters together (frequency-like ones move within +-5 % of their range)
+        if len(params) > 1 and count < spec.max_evals:
+            z0 = np.array([to_x(p, values[p.name]) for p in params])
+            res = minimize(lambda z: lsd({p.name: from_x(p, zi) for p, zi in zip(params, z)}), z0,
+                           method="Nelder-Mead",
+                           options={"maxfev": max(spec.max_evals - count, 4), "xatol": 2e-3, "fatol": 0.01,
+                                    "initial_simplex": np.vstack([z0] + [z0 + 0.05 * np.eye(len(params))[i]
+                                                                         for i in range(len(params))])})
+            if res.fun < lsd(values):
+                values = {p.name: from_x(p, zi) for p, zi in zip(params, res.x)}
+    base: dict[str, float] = {}
+    # 3) the effect and its related base parameters together
+    if spec.related:
+        names = list(spec.related)
+        v0 = np.array([float(spec.related[k]) for k in names])
+        m = len(params)
+
+        def unpack(z):
+            eff_values = {p.name: from_x(p, zi) for p, zi in zip(params, z[:m])}
+            rel = np.clip(z[m:], -1.0, 1.0)
+            return eff_values, {k: float(v * (1 + RELATED_SPAN * r)) for k, v, r in zip(names, v0, rel)}
+
+        z0 = np.concatenate([[to_x(p, values[p.name]) for p in params], np.zeros(len(names))])
+        steps = np.concatenate([np.full(m, 0.05), np.full(len(names), 0.5)])   # 5 % of range, 5 % of value
+        simplex = np.vstack([z0] + [z0 + steps[i] * np.eye(z0.size)[i] for i in range(z0.size)])
+        res = minimize(lambda z: lsd(*unpack(z)), z0, method="Nelder-Mead",
+                       options={"maxfev": spec.related_evals, "xatol": 2e-3, "fatol": 0.005,
+                                "initial_simplex": simplex})
+        # the calibrated base values are the simplex's first vertex, so comparing costs no run
+        values, base = unpack(res.x) if res.fun < lsd(*unpack(z0)) else unpack(z0)
+    val = lsd(values, base)
+    fitted = {eff.parameter(k): float(v) for k, v in values.items()}
+    fitted.update(base)
+    return fitted, val, count, cache[key_of(values, base)][1]
 
 
 def _guarded_fit(spec: TrialSpec):
@@ -395,7 +441,7 @@ def diagnose(fmu_path, measured: np.ndarray, sample_rate: float, nominal_speed: 
              effects: Sequence[str] | None = None, executor=None, record: str = "record",
              candidates_fmu=None, duration: float = 2.0, max_evals: int = 30,
              min_cut: float = MIN_CUT, min_db: float = MIN_DB, solver_step: float | None = 1e-5,
-             progress: bool = False) -> Diagnosis:
+             related_leaders: int = 2, progress: bool = False) -> Diagnosis:
     """Diagnose one record (see the module docstring).
 
     Parameters
@@ -408,6 +454,8 @@ def diagnose(fmu_path, measured: np.ndarray, sample_rate: float, nominal_speed: 
     parameters : the current model's (calibrated) parameters.
     effects : candidate ids (default: every catalogue effect the current model lacks).
     candidates_fmu : the built ``Gearbox21Candidates`` FMU (built on demand when None).
+    related_leaders : how many of the leading candidates are refitted once more together with
+        their related base parameters (:attr:`Effect.related`); 0 switches that off.
     """
     from twin.executor import LocalExecutor
 
@@ -459,6 +507,25 @@ def diagnose(fmu_path, measured: np.ndarray, sample_rate: float, nominal_speed: 
         cands.append(Candidate(eff.id, eff.title, score, after.lsd_db, fitted, _explained(before, after, eff),
                                after.findings, n_eval))
     cands.sort(key=lambda c: -c.score)
+    # the leading candidates are tried again with their related base parameters refitted too
+    lead = [c for c in cands[:related_leaders] if c.error is None and c.score > 0 and CATALOGUE[c.effect].related]
+    if lead:
+        specs2 = [TrialSpec(c.effect, str(candidates_fmu), channel, measured, op, probe,
+                            {k.split(".", 1)[1]: v for k, v in c.fitted.items() if k.startswith(c.effect + ".")},
+                            max_evals, related={k: float(probe.get(k, current[k])) for k in CATALOGUE[c.effect].related},
+                            polish_only=True) for c in lead]
+        for c, r in zip(lead, ex.map(_guarded_fit, specs2, progress=progress, desc="related base parameters")):
+            if isinstance(r, Exception) or r[3] is None:
+                continue
+            after = compare_signals(r[3], measured, sample_rate, shaft, z1=z1, z2=z2)
+            if after.lsd_db >= c.lsd_after_db:
+                continue
+            eff = CATALOGUE[c.effect]
+            score = max(0.0, (before.lsd_db - after.lsd_db) / before.lsd_db) if before.lsd_db > 0 else 0.0
+            cands[cands.index(c)] = Candidate(eff.id, eff.title, score, after.lsd_db, r[0],
+                                              _explained(before, after, eff), after.findings,
+                                              c.n_evaluations + r[2])
+        cands.sort(key=lambda c: -c.score)
 
     best = cands[0] if cands else None
     useful = best is not None and best.score >= min_cut and before.lsd_db - best.lsd_after_db >= min_db

@@ -62,7 +62,7 @@ class Addition:
     modelica_file: Path
     fmu: Path
     scenario_file: Path | None
-    fitted: dict                        # effect parameters after recalibration
+    fitted: dict                        # effect parameters and related base parameters after recalibration
     lsd_before_db: float
     lsd_after_db: float
     per_finding: tuple                  # (description, squared-dB error before, after)
@@ -118,11 +118,16 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
     guesses = starting_values(before, measured, sim0, rec.sample_rate, shaft, z1, z2).get(effect_id, {})
     if start:
         guesses.update({k.split(".", 1)[1]: v for k, v in start.items() if k.startswith(effect_id + ".")})
+    # ... together with the base parameters that shape the same signature (Effect.related)
+    related = {k: float(base_params.get(k, current[k])) for k in eff.related if k in current}
     spec = TrialSpec(effect_id, str(fmu_path), channel, measured, op, {**base_params, **values, **neutral},
-                     guesses, max_evals)
+                     guesses, max_evals, related=related)
     fitted, _, _, _ = fit_effect(spec)
+    fitted_effect = {k: v for k, v in fitted.items() if k.startswith(effect_id + ".")}
+    fitted_base = {k: v for k, v in fitted.items() if k not in fitted_effect}
+    base_params.update(fitted_base)
     # 3) write the variant again with the fitted values as its defaults, rebuild (cached by source)
-    model, path = write_variant(variant_source(ids, {**values, **neutral, **fitted}), modelica_dir)
+    model, path = write_variant(variant_source(ids, {**values, **neutral, **fitted_effect}), modelica_dir)
     fmu_path = build_fmu(model, modelica_dir, build_dir)
     sim1 = simulate(fmu_path, base_params, op, measured.size, channel)
     after = compare_signals(sim1, measured, rec.sample_rate, shaft, z1=z1, z2=z2)
@@ -134,7 +139,7 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
     # the model name resolves through the repository's modelica/; a variant written elsewhere is
     # referenced by its FMU file
     raw["fmu"] = model if modelica_dir.resolve() == _REPO_MODELICA.resolve() else str(Path(fmu_path).resolve())
-    raw["parameters"] = {k: float(v) for k, v in scenario.parameters.items()}
+    raw["parameters"] = {k: float(v) for k, v in base_params.items()}   # with the refitted related ones
     scen_file = out / f"scenario_{effect_id}.yaml"
     with atomic_path(scen_file) as tmp:
         Path(tmp).write_text(yaml.safe_dump(raw, sort_keys=False))
