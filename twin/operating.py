@@ -21,6 +21,22 @@ def operating_point(speed_hz: float, load_nm: float) -> tuple[dict[str, float], 
             {"motor_speed_ref": omega, "load_torque": float(load_nm)})
 
 
+def consistent_start(parameters: Mapping[str, float], inputs: Mapping[str, float],
+                     tunable: Sequence[str]) -> dict[str, float]:
+    """``parameters`` with the start parameters filled in from the inputs at the start time.
+
+    A run whose inputs start at another speed or load than ``speed_ref_start``/``load_start``
+    (defaults: 20 Hz, 20 N.m) would begin with a transient: the flanks fly apart, and with the
+    mesh damping acting only in contact, they may stay apart for seconds. Values the caller set
+    are kept; parameters the model does not have (``tunable``) are not added.
+    """
+    out = dict(parameters)
+    for par, inp in (("speed_ref_start", "motor_speed_ref"), ("load_start", "load_torque")):
+        if par not in out and par in tunable and inp in inputs:
+            out[par] = float(inputs[inp])
+    return out
+
+
 def simulate_operating_point(fmu_path: str | Path, speed_hz: float, load_nm: float, *,
                              parameters: Mapping[str, float] | None = None, settle: float = 0.1,
                              duration: float, channels: Sequence[str],

@@ -47,6 +47,17 @@ def test_wear_moves_the_profile(gearbox_fmu):
     assert dev[0] > dev[5] and dev[-1] > dev[5]
 
 
+def test_a_run_off_the_default_operating_point_starts_in_contact(gearbox_fmu):
+    """dry.yaml runs at 10 Hz / 5 N.m; the model's start parameters say 20 Hz / 20 N.m. Started
+    from those, the gear flew ahead of the slowing pinion and, with the mesh damping acting only
+    in contact, the flanks stayed apart: the first update saw no load and jumped 1e7 cycles."""
+    sc = load_scenario(REPO / "scenarios" / "dry.yaml")
+    d = dict(sc.degradation)
+    d.update({"max_updates": 2, "load_window": 0.1, "record_duration": 0.0})
+    run = run_degradation(sc.with_overrides(degradation=d), None, fmu_path=gearbox_fmu, progress=False)
+    assert run.damage[1] > 0 and run.cycles[1] < 1e6
+
+
 def test_resume_continues_from_last_stage(gearbox_fmu, tmp_path):
     out = tmp_path / "r.h5"
     part = run_degradation(_lubricated(stop=0.02), out, fmu_path=gearbox_fmu, progress=False)
