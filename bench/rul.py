@@ -146,9 +146,6 @@ def main() -> None:
               "- Records only say which stage the damage is in, so the RUL is pinned down by stage "
               "transitions: before the first one (early life) the band is mostly the prior on the rate "
               "factor; each transition seen narrows it.",
-              "- The dry co-simulated trajectory has a slow stretch (the mean wear rate drops between about "
-              "90 and 120 um) inside stage 1; while the records sit in that stage the posterior is wide and "
-              "right-skewed, and its median over-estimates the RUL (see the 60 % row).",
               "- The quasi-static block measures a model-form error: the truth follows the co-simulated "
               "shape, the estimator a slightly different one, and the band does not account for that.", ""]
     text = "\n".join(lines)
