@@ -146,7 +146,7 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
         if stages:
             params.update(stages[-1].parameters)
         from twin.operating import consistent_start
-        fmu.setup(t0, parameters=consistent_start(params, inputs, fmu.parameter_values()), inputs=inputs)
+        fmu.setup(t0, parameters=consistent_start(params, inputs, [v.name for v in fmu.parameters]), inputs=inputs)
         fmu.capture(t0 + 0.05, dt, ["mesh_force"])        # settle the lateral static deflection
         bar = progress_bar(max_updates, progress, f"{scenario.name} stages", "stage")
         bar.update(len(stages))

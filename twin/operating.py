@@ -28,7 +28,8 @@ def consistent_start(parameters: Mapping[str, float], inputs: Mapping[str, float
     A run whose inputs start at another speed or load than ``speed_ref_start``/``load_start``
     (defaults: 20 Hz, 20 N.m) would begin with a transient: the flanks fly apart, and with the
     mesh damping acting only in contact, they may stay apart for seconds. Values the caller set
-    are kept; parameters the model does not have (``tunable``) are not added.
+    are kept; start parameters the model does not have (not in ``tunable``, its parameter
+    names) are not added.
     """
     out = dict(parameters)
     for par, inp in (("speed_ref_start", "motor_speed_ref"), ("load_start", "load_torque")):

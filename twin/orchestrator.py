@@ -119,8 +119,8 @@ def run_scenario(scenario: Scenario, output: str | Path | None = None, *, fmu_pa
         t0 = scenario.start_time
         inputs_now = {n: p(t0) for n, p in scenario.inputs.items()}
         from twin.operating import consistent_start
-        fmu.setup(t0, parameters=consistent_start(scenario.parameters, inputs_now, fmu.parameter_values()),
-                  inputs=inputs_now)
+        start = consistent_start(scenario.parameters, inputs_now, [v.name for v in fmu.parameters])
+        fmu.setup(t0, parameters=start, inputs=inputs_now)
         initial = {n: fmu.get(n) for n in required_variables(scenario)
                    if fmu.variables[n].causality in ("parameter", "input")}
         start_parameters = fmu.parameter_values()
