@@ -388,6 +388,27 @@ def active_effects(parameter_names: Sequence[str]) -> list[str]:
     return [e for e in CATALOGUE if e in ids]
 
 
+def split_fitted(effect_id: str, fitted: Mapping[str, float]) -> tuple[dict[str, float], dict[str, float]]:
+    """Fitted FMU values -> (the effect's own, by component name; the moved base parameters)."""
+    prefix = effect_id + "."
+    own = {k[len(prefix):]: v for k, v in fitted.items() if k.startswith(prefix)}
+    return own, {k: v for k, v in fitted.items() if not k.startswith(prefix)}
+
+
+def related_values(eff: Effect, parameters: Mapping[str, float], current: Mapping[str, float]) -> dict[str, float]:
+    """Calibrated values of the effect's related base parameters: the scenario's, else the FMU's."""
+    return {k: float(parameters.get(k, current[k])) for k in eff.related if k in parameters or k in current}
+
+
+def _candidate(eff: Effect, before: Comparison, fitted: dict, n_eval: int, sim: np.ndarray, measured: np.ndarray,
+               op: Operating, z1: int, z2: int) -> Candidate:
+    """Score a fitted candidate against the baseline comparison."""
+    after = compare_signals(sim, measured, op.sample_rate, op.shaft_hz, z1=z1, z2=z2)
+    score = max(0.0, (before.lsd_db - after.lsd_db) / before.lsd_db) if before.lsd_db > 0 else 0.0
+    return Candidate(eff.id, eff.title, score, after.lsd_db, fitted, _explained(before, after, eff), after.findings,
+                     n_eval)
+
+
 @dataclass(frozen=True)
 class Conditions:
     """A record in model terms: what both the diagnosis and add-effect simulate against."""
@@ -405,13 +426,15 @@ def record_conditions(fmu_path, measured: np.ndarray, sample_rate: float, nomina
     """Check the record and the model, keep the last ``duration`` s, and find the operating point.
 
     Raises :class:`MeasurementError` for a record that is not 1-D, shorter than 0.25 s or not
-    finite, and :class:`ParameterError` for a model that is not ``GearTwin.Gearbox21`` or a
-    variant of it.
+    finite, and :class:`ParameterError` for a ``duration`` under 0.25 s or a model that is not
+    ``GearTwin.Gearbox21`` or a variant of it.
     """
     from twin.calibration.objectives import estimate_shaft_hz
     from twin.errors import MeasurementError, ParameterError
     from twin.fmu import FMU
 
+    if not (isinstance(duration, (int, float)) and math.isfinite(duration) and duration >= 0.25):
+        raise ParameterError(f"duration must be at least 0.25 s of the record, got {duration!r}")
     measured = np.asarray(measured, float)
     if measured.ndim != 1 or measured.size < int(0.25 * sample_rate):
         raise MeasurementError("<array>", record, f"diagnosis needs a 1-D record of at least 0.25 s, got shape "
@@ -502,30 +525,21 @@ def diagnose(fmu_path, measured: np.ndarray, sample_rate: float, nominal_speed: 
             cands.append(Candidate(eff.id, eff.title, 0.0, before.lsd_db, fitted, (), (), n_eval,
                                    "every trial of this effect failed to simulate"))
             continue
-        after = compare_signals(sim, measured, sample_rate, shaft, z1=z1, z2=z2)
-        score = max(0.0, (before.lsd_db - after.lsd_db) / before.lsd_db) if before.lsd_db > 0 else 0.0
-        cands.append(Candidate(eff.id, eff.title, score, after.lsd_db, fitted, _explained(before, after, eff),
-                               after.findings, n_eval))
+        cands.append(_candidate(eff, before, fitted, n_eval, sim, measured, op, z1, z2))
     cands.sort(key=lambda c: -c.score)
     # the leading candidates are tried again with their related base parameters refitted too
     lead = [c for c in cands[:related_leaders] if c.error is None and c.score > 0 and CATALOGUE[c.effect].related]
-    if lead:
-        specs2 = [TrialSpec(c.effect, str(candidates_fmu), channel, measured, op, probe,
-                            {k.split(".", 1)[1]: v for k, v in c.fitted.items() if k.startswith(c.effect + ".")},
-                            max_evals, related={k: float(probe.get(k, current[k])) for k in CATALOGUE[c.effect].related},
-                            polish_only=True) for c in lead]
-        for c, r in zip(lead, ex.map(_guarded_fit, specs2, progress=progress, desc="related base parameters")):
-            if isinstance(r, Exception) or r[3] is None:
-                continue
-            after = compare_signals(r[3], measured, sample_rate, shaft, z1=z1, z2=z2)
-            if after.lsd_db >= c.lsd_after_db:
-                continue
-            eff = CATALOGUE[c.effect]
-            score = max(0.0, (before.lsd_db - after.lsd_db) / before.lsd_db) if before.lsd_db > 0 else 0.0
-            cands[cands.index(c)] = Candidate(eff.id, eff.title, score, after.lsd_db, r[0],
-                                              _explained(before, after, eff), after.findings,
-                                              c.n_evaluations + r[2])
-        cands.sort(key=lambda c: -c.score)
+    specs2 = [TrialSpec(c.effect, str(candidates_fmu), channel, measured, op, probe, split_fitted(c.effect, c.fitted)[0],
+                        max_evals, related=related_values(CATALOGUE[c.effect], probe, current), polish_only=True)
+              for c in lead]
+    for c, r in zip(lead, ex.map(_guarded_fit, specs2, progress=progress, desc="related base parameters")
+                    if specs2 else ()):
+        if isinstance(r, Exception) or r[3] is None:
+            continue
+        joint = _candidate(CATALOGUE[c.effect], before, r[0], c.n_evaluations + r[2], r[3], measured, op, z1, z2)
+        if joint.lsd_after_db < c.lsd_after_db:
+            cands[cands.index(c)] = joint
+    cands.sort(key=lambda c: -c.score)
 
     best = cands[0] if cands else None
     useful = best is not None and best.score >= min_cut and before.lsd_db - best.lsd_after_db >= min_db

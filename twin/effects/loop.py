@@ -20,7 +20,7 @@ import numpy as np
 from twin.compare import MeasuredRecord, read_record  # noqa: F401  (part of this module's API)
 from twin.effects.catalogue import effect as get_effect
 from twin.effects.diagnose import (Diagnosis, TrialSpec, active_effects, diagnose, fit_effect,
-                                   record_conditions, simulate)
+                                   record_conditions, related_values, simulate, split_fitted)
 
 
 def _write_json(path: Path, data: dict) -> None:
@@ -117,17 +117,17 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
     # 2) recalibrate the new effect's parameters on the variant's own FMU
     guesses = starting_values(before, measured, sim0, rec.sample_rate, shaft, z1, z2).get(effect_id, {})
     if start:
-        guesses.update({k.split(".", 1)[1]: v for k, v in start.items() if k.startswith(effect_id + ".")})
+        guesses.update(split_fitted(effect_id, start)[0])
     # ... together with the base parameters that shape the same signature (Effect.related)
-    related = {k: float(base_params.get(k, current[k])) for k in eff.related if k in current}
     spec = TrialSpec(effect_id, str(fmu_path), channel, measured, op, {**base_params, **values, **neutral},
-                     guesses, max_evals, related=related)
+                     guesses, max_evals, related=related_values(eff, base_params, current))
     fitted, _, _, _ = fit_effect(spec)
-    fitted_effect = {k: v for k, v in fitted.items() if k.startswith(effect_id + ".")}
-    fitted_base = {k: v for k, v in fitted.items() if k not in fitted_effect}
+    fitted_effect, fitted_base = split_fitted(effect_id, fitted)
     base_params.update(fitted_base)
     # 3) write the variant again with the fitted values as its defaults, rebuild (cached by source)
-    model, path = write_variant(variant_source(ids, {**values, **neutral, **fitted_effect}), modelica_dir)
+    model, path = write_variant(variant_source(ids, {**values, **neutral,
+                                                     **{eff.parameter(k): v for k, v in fitted_effect.items()}}),
+                                modelica_dir)
     fmu_path = build_fmu(model, modelica_dir, build_dir)
     sim1 = simulate(fmu_path, base_params, op, measured.size, channel)
     after = compare_signals(sim1, measured, rec.sample_rate, shaft, z1=z1, z2=z2)

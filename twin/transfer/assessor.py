@@ -617,12 +617,18 @@ class Assessor:
         a.history_ = cfg["history"]
         a.n_source_windows_ = cfg["n_source_windows"]
         a.n_target_windows_ = cfg["n_target_windows"]
-        if version == 1:
-            a.source_normaliser_ = DomainNormaliser(0.0, float(cfg["source_scale"]))
-            a.target_normaliser_ = DomainNormaliser(0.0, float(cfg["target_scale"]))
-        else:
-            a.source_normaliser_ = DomainNormaliser.from_dict(cfg["source_normaliser"])
-            a.target_normaliser_ = DomainNormaliser.from_dict(cfg["target_normaliser"])
+        try:
+            if version == 1:
+                norms = [DomainNormaliser(0.0, float(cfg[f"{d}_scale"])) for d in ("source", "target")]
+            else:
+                norms = [DomainNormaliser.from_dict(cfg[f"{d}_normaliser"]) for d in ("source", "target")]
+        except (KeyError, TypeError, ValueError) as exc:
+            raise AssessorError(f"'{cfg_file}' has no valid domain normalisers: {exc!r}") from None
+        for n in norms:
+            if np.ndim(n.centre) and np.shape(n.centre) != (a._pre.window,) or not n.scale > 0:
+                raise AssessorError(f"'{cfg_file}': a domain normaliser has centre shape {np.shape(n.centre)} "
+                                    f"and scale {n.scale!r}; expected ({a._pre.window},) or a number, and > 0")
+        a.source_normaliser_, a.target_normaliser_ = norms
         if cfg.get("fit_time") is not None:
             a.fit_time_ = cfg["fit_time"]
         return a

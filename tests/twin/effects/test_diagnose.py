@@ -30,6 +30,8 @@ def test_bad_records_and_models_are_refused(gearbox_fmu, two_mass_fmu):
         diagnose(gearbox_fmu, np.full(20000, np.nan), 20000.0, 20.0, 20.0)
     with pytest.raises(MeasurementError, match="at least 0.25 s"):
         diagnose(gearbox_fmu, np.zeros(100), 20000.0, 20.0, 20.0)
+    with pytest.raises(ParameterError, match="duration.*-1"):
+        diagnose(gearbox_fmu, np.zeros(20000), 20000.0, 20.0, 20.0, duration=-1)
     with pytest.raises(ParameterError, match="not a GearTwin.Gearbox21 model"):
         diagnose(two_mass_fmu, np.zeros(20000), 20000.0, 20.0, 20.0)
 

@@ -97,6 +97,19 @@ def test_version_1_assessors_still_load_as_waveform_models(tiny_data, tmp_path):
     np.testing.assert_array_equal(back.predict_proba(test), a.predict_proba(test))
 
 
+def test_a_damaged_normaliser_is_an_assessor_error(fitted, tmp_path):
+    d = fitted.save(tmp_path / "bad")
+    cfg = json.loads((d / "config.json").read_text())
+    cfg["target_normaliser"]["centre"] = [0.0, 1.0]          # not one value per bin
+    (d / "config.json").write_text(json.dumps(cfg))
+    with pytest.raises(AssessorError, match=r"centre shape \(2,\)"):
+        Assessor.load(d)
+    del cfg["target_normaliser"]
+    (d / "config.json").write_text(json.dumps(cfg))
+    with pytest.raises(AssessorError, match="target_normaliser"):
+        Assessor.load(d)
+
+
 def test_save_to_missing_parent_is_an_output_path_error(fitted, tmp_path):
     with pytest.raises(OutputPathError, match="nope"):
         fitted.save(tmp_path / "nope" / "assessor")
