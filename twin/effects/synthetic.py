@@ -69,14 +69,6 @@ class HiddenCase:
         return self.signal.size / self.sample_rate
 
 
-def wear_profile(depth: float, roll_pitch: float, n_profile: int = 11) -> dict[str, float]:
-    """``profile_deviation[1..n]`` [m] of uniform sliding wear: zero at the pitch point, ``depth``
-    at the end of the path of contact farther from it (the shape of ``DistributedWear``)."""
-    s = np.linspace(0.0, 1.0, n_profile)
-    h = depth * np.abs(s - roll_pitch) / max(roll_pitch, 1.0 - roll_pitch)
-    return {f"profile_deviation[{i + 1}]": float(v) for i, v in enumerate(h)}
-
-
 def make_case(effect: str | None, seed: int, *, candidates_fmu, duration: float | None = None,
               sample_rate: float = 20000.0,
               nominal_speed: float = 20.0, load: float | None = None, noise: float = 0.05,
@@ -94,15 +86,19 @@ def make_case(effect: str | None, seed: int, *, candidates_fmu, duration: float 
     if effect is not None and effect != "out_of_catalogue" and effect not in CATALOGUE:
         raise ParameterError(f"unknown hidden effect {effect!r}")
     rng = np.random.default_rng(seed)
-    with FMU(candidates_fmu) as fmu:
-        defaults = fmu.parameter_values()
-        fmu.setup(0.0)
-        roll_pitch = fmu.get("roll_pitch")      # a calculated parameter (gear geometry)
-    params = {k: defaults[k] * (1 + rng.uniform(-r, r)) for k, r in BASE_OFFSETS.items()}
     cond = CONDITIONS.get(effect or "", {})
     load = float(cond.get("load", 20.0)) if load is None else float(load)
     duration = float(cond.get("duration", 2.0)) if duration is None else float(duration)
-    known = wear_profile(cond["known_wear_depth"], roll_pitch) if "known_wear_depth" in cond else {}
+    with FMU(candidates_fmu) as fmu:
+        defaults = fmu.parameter_values()
+        known = {}
+        if "known_wear_depth" in cond:
+            # the known wear has the shape of the DistributedWear component; the model computes it
+            fmu.setup(0.0, parameters={CATALOGUE["distributed_wear"].parameter("wear_depth"): cond["known_wear_depth"]})
+            n = int(fmu.variables["n_profile"].start)
+            dev = fmu.get([CATALOGUE["distributed_wear"].parameter(f"deviation[{i}]") for i in range(1, n + 1)])
+            known = {f"profile_deviation[{i}]": float(v) for i, v in enumerate(dev, start=1)}
+    params = {k: defaults[k] * (1 + rng.uniform(-r, r)) for k, r in BASE_OFFSETS.items()}
     params.update(known)
     for e in CATALOGUE.values():
         params.update({e.parameter(k): v for k, v in e.neutral.items()})
