@@ -63,8 +63,12 @@ def _source_ceiling(args, tasks) -> None:
 
     from twin.transfer.benchmark import _ceiling_star, prepare_task
 
+    from twin.errors import OutputPathError
+
     data_dir = Path(args.data_dir) if args.data_dir else Path(args.out) / "data"
-    data_dir.mkdir(parents=True, exist_ok=True)
+    if not data_dir.parent.is_dir():
+        raise OutputPathError(f"output directory '{data_dir.parent}' does not exist (for '{data_dir}')")
+    data_dir.mkdir(exist_ok=True)
     jobs = [(t, str(prepare_task(t, data_dir)[0]), s, args.epochs) for t in tasks for s in range(args.seeds)]
     with ProcessPoolExecutor(max_workers=args.jobs, mp_context=mp.get_context("spawn")) as pool:
         acc = list(pool.map(_ceiling_star, jobs))
