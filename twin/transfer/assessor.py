@@ -46,8 +46,9 @@ __all__ = ["Assessment", "Assessor", "METHODS", "RecordAssessment"]
 
 METHODS = ("cnn", "mmd", "proposed", "coral")
 SAVE_FORMAT = "gear-twin-assessor"
-SAVE_VERSION = 2
-_READABLE_VERSIONS = (1, 2)     # version 1: waveform only, one scale per domain
+SAVE_VERSION = 3
+# version 1: waveform only, one scale per domain; version 2: log spectra under one Hann taper, level removed
+_READABLE_VERSIONS = (1, 2, 3)
 _EVAL_BATCH = 256
 
 
@@ -603,6 +604,8 @@ class Assessor:
         version = cfg["format_version"]
         # version 1 predates the log-spectrum representation: its networks were trained on waveforms
         pre_cfg = {"representation": "waveform", **cfg["preprocessing"]} if version == 1 else cfg["preprocessing"]
+        if version < 3:     # before the multitaper spectrum and the kept level
+            pre_cfg = {**pre_cfg, "time_bandwidth": 0.0, "remove_level": True}
         a = cls(**params, preprocessing=Preprocessing(**pre_cfg), augmentation=aug)
         net = Network(int(cfg["n_classes"]), a._pre.window)
         try:

@@ -7,9 +7,12 @@ model, so ``assess`` windows new data exactly as training did):
    it is an error naming the record and the channel.
 2. **resampling** -- to ``sample_rate`` (default 20 kHz) with
    :func:`twin.measurements.resample_record` (polyphase FIR, anti-aliased, flat to 80 % of the
-   new Nyquist frequency).  20 kHz keeps the first ~25 mesh harmonics at 20 Hz shaft speed and the
-   casing modes up to 2 kHz, and makes a 2048-sample window 0.1024 s long: two pinion
-   revolutions at 20 Hz, one at 10 Hz, so every tooth is in every window.
+   new Nyquist frequency).  The rule is a window of two pinion revolutions,
+   ``sample_rate = 1024 x shaft speed`` (:meth:`Preprocessing.for_shaft_speed`, ``twin
+   train-assessor --shaft-speed``): 20.48 kHz for the lubricated test at 20 Hz, 10.24 kHz for the
+   dry test at 10 Hz.  Every tooth is then in every window twice, and the spectrum holds the
+   same ~26 mesh harmonics at either speed.  At 20 kHz the dry test's window would hold one
+   revolution, and its wear stages were told apart 4 points worse (``bench/transfer_RESULTS.md``).
 3. **windowing** -- windows of ``window`` samples (2048, the paper's segment length) every ``hop``
    samples from the start of the record; the tail shorter than a window is dropped.
 4. **normalisation** (``normalise``), two documented choices:
@@ -32,21 +35,30 @@ model, so ``assess`` windows new data exactly as training did):
    (This step is described for ``representation="waveform"``; for the log spectrum see step 5.)
 5. **representation** (``representation``):
 
-   * ``"log_spectrum"`` (default) -- the window's log-magnitude spectrum (Hann taper, ``window``
-     bins up to the Nyquist frequency, :func:`log_spectrum`).  Per window, its mean log
-     magnitude (the level) is removed: a sensor gain or a few per cent of load moves the level of
-     a whole record, while the damage shows in the *shape* -- which mesh harmonics, sidebands and
-     resonance regions rise.  Per domain ("domain" normalisation), the domain's mean log spectrum
-     is removed: a linear transfer path (accelerometer, mount, casing, foundation) adds the same
-     ``log|H(f)|`` to every spectrum of a rig, so this cancels a transfer path the twin never
-     modelled, the cepstral mean normalisation of speech recognition applied to the vibration
-     channel (:func:`domain_normaliser`).  The scale is the source's and is shared.
+   * ``"log_spectrum"`` (default) -- the window's log-magnitude spectrum (``window`` bins up to
+     the Nyquist frequency, :func:`log_spectrum`): a multitaper estimate (``time_bandwidth`` NW
+     = 4, five Slepian tapers), whose scatter from window to window is a third of a single
+     taper's.  Per domain ("domain" normalisation), the domain's mean log spectrum is removed: a
+     linear transfer path (accelerometer, mount, casing, foundation) adds the same ``log|H(f)|``
+     to every spectrum of a rig, so this cancels a transfer path the twin never modelled (and a
+     constant sensor gain with it), the cepstral mean normalisation of speech recognition applied
+     to the vibration channel (:func:`domain_normaliser`).  The scale is the source's and is
+     shared.  Each window's *level* (its mean log magnitude) is kept: it carries the damage.  Once
+     the wear depth is far above the teeth's elastic deflection, the transmission error follows the
+     worn profile, so the vibration grows in proportion to the depth while its spectral shape
+     hardly changes (wear stages 3 and 4 of the dry test differ by 0.36 in log level and little
+     else).  What the level costs is robustness to a gain that changes from record to record;
+     ``remove_level=True`` (or ``normalise="window"``) removes it where a stage's level step is
+     within the rig's gain scatter, as for pitting: tooth-local damage shows in the spectral
+     shape, and the early pitting stages differ in level by only ~19 % per stage
+     (``twin.transfer.benchmark.TASK_REMOVE_LEVEL``).
    * ``"waveform"`` -- the paper's raw samples, normalised as in step 4.
 
    Why the default changed from the paper's waveform: on the benchmark's pitting task (same data),
    the source-only CNN fed waveforms reaches 38 % on the rig (6 stages), because the rig's mount
    and casing reshape the spectrum; fed centred log spectra it reaches 70 %, and the proposed
-   method 94 % instead of 62 % (``BENCHMARKS.md``).
+   method 94 % instead of 62 % (``BENCHMARKS.md``, Hann taper with the level removed, as saved
+   by assessor format version 2).
 
 Simulation-side augmentation (:class:`Augmentation`, source training windows only, re-drawn every
 epoch from a seeded generator): a speed jitter (the record is time-stretched by a factor
@@ -57,6 +69,7 @@ gain ``exp(gain * N(0, 1))`` (per record: the rig's gain scatters from record to
 """
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Iterable, Sequence
 from dataclasses import asdict, dataclass
@@ -95,6 +108,14 @@ class Preprocessing:
     representation : {"log_spectrum", "waveform"}
         What the network sees (step 5): the window's log-magnitude spectrum (``window`` bins,
         0 to the Nyquist frequency) or the paper's raw samples.
+    time_bandwidth : float
+        Multitaper time-bandwidth product NW of the log spectrum (:func:`log_spectrum`); 0 means
+        a single Hann taper.  Ignored for ``waveform``.
+    remove_level : bool
+        Log spectrum with ``normalise="domain"`` only: also remove each window's mean log
+        magnitude (its level), as ``normalise="window"`` always does.  Off by default: the level
+        between records carries deep wear (step 5).  Turn it on where a stage's level step is
+        within the rig's record-to-record gain scatter, e.g. for early pitting.
     """
 
     channel: str = "accel_pinion_casing"
@@ -103,6 +124,8 @@ class Preprocessing:
     hop: int = 1024
     normalise: str = "domain"
     representation: str = "log_spectrum"
+    time_bandwidth: float = 4.0
+    remove_level: bool = False
 
     def __post_init__(self) -> None:
         if not isinstance(self.channel, str) or not self.channel:
@@ -119,9 +142,31 @@ class Preprocessing:
         if self.representation not in REPRESENTATIONS:
             raise ParameterError(f"representation must be one of {', '.join(REPRESENTATIONS)}, "
                                  f"got {self.representation!r}")
+        if not isinstance(self.remove_level, bool):
+            raise ParameterError(f"remove_level must be True or False, got {self.remove_level!r}")
+        nw = self.time_bandwidth
+        if not (isinstance(nw, (int, float)) and math.isfinite(nw) and (nw == 0 or 1 <= nw < self.window / 4)):
+            raise ParameterError(f"time_bandwidth must be 0 (Hann taper) or in [1, window/4 = {self.window / 4:g}), "
+                                 f"got {nw!r}")
 
     def to_dict(self) -> dict:
         return asdict(self)
+
+    @classmethod
+    def for_shaft_speed(cls, speed: float, revolutions: float = 2.0, **settings) -> "Preprocessing":
+        """Settings whose window spans ``revolutions`` pinion revolutions at ``speed`` [Hz].
+
+        ``sample_rate = window * speed / revolutions``: 20.48 kHz for the lubricated test (20 Hz)
+        and 10.24 kHz for the dry test (10 Hz) with the default 2048-sample window, so every
+        window holds every tooth twice and the same ~26 mesh harmonics, whatever the test speed.
+        ``settings`` are the other :class:`Preprocessing` fields.
+        """
+        if not (isinstance(speed, (int, float)) and math.isfinite(speed) and speed > 0):
+            raise ParameterError(f"shaft speed must be a finite number > 0 [Hz], got {speed!r}")
+        if not (isinstance(revolutions, (int, float)) and math.isfinite(revolutions) and revolutions > 0):
+            raise ParameterError(f"revolutions must be a finite number > 0, got {revolutions!r}")
+        window = settings.get("window", cls.window)
+        return cls(sample_rate=window * speed / revolutions, **settings)
 
 
 @dataclass(frozen=True)
@@ -179,32 +224,62 @@ def apply_normalisation(w: np.ndarray, mode: str) -> np.ndarray:
     return w
 
 
-def log_spectrum(w: np.ndarray) -> np.ndarray:
+def log_spectrum(w: np.ndarray, time_bandwidth: float = 4.0) -> np.ndarray:
     """Log-magnitude spectrum of each window, shape (n, window) -> (n, window).
 
-    Hann taper, zero-padded to twice the window so there are ``window`` bins from 0 Hz up to
-    (not including) the Nyquist frequency, spaced ``sample_rate / (2 window)``.  The small
-    absolute floor (1e-12 in the signal's unit) only keeps an all-zero window finite.
+    ``time_bandwidth`` NW > 0: Thomson's multitaper estimate -- the power spectra of the window
+    under unit-energy discrete prolate spheroidal (Slepian) tapers, averaged, so the estimate has
+    ``K`` times the degrees of freedom of a single taper.  Of the ``2 NW - 1`` tapers of the
+    textbook rule only those whose out-of-band leakage is at most 0.1 % are used (NW = 4: K = 5):
+    the higher-order ones leak up to 6 %, which fills the spectrum between strong mesh lines with
+    leakage that a transfer path weights differently, and the domain centring cannot cancel that
+    (on a clean two-line signal through a mount resonance it leaves 31 % of the path's effect
+    with seven tapers, 13 % with five, 4 % with one Hann taper).  The log of a single taper's
+    periodogram scatters by ``sqrt(pi**2 / 6)`` = 1.28 (log power) from window to window even
+    for a stationary signal; with K = 5 by ``sqrt(trigamma(5))`` = 0.47, at a resolution of
+    ``2 NW / T`` (80 Hz for a 0.1 s window, below the 380 Hz mesh-line spacing at 20 Hz shaft
+    speed).  ``time_bandwidth`` 0: one Hann taper (assessors saved before version 3).
+
+    Zero-padded to twice the window, so there are ``window`` bins from 0 Hz up to (not including)
+    the Nyquist frequency, spaced ``sample_rate / (2 window)``; the value is half the log power,
+    i.e. the log magnitude.  The small absolute floor only keeps an all-zero window finite.
     """
     w = np.asarray(w, dtype=np.float64)
     n = w.shape[-1]
-    mag = np.abs(np.fft.rfft(w * np.hanning(n), n=2 * n, axis=-1))[..., :n]
-    return np.log(mag + 1e-12)
+    if time_bandwidth == 0:
+        mag = np.abs(np.fft.rfft(w * np.hanning(n), n=2 * n, axis=-1))[..., :n]
+        return np.log(mag + 1e-12)
+    tapers = _slepian_tapers(n, float(time_bandwidth))                 # (K, n)
+    power = np.zeros(w.shape[:-1] + (n,))
+    for taper in tapers:                                               # K FFTs; keeps memory at one copy
+        power += np.abs(np.fft.rfft(w * taper, n=2 * n, axis=-1)[..., :n]) ** 2
+    return 0.5 * np.log(power / len(tapers) + 1e-24)
+
+
+@functools.lru_cache(maxsize=8)
+def _slepian_tapers(n: int, time_bandwidth: float) -> np.ndarray:
+    from scipy.signal.windows import dpss
+
+    tapers, concentration = dpss(n, time_bandwidth, Kmax=max(int(2 * time_bandwidth) - 1, 1), norm=2,
+                                 return_ratios=True)
+    keep = max(int(np.sum(1.0 - concentration <= 1e-3)), 1)     # concentrations are descending
+    return tapers[:keep]
 
 
 def represent(w: np.ndarray, pre: "Preprocessing") -> np.ndarray:
     """Steps 4-5 per window: the representation and its per-window part of the normalisation.
 
     ``waveform``: :func:`apply_normalisation`.  ``log_spectrum``: :func:`log_spectrum`; with
-    ``normalise`` "domain" or "window" the window's mean log magnitude (its level, where a sensor
-    gain or a load change shows first) is removed, so the network sees spectral *shape*.
+    ``normalise`` "window" (or "domain" with ``remove_level``) the window's mean log magnitude
+    (its level, where a sensor gain shows) is removed, so the network sees spectral *shape* only;
+    with "domain" the level stays, and the domain centring removes the rig's constant gain.
     """
     if pre.representation == "waveform":
         return apply_normalisation(w, pre.normalise)
-    spec = log_spectrum(w)
-    if pre.normalise == "none":
-        return spec
-    return spec - spec.mean(axis=-1, keepdims=True)
+    spec = log_spectrum(w, pre.time_bandwidth)
+    if pre.normalise == "window" or (pre.normalise == "domain" and pre.remove_level):
+        return spec - spec.mean(axis=-1, keepdims=True)
+    return spec
 
 
 @dataclass(frozen=True)

@@ -69,7 +69,8 @@ def test_save_load_round_trip_gives_identical_predictions(fitted, tiny_data, tmp
     d = fitted.save(tmp_path / "assessor")
     cfg = json.loads((d / "config.json").read_text())
     assert cfg["preprocessing"] == {"channel": "accel_pinion_casing", "sample_rate": FS, "window": 64, "hop": 32,
-                                    "normalise": "domain", "representation": "log_spectrum"}
+                                    "normalise": "domain", "representation": "log_spectrum",
+                                    "time_bandwidth": 4.0, "remove_level": False}
     back = Assessor.load(d)
     assert back._pre == fitted._pre
     np.testing.assert_array_equal(back.target_normaliser_.centre, fitted.target_normaliser_.centre)
@@ -95,6 +96,21 @@ def test_version_1_assessors_still_load_as_waveform_models(tiny_data, tmp_path):
     back = Assessor.load(d)
     assert back._pre.representation == "waveform"
     np.testing.assert_array_equal(back.predict_proba(test), a.predict_proba(test))
+
+
+def test_version_2_assessors_keep_their_single_taper_level_free_spectrum(fitted, tiny_data, tmp_path):
+    """Version 2 had no multitaper or level setting: its networks were trained on Hann-taper log
+    spectra with each window's level removed."""
+    _, _, test = tiny_data
+    d = fitted.save(tmp_path / "v2")
+    cfg = json.loads((d / "config.json").read_text())
+    del cfg["preprocessing"]["time_bandwidth"], cfg["preprocessing"]["remove_level"]
+    cfg["format_version"] = 2
+    (d / "config.json").write_text(json.dumps(cfg))
+    back = Assessor.load(d)
+    from dataclasses import replace
+    assert back._pre == replace(fitted._pre, time_bandwidth=0.0, remove_level=True)
+    assert not np.array_equal(back.predict_proba(test), fitted.predict_proba(test))   # the input differs
 
 
 def test_a_damaged_normaliser_is_an_assessor_error(fitted, tmp_path):

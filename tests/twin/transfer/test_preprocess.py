@@ -47,7 +47,12 @@ def test_log_spectrum_cancels_gain_and_domain_centring_cancels_a_transfer_path()
     y = 3.0 * resonator(x, fs, 3000.0, 5.0)
     pre = Preprocessing(sample_rate=fs, window=n, hop=n)
     ws, wt = window_signal(x, n, n)[1:], window_signal(y, n, n)[1:]     # skip the filter's transient
-    np.testing.assert_allclose(represent(7.0 * ws, pre), represent(ws, pre), atol=1e-9)   # gain cancels
+    # a constant gain: the domain centring cancels it; the per-window level removal does too
+    f1, f7 = represent(ws, pre), represent(7.0 * ws, pre)
+    np.testing.assert_allclose(f7 - f1, np.log(7.0), atol=1e-9)
+    np.testing.assert_allclose(domain_normaliser(f7, pre)(f7), domain_normaliser(f1, pre)(f1), atol=1e-5)
+    flat = Preprocessing(sample_rate=fs, window=n, hop=n, remove_level=True)
+    np.testing.assert_allclose(represent(7.0 * ws, flat), represent(ws, flat), atol=1e-9)
     fs_, ft = represent(ws, pre), represent(wt, pre)
     src = domain_normaliser(fs_, pre)
     tgt = domain_normaliser(ft, pre, reference=src)
@@ -60,7 +65,48 @@ def test_log_spectrum_cancels_gain_and_domain_centring_cancels_a_transfer_path()
     assert np.corrcoef(tgt(ft)[:, line], stage_amp[1:])[0, 1] > 0.9
 
 
+@pytest.mark.parametrize("time_bandwidth, tapers", [(0.0, 1), (4.0, 5), (3.0, 3)])
+def test_log_spectrum_scatter_of_white_noise_matches_the_tapers_degrees_of_freedom(time_bandwidth, tapers):
+    """The log of an average of K independent chi-squared(2) powers has variance trigamma(K); the
+    value returned is half the log power, so its scatter over windows is sqrt(trigamma(K)) / 2
+    (0.641 for one Hann taper, 0.235 for NW = 4, whose five tapers leak at most 0.1 %)."""
+    from scipy.special import polygamma
+
+    from twin.transfer.preprocess import log_spectrum
+    w = np.random.default_rng(3).normal(size=(400, 512))
+    scatter = log_spectrum(w, time_bandwidth)[:, 40:-40].std(axis=0).mean()     # away from DC and Nyquist
+    assert scatter == pytest.approx(0.5 * np.sqrt(float(polygamma(1, tapers))), rel=0.05)
+
+
+def test_domain_normalisation_keeps_the_level_between_records_and_remove_level_drops_it():
+    """Two records of the same spectral shape, one 4x louder (a deeper wear): with the default the
+    louder one sits log(4) higher after the domain centring; with remove_level they coincide."""
+    rng = np.random.default_rng(1)
+    w = rng.normal(size=(8, 256))
+    both = np.vstack([w, 4.0 * w])
+    for remove_level, step in ((False, np.log(4.0)), (True, 0.0)):
+        pre = Preprocessing(sample_rate=1000.0, window=256, hop=256, remove_level=remove_level)
+        f = represent(both, pre)
+        g = domain_normaliser(f, pre)(f) * domain_normaliser(f, pre).scale
+        assert g[8:].mean() - g[:8].mean() == pytest.approx(step, abs=1e-6)
+
+
+def test_for_shaft_speed_gives_windows_of_two_pinion_revolutions():
+    assert Preprocessing.for_shaft_speed(20.0).sample_rate == 20480.0
+    pre = Preprocessing.for_shaft_speed(10.0, window=1024, hop=512)
+    assert pre.sample_rate * 2 / 10.0 == pre.window and pre.hop == 512
+    assert Preprocessing.for_shaft_speed(25.0, revolutions=1.0).sample_rate == 51200.0
+    with pytest.raises(ParameterError, match="shaft speed.*-3"):
+        Preprocessing.for_shaft_speed(-3.0)
+    with pytest.raises(ParameterError, match="revolutions"):
+        Preprocessing.for_shaft_speed(20.0, revolutions=0)
+
+
 def test_preprocessing_validates():
+    with pytest.raises(ParameterError, match="remove_level"):
+        Preprocessing(remove_level="yes")
+    with pytest.raises(ParameterError, match="time_bandwidth.*0.5"):
+        Preprocessing(time_bandwidth=0.5)
     with pytest.raises(ParameterError, match="window"):
         Preprocessing(window=100)
     with pytest.raises(ParameterError, match="normalise"):
