@@ -240,19 +240,18 @@ def _transfer_demo(out_dir: Path, epochs: int = 15):
     BENCHMARKS.md.
     """
     from twin.transfer.assessor import Assessor
-    from twin.transfer.benchmark import DataSettings, load_task_data, prepare_task
-    from twin.transfer.preprocess import Preprocessing
+    from twin.transfer.benchmark import DataSettings, load_task_data, prepare_task, task_preprocessing
 
     t = time.perf_counter()
     data = out_dir / "transfer_data"
     data.mkdir(exist_ok=True)
     settings = DataSettings(source_records_per_stage=8, target_records_per_stage=6)
     src, tgt = prepare_task("pitting", data, settings, progress=False)
-    # the assessors below use the default preprocessing, so its sample rate is the one to load at
-    source, adapt, test = load_task_data("pitting", str(src), str(tgt), Preprocessing().sample_rate)
+    pre = task_preprocessing("pitting")       # windows of two pinion revolutions, as in the benchmark
+    source, adapt, test = load_task_data("pitting", str(src), str(tgt), pre.sample_rate)
     accuracy, assessed = {}, None
     for method in ("cnn", "mmd", "proposed"):
-        a = Assessor(method, epochs=epochs, seed=0, progress=False)
+        a = Assessor(method, epochs=epochs, seed=0, preprocessing=pre, progress=False)
         a.fit(source, adapt)
         asm = a.assess(test)
         windows = [(r.label, w) for r in asm.records for w in r.window_stages]

@@ -22,7 +22,11 @@ def _cmd_train_assessor(args: argparse.Namespace) -> int:
     out = Path(args.out)
     if not out.parent.is_dir():    # before minutes of training, not after
         raise OutputPathError(f"output directory '{out.parent}' does not exist (for '{out}')")
-    a = transfer.Assessor(args.method, epochs=args.epochs, seed=args.seed, progress=not args.no_progress)
+    level = {"remove_level": args.remove_level}
+    pre = (transfer.Preprocessing(**level) if args.shaft_speed is None
+           else transfer.Preprocessing.for_shaft_speed(args.shaft_speed, **level))
+    a = transfer.Assessor(args.method, epochs=args.epochs, seed=args.seed, preprocessing=pre,
+                          progress=not args.no_progress)
     a.fit(Path(args.source), Path(args.target))
     a.save(out)
     last = a.history_[-1]
@@ -71,6 +75,13 @@ def add_subcommands(sub) -> None:
                    help="proposed (MMD + class contrastive, default), mmd, cnn (source only), coral")
     p.add_argument("--seed", type=int, default=0, help="seed of initialisation, batches, augmentation")
     p.add_argument("--epochs", type=int, default=80, help="passes over the source windows (default: 80)")
+    p.add_argument("--shaft-speed", type=float, metavar="HZ",
+                   help="nominal pinion speed of the test [Hz]: records are resampled so a 2048-sample window "
+                        "spans two pinion revolutions (default: 20 kHz, about two revolutions at 20 Hz)")
+    p.add_argument("--remove-level", action="store_true",
+                   help="remove each window's level and keep only the spectral shape: for pitting, whose early "
+                        "stages differ in level by less than the rig's gain scatter (the default keeps the level, "
+                        "which carries deep wear)")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bars")
     p.set_defaults(handler=_cmd_train_assessor)
 

@@ -23,7 +23,9 @@ sensor-mount resonance       2nd-order base-excitation transmissibility of the a
                              the simulation rate: a different transfer path
 sensor gain error            per-record log-normal gain, 10 % standard deviation
 measurement noise            white, 8 % of the record RMS (the archive has 5 %)
-operating scatter            speed and load scattered by 2 % and 10 % (archive: 1 % and 5 %)
+operating scatter            speed and load scattered by 2 % and 10 % (the scenarios'
+                             archives: 1 % and 5 %; the benchmark's source archive: 3 % and
+                             15 %)
 ===========================  ==================================================================
 
 A first, harsher default (10 um run-out, 3 kHz / Q 8 mount, 0.3 rad, 0.8 stiffness, 10 % noise)

@@ -55,6 +55,23 @@ def test_train_then_assess(tmp_path, capsys):
     assert "accuracy" in capsys.readouterr().out
 
 
+def test_shaft_speed_and_remove_level_reach_the_saved_preprocessing(tmp_path):
+    src = _file(tmp_path / "src.h5", False, True)
+    tgt = _file(tmp_path / "tgt.h5", True, True)
+    p = _parser()
+    args = p.parse_args(["train-assessor", "--source", str(src), "--target", str(tgt), "--out",
+                         str(tmp_path / "model"), "--epochs", "1", "--method", "cnn", "--shaft-speed", "10",
+                         "--remove-level", "--no-progress"])
+    assert args.handler(args) == 0
+    cfg = json.loads((tmp_path / "model" / "config.json").read_text())
+    assert cfg["preprocessing"]["sample_rate"] == 10240.0               # 2048 samples = 0.2 s = 2 revolutions
+    assert cfg["preprocessing"]["remove_level"] is True
+    args = p.parse_args(["assess", str(tmp_path / "model"), str(tgt), "--json", str(tmp_path / "stages.json")])
+    assert args.handler(args) == 0
+    out = json.loads((tmp_path / "stages.json").read_text())
+    assert len(out["records"][0]["windows"]) == (3072 - 2048) // 1024 + 1   # 0.3 s at 10.24 kHz
+
+
 def test_train_to_missing_directory_fails_early(tmp_path):
     from twin.errors import OutputPathError
     p = _parser()

@@ -1,0 +1,37 @@
+"""The benchmark's per-task settings and its statistics (no training here: that is bench/transfer.py)."""
+from __future__ import annotations
+
+import pytest
+
+from twin.errors import ParameterError
+from twin.transfer.benchmark import (TASK_SETTINGS, RunResult, markdown_table, summarise, task_preprocessing)
+
+
+def test_task_preprocessing_windows_two_revolutions_at_each_tests_speed():
+    pitting, wear = task_preprocessing("pitting"), task_preprocessing("wear")
+    assert pitting.sample_rate == 20480.0 and wear.sample_rate == 10240.0     # 20 Hz and 10 Hz tests
+    assert pitting.remove_level and not wear.remove_level
+    # records hold the same number of revolutions, so the same number of windows, at either speed
+    for task, pre in (("pitting", pitting), ("wear", wear)):
+        n = int(round(TASK_SETTINGS[task].source_record_duration * pre.sample_rate))
+        assert (n - pre.window) // pre.hop + 1 == 4
+    with pytest.raises(ParameterError, match="'gearbox'"):
+        task_preprocessing("gearbox")
+
+
+def _run(method, seed, acc):
+    return RunResult("wear", method, seed, acc, acc, 1.0, 10.0, [[1]], [])
+
+
+def test_summarise_pairs_methods_by_seed():
+    runs = [_run("cnn", s, a) for s, a in enumerate([0.80, 0.82, 0.81])]
+    runs += [_run("mmd", s, a) for s, a in enumerate([0.90, 0.91, 0.93])]
+    runs += [_run("proposed", s, a) for s, a in enumerate([0.91, 0.90, 0.95])]
+    s = summarise(runs)["wear"]
+    assert s["methods"]["mmd"]["mean"] == pytest.approx(0.9133333, abs=1e-6)
+    assert s["methods"]["cnn"]["std"] == pytest.approx(0.01, abs=1e-9)
+    d = s["paired"]["proposed-mmd"]
+    assert d["mean_diff"] == pytest.approx(0.0066667, abs=1e-6) and d["wins"] == 2 and d["n"] == 3
+    assert s["paired"]["mmd-cnn"]["paired_t_p"] < 0.05
+    table = markdown_table(summarise(runs))
+    assert "| wear | mmd | 91.3 +- 1.5 |" in table and "| wear | proposed-mmd | +0.7 | 2/3 |" in table
