@@ -61,11 +61,14 @@ def _source_ceiling(args, tasks) -> None:
 
     import numpy as np
 
+    from twin.errors import OutputPathError
     from twin.transfer.benchmark import _ceiling_star, prepare_task
 
-    from twin.errors import OutputPathError
-
-    data_dir = Path(args.data_dir) if args.data_dir else Path(args.out) / "data"
+    if args.data_dir:
+        data_dir = Path(args.data_dir)
+    else:       # OUT/data, as for the main run: main() made OUT's parent, run_benchmark makes OUT
+        Path(args.out).mkdir(exist_ok=True)
+        data_dir = Path(args.out) / "data"
     if not data_dir.parent.is_dir():
         raise OutputPathError(f"output directory '{data_dir.parent}' does not exist (for '{data_dir}')")
     data_dir.mkdir(exist_ok=True)
