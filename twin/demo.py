@@ -240,12 +240,14 @@ def _transfer_demo(out_dir: Path, epochs: int = 15):
     BENCHMARKS.md.
     """
     from twin.transfer.assessor import Assessor
-    from twin.transfer.benchmark import DataSettings, load_task_data, prepare_task, task_preprocessing
+    from dataclasses import replace
+
+    from twin.transfer.benchmark import TASK_SETTINGS, load_task_data, prepare_task, task_preprocessing
 
     t = time.perf_counter()
     data = out_dir / "transfer_data"
     data.mkdir(exist_ok=True)
-    settings = DataSettings(source_records_per_stage=8, target_records_per_stage=6)
+    settings = replace(TASK_SETTINGS["pitting"], source_records_per_stage=8, target_records_per_stage=6)
     src, tgt = prepare_task("pitting", data, settings, progress=False)
     pre = task_preprocessing("pitting")       # windows of two pinion revolutions, as in the benchmark
     source, adapt, test = load_task_data("pitting", str(src), str(tgt), pre.sample_rate)

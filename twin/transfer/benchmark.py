@@ -104,7 +104,7 @@ def prepare_task(task: str, data_dir: str | Path, settings: DataSettings | None 
 
     if task not in TASKS:
         raise ParameterError(f"unknown task {task!r}; use one of {', '.join(TASKS)}")
-    settings = settings or TASK_SETTINGS[task]
+    settings = TASK_SETTINGS[task] if settings is None else settings
     data_dir = Path(data_dir)
     if not data_dir.is_dir():
         from twin.errors import OutputPathError
