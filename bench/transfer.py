@@ -30,6 +30,8 @@ def main() -> None:
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--out", default=str(REPO / "bench_out" / "transfer"))
     ap.add_argument("--data-dir", default=None)
+    ap.add_argument("--rig", choices=("rig", "blind"), default="rig",
+                    help="the emulated rig of the target data (blind: fixed after every choice, only scored)")
     ap.add_argument("--source-ceiling", action="store_true",
                     help="instead: the source-only CNN on held-out *source* records (no domain shift), per seed")
     args = ap.parse_args()
@@ -45,12 +47,13 @@ def main() -> None:
         return
     t = time.perf_counter()
     summary = run_benchmark(out, tasks=tasks, seeds=args.seeds, epochs=args.epochs, jobs=args.jobs,
-                            data_dir=args.data_dir)
+                            data_dir=args.data_dir, rig=args.rig)
     wall = time.perf_counter() - t
     cpu = next((ln.split(":", 1)[1].strip() for ln in open("/proc/cpuinfo") if ln.startswith("model name")), "?")
     print(f"Machine: {cpu}, {len(os.sched_getaffinity(0))} cores, Python {platform.python_version()}, "
           f"torch {torch.__version__} (CPU, 1 thread per training run, {args.jobs} runs in parallel)")
-    print(f"{args.seeds} seeds x 3 methods x {len(tasks)} task(s), {args.epochs} epochs; total wall time {wall:.0f} s\n")
+    print(f"{args.seeds} seeds x 3 methods x {len(tasks)} task(s), {args.epochs} epochs, rig '{args.rig}'; "
+          f"total wall time {wall:.0f} s\n")
     print(markdown_table(summary))
     print(f"\nfigures and report.html -> {out}")
 

@@ -247,7 +247,7 @@ def _transfer_demo(out_dir: Path, epochs: int = 15):
     t = time.perf_counter()
     data = out_dir / "transfer_data"
     data.mkdir(exist_ok=True)
-    settings = replace(TASK_SETTINGS["pitting"], source_records_per_stage=8, target_records_per_stage=6)
+    settings = replace(TASK_SETTINGS["pitting"], source_records_per_stage=16, target_records_per_stage=6)
     src, tgt = prepare_task("pitting", data, settings, progress=False)
     pre = task_preprocessing("pitting")       # windows of two pinion revolutions, as in the benchmark
     source, adapt, test = load_task_data("pitting", str(src), str(tgt), pre.sample_rate)

@@ -58,7 +58,7 @@ def _cmd_benchmark_transfer(args: argparse.Namespace) -> int:
     tasks = ("pitting", "wear") if args.task == "both" else (args.task,)
     summary = bench.run_benchmark(Path(args.out), tasks=tasks, seeds=args.seeds, epochs=args.epochs,
                                   jobs=args.jobs, data_dir=Path(args.data_dir) if args.data_dir else None,
-                                  progress=not args.no_progress)
+                                  rig=args.rig, progress=not args.no_progress)
     print(bench.markdown_table(summary))
     print(f"report -> {Path(args.out) / 'report.html'}")
     return 0
@@ -98,5 +98,8 @@ def add_subcommands(sub) -> None:
     p.add_argument("--epochs", type=int, default=80, help="epochs per training run (default: 80)")
     p.add_argument("--jobs", type=int, default=2, help="training runs in parallel (default: 2)")
     p.add_argument("--data-dir", help="where the simulated source/target data are cached (default: OUT/data)")
+    p.add_argument("--rig", choices=("rig", "blind"), default="rig",
+                   help="emulated rig of the target data: the benchmark's (default) or the blind one, fixed "
+                        "after every setting was chosen")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bars")
     p.set_defaults(handler=_cmd_benchmark_transfer)

@@ -1,10 +1,13 @@
 """The benchmark's per-task settings and its statistics (no training here: that is bench/transfer.py)."""
 from __future__ import annotations
 
+from dataclasses import replace
+
 import pytest
 
 from twin.errors import ParameterError
-from twin.transfer.benchmark import (TASK_SETTINGS, RunResult, markdown_table, summarise, task_preprocessing)
+from twin.transfer.benchmark import (RIGS, TASK_SETTINGS, DataSettings, RunResult, markdown_table, rig_settings,
+                                     run_benchmark, summarise, task_preprocessing)
 
 
 def test_task_preprocessing_windows_two_revolutions_at_each_tests_speed():
@@ -14,9 +17,29 @@ def test_task_preprocessing_windows_two_revolutions_at_each_tests_speed():
     # records hold the same number of revolutions, so the same number of windows, at either speed
     for task, pre in (("pitting", pitting), ("wear", wear)):
         n = int(round(TASK_SETTINGS[task].source_record_duration * pre.sample_rate))
-        assert (n - pre.window) // pre.hop + 1 == 4
+        assert (n - pre.window) // pre.hop + 1 == 2
     with pytest.raises(ParameterError, match="'gearbox'"):
         task_preprocessing("gearbox")
+
+
+def test_blind_rig_changes_only_the_target_rig_and_its_data_seed():
+    for task in ("pitting", "wear"):
+        blind = rig_settings(task, "blind")
+        assert blind.rig == "blind" and blind.target_seed != TASK_SETTINGS[task].target_seed
+        assert replace(blind, rig="rig", target_seed=TASK_SETTINGS[task].target_seed) == TASK_SETTINGS[task]
+        assert rig_settings(task) == TASK_SETTINGS[task]
+    rig, other = RIGS["rig"], RIGS["blind"]
+    assert other.resonance_hz != rig.resonance_hz and other.pedestal_stiffness_factor != rig.pedestal_stiffness_factor
+
+
+def test_unknown_rig_is_refused_before_any_data_are_built(tmp_path):
+    with pytest.raises(ParameterError, match="'garage'"):
+        DataSettings(rig="garage")
+    with pytest.raises(ParameterError, match="'garage'"):
+        rig_settings("wear", "garage")
+    with pytest.raises(ParameterError, match="'garage'"):
+        run_benchmark(tmp_path / "out", rig="garage", progress=False)
+    assert not (tmp_path / "out" / "data").exists()
 
 
 def _run(method, seed, acc):
