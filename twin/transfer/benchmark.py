@@ -149,9 +149,10 @@ def prepare_task(task: str, data_dir: str | Path, settings: DataSettings | None 
     if not data_dir.is_dir():
         from twin.errors import OutputPathError
         raise OutputPathError(f"data directory '{data_dir}' does not exist")
-    # The default rig keeps the plain names; another rig's target (and key) carry its name.
+    # The default rig keeps the plain names; another rig's files carry its name.  Each rig has its
+    # own copy of the source archive, so one key always describes the pair it sits next to.
     tag = task if settings.rig == "rig" else f"{task}_{settings.rig}"
-    src, tgt, key = data_dir / f"source_{task}.h5", data_dir / f"target_{tag}.h5", data_dir / f"{tag}.json"
+    src, tgt, key = data_dir / f"source_{tag}.h5", data_dir / f"target_{tag}.h5", data_dir / f"{tag}.json"
     wanted = json.dumps(asdict(settings), sort_keys=True)
     if src.exists() and tgt.exists() and key.exists() and key.read_text() == wanted:
         return src, tgt
