@@ -58,3 +58,39 @@ def test_summarise_pairs_methods_by_seed():
     assert s["paired"]["mmd-cnn"]["paired_t_p"] < 0.05
     table = markdown_table(summarise(runs))
     assert "| wear | mmd | 91.3 +- 1.5 |" in table and "| wear | proposed-mmd | +0.7 | 2/3 |" in table
+
+
+def test_prepare_task_keeps_each_rigs_data_apart_and_reuses_it(tmp_path, monkeypatch):
+    """The cache logic only: the simulations are replaced by recorders that write marker files."""
+    import twin.archive
+    import twin.degradation_run
+    import twin.scenario
+    import twin.transfer.domain
+    from twin.transfer.benchmark import prepare_task
+
+    calls = []
+
+    def build_archive(sc, path, **kw):
+        calls.append(("source", path.name))
+        path.write_text(f"{sc.archive['records_per_stage']}")
+
+    def make_target_domain(sc, path, *, shift, seed, **kw):
+        calls.append(("target", path.name))
+        path.write_text(f"{shift.resonance_hz} {seed}")
+
+    monkeypatch.setattr(twin.scenario.Scenario, "fmu_path", lambda self: tmp_path / "model.fmu")
+    monkeypatch.setattr(twin.archive, "build_archive", build_archive)
+    monkeypatch.setattr(twin.degradation_run, "run_degradation", lambda *a, **kw: None)
+    monkeypatch.setattr(twin.transfer.domain, "make_target_domain", make_target_domain)
+
+    rig = prepare_task("wear", tmp_path, progress=False)
+    blind = prepare_task("wear", tmp_path, rig_settings("wear", "blind"), progress=False)
+    assert [p.name for p in rig] == ["source_wear.h5", "target_wear.h5"]
+    assert [p.name for p in blind] == ["source_wear_blind.h5", "target_wear_blind.h5"]
+    assert blind[1].read_text() == f"{RIGS['blind'].resonance_hz} 2" and rig[1].read_text() == f"{RIGS['rig'].resonance_hz} 1"
+    n = len(calls)
+    assert prepare_task("wear", tmp_path, progress=False) == rig and len(calls) == n      # reused, not rebuilt
+    changed = replace(TASK_SETTINGS["wear"], source_records_per_stage=3)
+    prepare_task("wear", tmp_path, changed, progress=False)                                  # new settings: rebuilt
+    assert calls[n:] == [("source", "source_wear.h5"), ("target", "target_wear.h5")]
+    assert rig[0].read_text() == "3" and blind[0].read_text() == "32"                       # the blind pair untouched
