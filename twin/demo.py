@@ -239,9 +239,9 @@ def _transfer_demo(out_dir: Path, epochs: int = 15):
     the demo stays within minutes; the figures over 5 seeds with the paper's 80 epochs are in
     BENCHMARKS.md.
     """
-    from twin.transfer.assessor import Assessor
     from dataclasses import replace
 
+    from twin.transfer.assessor import Assessor
     from twin.transfer.benchmark import TASK_SETTINGS, load_task_data, prepare_task, task_preprocessing
 
     t = time.perf_counter()

@@ -45,6 +45,7 @@ from pathlib import Path
 import numpy as np
 
 from twin.errors import ParameterError
+from twin.transfer.domain import TargetShift
 
 REPO = Path(__file__).resolve().parents[2]
 TASKS = {"pitting": "scenarios/lubricated.yaml", "wear": "scenarios/dry.yaml"}
@@ -70,8 +71,7 @@ class DataSettings:
     rig: str = "rig"
 
     def __post_init__(self) -> None:
-        if self.rig not in RIGS:
-            raise ParameterError(f"unknown rig {self.rig!r}; use one of {', '.join(RIGS)}")
+        _check_rig(self.rig)
 
 
 # The emulated rigs (twin.transfer.domain.TargetShift).  "rig" is the benchmark's: every setting of
@@ -79,16 +79,16 @@ class DataSettings:
 # second rig, fixed after all those choices (stop 11) and only ever scored: a stiffer pedestal
 # instead of a softer one, the sensor tilted by half the angle, a lower and sharper mount resonance,
 # less run-out and noise, its own data seed (2).  A result on it is a blind test of the settings.
-def _rigs() -> dict:
-    from twin.transfer.domain import TargetShift
-    return {"rig": TargetShift(),
-            "blind": TargetShift(runout=3e-6, sensor_angle=0.1, pedestal_stiffness_factor=1.15,
-                                 resonance_hz=3300.0, resonance_q=6.0, gain_error=0.10, noise=0.06,
-                                 speed_scatter=0.02, load_scatter=0.10)}
-
-
-RIGS = _rigs()
+RIGS = {"rig": TargetShift(),
+        "blind": TargetShift(runout=3e-6, sensor_angle=0.1, pedestal_stiffness_factor=1.15,
+                             resonance_hz=3300.0, resonance_q=6.0, gain_error=0.10, noise=0.06,
+                             speed_scatter=0.02, load_scatter=0.10)}
 RIG_SEEDS = {"rig": 1, "blind": 2}
+
+
+def _check_rig(rig: str) -> None:
+    if rig not in RIGS:
+        raise ParameterError(f"unknown rig {rig!r}; use one of {', '.join(RIGS)}")
 
 
 # Record lengths in the same number of pinion revolutions for both tests: the dry test runs at
@@ -112,8 +112,7 @@ def rig_settings(task: str, rig: str = "rig") -> DataSettings:
 
     if task not in TASKS:
         raise ParameterError(f"unknown task {task!r}; use one of {', '.join(TASKS)}")
-    if rig not in RIGS:
-        raise ParameterError(f"unknown rig {rig!r}; use one of {', '.join(RIGS)}")
+    _check_rig(rig)
     return replace(TASK_SETTINGS[task], rig=rig, target_seed=RIG_SEEDS[rig])
 
 
@@ -332,8 +331,7 @@ def run_benchmark(out: str | Path, *, tasks: tuple[str, ...] = ("pitting", "wear
     from twin.errors import OutputPathError
 
     out = Path(out)
-    if rig not in RIGS:
-        raise ParameterError(f"unknown rig {rig!r}; use one of {', '.join(RIGS)}")
+    _check_rig(rig)
     if not out.parent.is_dir():
         raise OutputPathError(f"output directory '{out.parent}' does not exist (for '{out}')")
     out.mkdir(exist_ok=True)
