@@ -1,4 +1,5 @@
-"""The benchmark's per-task settings and its statistics (no training here: that is bench/transfer.py)."""
+"""The benchmark's per-task settings, its statistics and its references (training only on tiny synthetic data;
+the real runs are bench/transfer.py)."""
 from __future__ import annotations
 
 from dataclasses import replace
@@ -94,3 +95,44 @@ def test_prepare_task_keeps_each_rigs_data_apart_and_reuses_it(tmp_path, monkeyp
     prepare_task("wear", tmp_path, changed, progress=False)                                  # new settings: rebuilt
     assert calls[n:] == [("source", "source_wear.h5"), ("target", "target_wear.h5")]
     assert rig[0].read_text() == "3" and blind[0].read_text() == "32"                       # the blind pair untouched
+
+
+def _rig_file(tmp_path, name, shuffle_labels=False):
+    from twin.measurements import MeasurementSet, write_measurements
+
+    from .conftest import make_records
+
+    recs = make_records(8, shifted=True, seed=2, duration=0.768)
+    if shuffle_labels:       # each record keeps one label for both halves, unrelated to its signal
+        import numpy as np
+        labels = np.random.default_rng(0).permutation([r.label for r in recs])
+        recs = [replace(r, label=int(k)) for r, k in zip(recs, labels)]
+    return write_measurements(MeasurementSet(tuple(recs), None, (), {}), tmp_path / name)
+
+
+def test_target_ceiling_trains_on_the_rigs_first_halves_and_scores_the_second(tmp_path, monkeypatch, tiny_pre):
+    from twin.transfer import benchmark
+    from twin.transfer.assessor import Assessor
+
+    monkeypatch.setattr(benchmark, "task_preprocessing", lambda task: tiny_pre)
+    seen = {}
+    fit, score = Assessor.fit, Assessor.score
+
+    def spy_fit(self, source, target, **kw):
+        seen["fit"] = [(r.time_start, r.n_samples, r.label) for r in source]
+        seen["fit_target_labels"] = {r.label for r in target}
+        return fit(self, source, target, **kw)
+
+    def spy_score(self, data, labels=None):
+        seen["score"] = [(r.time_start, r.n_samples) for r in data]
+        return score(self, data, labels)
+
+    monkeypatch.setattr(Assessor, "fit", spy_fit)
+    monkeypatch.setattr(Assessor, "score", spy_score)
+    acc = benchmark.target_ceiling("wear", str(_rig_file(tmp_path, "rig.h5")), seed=0, epochs=6)
+    assert all(t0 == 0 and n == 384 and k is not None for t0, n, k in seen["fit"])
+    assert seen["fit_target_labels"] == {None}
+    assert all(t0 == pytest.approx(0.384) and n == 384 for t0, n in seen["score"])
+    assert acc >= 0.9
+    # the rig's labels are what it learns from: labels unrelated to the signals leave it near chance
+    assert benchmark.target_ceiling("wear", str(_rig_file(tmp_path, "shuffled.h5", True)), seed=0, epochs=6) < 0.6
