@@ -1,0 +1,125 @@
+"""Why the wear stages are hard to transfer: level and spectral-shape statistics of the benchmark data.
+
+    python bench/transfer_diagnostics.py --data-dir DIR [--rig rig|blind] [--task wear]
+
+Reads the source archive and the target records that ``bench/transfer.py`` built in DIR
+(``twin.transfer.benchmark.prepare_task``; nothing is simulated or trained here) and prints, per
+stage and per domain, the following. Target labels are read here, for diagnosis only.
+
+* the mean and spread of each record's log RMS, after the domain's mean is removed: the
+  "level" cue that the assessor keeps for wear;
+* a level-only reference: a Gaussian classifier of the record log RMS, fitted on the rig's
+  labelled first halves and scored on its second halves (what the level alone allows on that
+  rig, whatever a method learns from the twin);
+* per pair of neighbouring stages, the change of the level-free log spectrum (64 bands) in
+  each domain, and the correlation of the two changes (how well the *shape* cue carries over);
+* a linear probe: a shrinkage LDA trained on the twin's windows (shape, level, or both; each
+  domain centred on its own mean) and scored on the rig's test windows, with no adaptation.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO))
+
+BANDS = 64
+
+
+def _levels(records, channel: str) -> np.ndarray:
+    return np.array([np.log(np.std(r[channel])) for r in records])
+
+
+def _window_features(records, pre) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(window level (n,), level-free log spectrum in BANDS bands (n, BANDS), label (n,))."""
+    from twin.transfer.preprocess import log_spectrum, prepare, window_signal
+
+    levels, shapes, labels = [], [], []
+    for p in prepare(records, pre):
+        spec = log_spectrum(window_signal(p.signal, pre.window, pre.hop), pre.time_bandwidth)
+        level = spec.mean(axis=1)
+        levels.append(level)
+        shapes.append((spec - level[:, None]).reshape(len(spec), BANDS, -1).mean(axis=2))
+        labels.append(np.full(len(spec), -1 if p.label is None else p.label))
+    return np.concatenate(levels), np.concatenate(shapes), np.concatenate(labels)
+
+
+def _lda(x: np.ndarray, y: np.ndarray, shrinkage: float):
+    """Shrinkage linear discriminant: returns predict(z) for z (n, d)."""
+    k = int(y.max()) + 1
+    mu = np.array([x[y == c].mean(axis=0) for c in range(k)])
+    cov = np.atleast_2d(np.cov((x - mu[y]).T))
+    cov = (1 - shrinkage) * cov + shrinkage * np.trace(cov) / cov.shape[0] * np.eye(cov.shape[0])
+    w = np.linalg.solve(cov, mu.T)
+    b = -0.5 * np.sum(mu.T * w, axis=0)
+    return lambda z: np.argmax(z @ w + b, axis=1)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--data-dir", required=True, help="the data directory of bench/transfer.py (its --data-dir)")
+    ap.add_argument("--task", choices=("pitting", "wear"), default="wear")
+    ap.add_argument("--rig", choices=("rig", "blind"), default="rig")
+    args = ap.parse_args()
+
+    from twin.measurements import load_measurements
+    from twin.transfer.benchmark import prepare_task, rig_settings, task_preprocessing
+    from twin.transfer.preprocess import split_records
+
+    src_path, tgt_path = prepare_task(args.task, args.data_dir, rig_settings(args.task, args.rig))
+    pre = replace(task_preprocessing(args.task), remove_level=False)
+    ch = pre.channel
+    src = load_measurements(src_path, channels=[ch], resample_to=pre.sample_rate).records
+    tgt = load_measurements(tgt_path, channels=[ch], resample_to=pre.sample_rate).records
+    adapt, test = split_records(tgt, 0.5)
+    k = 1 + max(r.label for r in src)
+
+    print(f"{args.task}, rig '{args.rig}': {len(src)} source records, {len(tgt)} target records\n")
+    print("| stage | source log RMS (centred), mean / sd | rig log RMS (centred), mean / sd |")
+    print("|---|---|---|")
+    ls, lt = _levels(src, ch), _levels(tgt, ch)
+    ys, yt = np.array([r.label for r in src]), np.array([r.label for r in tgt])
+    ls, lt = ls - ls.mean(), lt - lt.mean()
+    for c in range(k):
+        print(f"| {c + 1} | {ls[ys == c].mean():+.2f} / {ls[ys == c].std():.2f} | "
+              f"{lt[yt == c].mean():+.2f} / {lt[yt == c].std():.2f} |")
+
+    la, lb = _levels(adapt, ch), _levels(test, ch)
+    ya, yb = np.array([r.label for r in adapt]), np.array([r.label for r in test])
+    mu = np.array([la[ya == c].mean() for c in range(k)])
+    sd = np.array([la[ya == c].std() for c in range(k)])
+    loglik = -0.5 * ((lb[:, None] - mu) / sd) ** 2 - np.log(sd)
+    print(f"\nLevel-only classifier fitted on the rig's labelled first halves: "
+          f"{100 * np.mean(loglik.argmax(axis=1) == yb):.1f} % of the second halves (records)\n")
+
+    lev_s, shp_s, y_s = _window_features(src, pre)
+    _, shp_a, _ = _window_features(adapt, pre)
+    lev_a = _window_features(adapt, pre)[0]
+    lev_t, shp_t, y_t = _window_features(test, pre)
+    # Each domain centred on its own unlabelled mean, as the assessor's domain normaliser does.
+    shp_s, shp_t = shp_s - shp_s.mean(axis=0), shp_t - shp_a.mean(axis=0)
+    lev_s, lev_t = lev_s - lev_s.mean(), lev_t - lev_a.mean()
+    _, shp_full, y_full = _window_features(tgt, pre)
+    shp_full = shp_full - shp_full.mean(axis=0)
+    print("| stages | shape change, twin [norm] | shape change, rig [norm] | correlation |")
+    print("|---|---|---|---|")
+    for a in range(k - 1):
+        d_s = shp_s[y_s == a + 1].mean(axis=0) - shp_s[y_s == a].mean(axis=0)
+        d_t = shp_full[y_full == a + 1].mean(axis=0) - shp_full[y_full == a].mean(axis=0)
+        print(f"| {a + 1} -> {a + 2} | {np.linalg.norm(d_s):.2f} | {np.linalg.norm(d_t):.2f} | "
+              f"{np.corrcoef(d_s, d_t)[0, 1]:.2f} |")
+
+    print("\n| linear probe trained on the twin, no adaptation | rig test windows [%] |\n|---|---|")
+    for name, xs, xt in (("shape", shp_s, shp_t), ("level", lev_s[:, None], lev_t[:, None]),
+                         ("shape + level", np.c_[shp_s, lev_s], np.c_[shp_t, lev_t])):
+        predict = _lda(xs, y_s, shrinkage=0.1)
+        print(f"| {name} | {100 * np.mean(predict(xt) == y_t):.1f} |")
+
+
+if __name__ == "__main__":
+    main()
