@@ -37,9 +37,10 @@ def main() -> None:
     ap.add_argument("--data-dir", default=None)
     ap.add_argument("--rig", choices=("rig", "blind"), default="rig",
                     help="the emulated rig of the target data (blind: fixed after every choice, only scored)")
-    ap.add_argument("--source-ceiling", action="store_true",
+    ref = ap.add_mutually_exclusive_group()
+    ref.add_argument("--source-ceiling", action="store_true",
                     help="instead: the source-only CNN on held-out *source* records (no domain shift), per seed")
-    ap.add_argument("--target-ceiling", action="store_true",
+    ref.add_argument("--target-ceiling", action="store_true",
                     help="instead: a CNN trained on the rig's own labelled first halves, tested on the "
                          "second halves (no transfer), per seed")
     args = ap.parse_args()
