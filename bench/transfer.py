@@ -28,6 +28,8 @@ sys.path.insert(0, str(REPO))
 
 
 def main() -> None:
+    from twin.transfer.benchmark import RIGS
+
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--seeds", type=int, default=5)
     ap.add_argument("--task", choices=("pitting", "wear", "both"), default="both")
@@ -35,7 +37,7 @@ def main() -> None:
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--out", default=str(REPO / "bench_out" / "transfer"))
     ap.add_argument("--data-dir", default=None)
-    ap.add_argument("--rig", choices=("rig", "blind"), default="rig",
+    ap.add_argument("--rig", choices=tuple(RIGS), default="rig",
                     help="the emulated rig of the target data (blind: fixed after every choice, only scored)")
     ref = ap.add_mutually_exclusive_group()
     ref.add_argument("--source-ceiling", action="store_true",

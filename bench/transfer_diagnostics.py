@@ -64,11 +64,11 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--data-dir", required=True, help="the data directory of bench/transfer.py (its --data-dir)")
     ap.add_argument("--task", choices=("pitting", "wear"), default="wear")
-    ap.add_argument("--rig", choices=("rig", "blind"), default="rig")
-    args = ap.parse_args()
-
     from twin.measurements import load_measurements
-    from twin.transfer.benchmark import prepare_task, rig_settings, task_preprocessing
+    from twin.transfer.benchmark import RIGS, prepare_task, rig_settings, task_preprocessing
+
+    ap.add_argument("--rig", choices=tuple(RIGS), default="rig")
+    args = ap.parse_args()
     from twin.transfer.preprocess import split_records
 
     src_path, tgt_path = prepare_task(args.task, args.data_dir, rig_settings(args.task, args.rig))
@@ -98,8 +98,7 @@ def main() -> None:
           f"{100 * np.mean(loglik.argmax(axis=1) == yb):.1f} % of the second halves (records)\n")
 
     lev_s, shp_s, y_s = _window_features(src, pre)
-    _, shp_a, _ = _window_features(adapt, pre)
-    lev_a = _window_features(adapt, pre)[0]
+    lev_a, shp_a, _ = _window_features(adapt, pre)
     lev_t, shp_t, y_t = _window_features(test, pre)
     # Each domain centred on its own unlabelled mean, as the assessor's domain normaliser does.
     shp_s, shp_t = shp_s - shp_s.mean(axis=0), shp_t - shp_a.mean(axis=0)

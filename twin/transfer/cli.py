@@ -98,7 +98,9 @@ def add_subcommands(sub) -> None:
     p.add_argument("--epochs", type=int, default=80, help="epochs per training run (default: 80)")
     p.add_argument("--jobs", type=int, default=2, help="training runs in parallel (default: 2)")
     p.add_argument("--data-dir", help="where the simulated source/target data are cached (default: OUT/data)")
-    p.add_argument("--rig", choices=("rig", "blind"), default="rig",
+    from twin.transfer.benchmark import RIGS      # numpy only: twin --help stays free of torch
+
+    p.add_argument("--rig", choices=tuple(RIGS), default="rig",
                    help="emulated rig of the target data: the benchmark's (default) or the blind one, fixed "
                         "after every setting was chosen")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bars")
