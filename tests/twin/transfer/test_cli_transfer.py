@@ -29,6 +29,19 @@ def _file(path, shifted, labelled):
     return write_measurements(recs, path)
 
 
+def test_rig_choices_are_the_benchmarks_rigs():
+    from twin.transfer.benchmark import RIGS
+
+    p = _parser()
+    for rig in RIGS:
+        assert p.parse_args(["benchmark-transfer", "--out", "x", "--rig", rig]).rig == rig
+    with pytest.raises(SystemExit):
+        p.parse_args(["benchmark-transfer", "--out", "x", "--rig", "garage"])
+    choices = next(a.choices for a in p._subparsers._group_actions[0].choices["benchmark-transfer"]._actions
+                   if a.dest == "rig")
+    assert tuple(choices) == tuple(RIGS)
+
+
 def test_registers_three_commands():
     p = _parser()
     assert p.parse_args(["assess", "a", "m.h5"]).handler.__name__ == "_cmd_assess"
