@@ -16,6 +16,11 @@ Methods (``method=``):
   on gated target pseudo-labels (see :func:`twin.transfer.losses.pseudo_label_gate`).
 * ``"coral"`` -- Eq. 15 + ``alpha`` * CORAL, a cheap extra baseline.
 
+Every method that adapts (all but ``"cnn"``) ends with a **class-prior match**
+(``class_prior="source"``, :mod:`twin.transfer.prior`): per-stage logit offsets, fitted on the
+unlabelled adaptation windows so that the rig's mean stage probabilities equal the twin's stage
+proportions, move the decision boundaries the rig has shifted.  ``class_prior=None`` switches it off.
+
 Training (paper Table 3 defaults): SGD with momentum 0.9 and weight decay 5e-4, initial learning
 rate ``lr`` = 0.01 annealed as ``lr / (1 + 10 p)^0.75`` over the training progress ``p`` in [0, 1]
 (the usual domain-adaptation schedule), batches of ``batch_size`` = 20 source windows paired with
@@ -46,9 +51,11 @@ __all__ = ["Assessment", "Assessor", "METHODS", "RecordAssessment"]
 
 METHODS = ("cnn", "mmd", "proposed", "coral")
 SAVE_FORMAT = "gear-twin-assessor"
-SAVE_VERSION = 3
-# version 1: waveform only, one scale per domain; version 2: log spectra under one Hann taper, level removed
-_READABLE_VERSIONS = (1, 2, 3)
+SAVE_VERSION = 4
+# version 1: waveform only, one scale per domain; version 2: log spectra under one Hann taper, level removed;
+# version 3: no class-prior match (its assessors load with zero offsets, as they were trained)
+_READABLE_VERSIONS = (1, 2, 3, 4)
+CLASS_PRIORS = ("source", None)
 _EVAL_BATCH = 256
 
 
@@ -137,6 +144,12 @@ class Assessor:
         Torch CPU threads during ``fit`` (determinism does not depend on it, speed does).
     progress : bool
         Progress bars.
+    class_prior : {"source", None}
+        ``"source"``: after training, offset the stage logits on rig data so that the mean stage
+        probabilities of the adaptation windows equal the twin's stage proportions
+        (:mod:`twin.transfer.prior`; methods that adapt only).  It assumes the rig's adaptation
+        data cover the stages in about the twin's proportions, as the domain normalisation does.
+        ``None``: no offsets.
 
     Attributes (after ``fit``)
     --------------------------
@@ -152,13 +165,16 @@ class Assessor:
         waveform scale [channel unit], or the mean log spectrum (window,) and the shared scale.
     fit_time_ : float
         Wall time of the training loop [s].
+    target_log_weights_ : ndarray (K,)
+        Logit offsets applied to rig (target-domain) data; zeros without a class-prior match.
     """
 
     def __init__(self, method: str = "proposed", *, alpha: float = 0.1, beta: float = 0.1, lr: float = 0.01,
                  batch_size: int = 20, epochs: int = 80, threshold: float = 0.9, warmup_epochs: int = 10,
                  margin: float = 1.0, pairs: str = "all", preprocessing: Preprocessing | None = None,
                  augmentation: Augmentation | None | str = "default", n_stages: int | None = None,
-                 seed: int = 0, device: str | None = None, n_threads: int = 1, progress: bool = True):
+                 seed: int = 0, device: str | None = None, n_threads: int = 1, progress: bool = True,
+                 class_prior: str | None = "source"):
         self.method = method
         self.alpha = alpha
         self.beta = beta
@@ -176,10 +192,12 @@ class Assessor:
         self.device = device
         self.n_threads = n_threads
         self.progress = progress
+        self.class_prior = class_prior
 
     # ---- scikit-learn plumbing ---------------------------------------------------------------
     _PARAMS = ("method", "alpha", "beta", "lr", "batch_size", "epochs", "threshold", "warmup_epochs", "margin",
-               "pairs", "preprocessing", "augmentation", "n_stages", "seed", "device", "n_threads", "progress")
+               "pairs", "preprocessing", "augmentation", "n_stages", "seed", "device", "n_threads", "progress",
+               "class_prior")
 
     def get_params(self, deep: bool = True) -> dict:
         return {k: getattr(self, k) for k in self._PARAMS}
@@ -230,6 +248,8 @@ class Assessor:
             bad("margin", "must be in (0, 4]")
         if self.pairs not in ("all", "diagonal"):
             bad("pairs", "use 'all' or 'diagonal'")
+        if self.class_prior not in CLASS_PRIORS:
+            bad("class_prior", "use 'source' or None")
         if self.n_stages is not None and (isinstance(self.n_stages, bool) or not isinstance(self.n_stages, int)
                                           or self.n_stages < 2):
             bad("n_stages", "must be an integer >= 2")
@@ -347,6 +367,7 @@ class Assessor:
             xt_t = torch.from_numpy(xt).unsqueeze(1).to(device)
             adapt = self.method != "cnn"
             history = []
+            self.target_log_weights_ = np.zeros(k)      # the monitor sees the network as trained
             bar = progress_bar(self.epochs, self.progress, f"train {self.method}", "epoch")
             t_start = time.perf_counter()
             step = 0
@@ -426,6 +447,10 @@ class Assessor:
         self.n_classes_ = k
         self.classes_ = np.arange(k)
         self.history_ = history
+        if adapt and self.class_prior == "source":
+            from twin.transfer.prior import match_class_prior
+            prior = np.bincount(ys_fixed.astype(np.int64), minlength=k) / ys_fixed.size
+            self.target_log_weights_ = match_class_prior(self._forward(xt)[1], prior)
         self.n_source_windows_ = int(n_s)
         self.n_target_windows_ = int(xt.shape[0])
         return self
@@ -450,8 +475,13 @@ class Assessor:
         net.train(was_training)
         return np.concatenate(feats), np.concatenate(probs)
 
-    def _proba_windows(self, x: np.ndarray) -> np.ndarray:
-        return self._forward(x)[1]
+    def _proba_windows(self, x: np.ndarray, domain: str = "target") -> np.ndarray:
+        p = self._forward(x)[1]
+        w = getattr(self, "target_log_weights_", None)
+        if domain == "target" and w is not None and np.any(w != 0):
+            from twin.transfer.prior import apply_log_weights
+            p = apply_log_weights(p, w)
+        return p
 
     def _windows(self, data, what: str, domain: str = "target"):
         """(windows (n, window), record index (n,), labels (n,), prepared records, is_array).
@@ -481,7 +511,7 @@ class Assessor:
         (mean over the record's windows) for records.  Data are taken as rig data (``domain``)."""
         self._check_fitted()
         x, rec, _, prepared, is_array = self._windows(data, "predict", domain)
-        p = self._proba_windows(x)
+        p = self._proba_windows(x, domain)
         if is_array:
             return p
         return np.stack([p[rec == i].mean(0) for i in range(len(prepared))])
@@ -500,7 +530,7 @@ class Assessor:
         """
         self._check_fitted()
         x, rec, lab, prepared, _ = self._windows(data, "assess", domain)
-        p = self._proba_windows(x)
+        p = self._proba_windows(x, domain)
         self._check_labels([q.label for q in prepared if q.label is not None], "assess")
         out = []
         for i, q in enumerate(prepared):
@@ -565,7 +595,8 @@ class Assessor:
                   "n_source_windows": self.n_source_windows_, "n_target_windows": self.n_target_windows_,
                   "fit_time": getattr(self, "fit_time_", None),
                   "source_normaliser": self.source_normaliser_.to_dict(),
-                  "target_normaliser": self.target_normaliser_.to_dict()}
+                  "target_normaliser": self.target_normaliser_.to_dict(),
+                  "target_log_weights": [float(v) for v in self.target_log_weights_]}
         with atomic_path(d / "weights.pt") as tmp:
             torch.save({k: v.cpu() for k, v in self.network_.state_dict().items()}, tmp)
         with atomic_path(d / "config.json") as tmp:
@@ -598,10 +629,12 @@ class Assessor:
             raise AssessorError(f"'{cfg_file}' has format {cfg.get('format')!r} version "
                                 f"{cfg.get('format_version')!r}; expected {SAVE_FORMAT!r} {SAVE_VERSION}")
         params = dict(cfg["params"])
+        version = cfg["format_version"]
+        if version < 4:     # trained before the class-prior match existed
+            params["class_prior"] = None
         if device is not None:
             params["device"] = device
         aug = Augmentation(**cfg["augmentation"]) if cfg["augmentation"] else None
-        version = cfg["format_version"]
         # version 1 predates the log-spectrum representation: its networks were trained on waveforms
         pre_cfg = {"representation": "waveform", **cfg["preprocessing"]} if version == 1 else cfg["preprocessing"]
         if version < 3:     # before the multitaper spectrum and the kept level
@@ -632,6 +665,14 @@ class Assessor:
                 raise AssessorError(f"'{cfg_file}': a domain normaliser has centre shape {np.shape(n.centre)} "
                                     f"and scale {n.scale!r}; expected ({a._pre.window},) or a number, and > 0")
         a.source_normaliser_, a.target_normaliser_ = norms
+        weights = cfg.get("target_log_weights", [0.0] * a.n_classes_) if version >= 4 else [0.0] * a.n_classes_
+        ok = isinstance(weights, list) and all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                                               for v in weights)
+        w = np.asarray(weights, dtype=np.float64) if ok else np.empty(0)
+        if w.shape != (a.n_classes_,) or not np.all(np.isfinite(w)):
+            raise AssessorError(f"'{cfg_file}': target_log_weights must be {a.n_classes_} finite numbers, "
+                                f"got {weights!r}")
+        a.target_log_weights_ = w
         if cfg.get("fit_time") is not None:
             a.fit_time_ = cfg["fit_time"]
         return a

@@ -26,7 +26,7 @@ def _cmd_train_assessor(args: argparse.Namespace) -> int:
     pre = (transfer.Preprocessing(**level) if args.shaft_speed is None
            else transfer.Preprocessing.for_shaft_speed(args.shaft_speed, **level))
     a = transfer.Assessor(args.method, epochs=args.epochs, seed=args.seed, preprocessing=pre,
-                          progress=not args.no_progress)
+                          progress=not args.no_progress, class_prior=None if args.no_class_prior else "source")
     a.fit(Path(args.source), Path(args.target))
     a.save(out)
     last = a.history_[-1]
@@ -82,6 +82,9 @@ def add_subcommands(sub) -> None:
                    help="remove each window's level and keep only the spectral shape: for pitting, whose early "
                         "stages differ in level by less than the rig's gain scatter (the default keeps the level, "
                         "which carries deep wear)")
+    p.add_argument("--no-class-prior", action="store_true",
+                   help="do not match the rig's stage proportions to the archive's after training (use it when the "
+                        "rig data are mostly one stage, e.g. a run-to-failure history; default: match them)")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bars")
     p.set_defaults(handler=_cmd_train_assessor)
 

@@ -208,3 +208,56 @@ def test_adaptation_beats_source_only_on_shifted_data(tiny_pre, tiny_data):
     acc = {m: np.mean([tiny_assessor(m, pre, seed=s, epochs=15).fit(src, adapt).score(test)
                        for s in (0, 1)]) for m in ("cnn", "proposed")}
     assert acc["proposed"] > acc["cnn"] + 0.1, acc
+
+
+def test_class_prior_match_balances_the_rig_and_leaves_training_alone(tiny_pre, tiny_data, fitted):
+    """After fit, the adaptation windows' mean stage probabilities equal the source's proportions
+    (1/3 each); the offsets only re-weight the probabilities of the very same network."""
+    from twin.transfer.preprocess import prepare, window_signal
+    from twin.transfer.prior import apply_log_weights
+    src, adapt, test = tiny_data
+
+    def raw_windows(records):
+        return np.concatenate([window_signal(p.signal, tiny_pre.window, tiny_pre.hop)
+                               for p in prepare(records, tiny_pre)])
+    x = raw_windows(adapt)
+    assert fitted.class_prior == "source" and np.any(fitted.target_log_weights_ != 0)
+    np.testing.assert_allclose(fitted.predict_proba(x).mean(0), 1 / 3, atol=1e-5)
+    plain = tiny_assessor("proposed", tiny_pre, seed=3, class_prior=None).fit(src, adapt)
+    assert np.array_equal(plain.target_log_weights_, np.zeros(3))
+    xt = raw_windows(test)
+    np.testing.assert_allclose(apply_log_weights(plain.predict_proba(xt), fitted.target_log_weights_),
+                               fitted.predict_proba(xt), rtol=1e-5, atol=1e-7)
+    # the twin's own data are never re-weighted
+    np.testing.assert_allclose(fitted.predict_proba(src, domain="source"), plain.predict_proba(src, domain="source"))
+
+
+def test_source_only_cnn_gets_no_class_prior_offsets(tiny_pre, tiny_data):
+    src, adapt, _ = tiny_data
+    a = tiny_assessor("cnn", tiny_pre, epochs=1).fit(src, adapt)
+    assert np.array_equal(a.target_log_weights_, np.zeros(3))
+
+
+def test_class_prior_offsets_survive_save_and_load_and_version_3_loads_without(fitted, tiny_data, tmp_path):
+    _, _, test = tiny_data
+    d = fitted.save(tmp_path / "v4")
+    back = Assessor.load(d)
+    np.testing.assert_array_equal(back.target_log_weights_, fitted.target_log_weights_)
+    assert back.class_prior == "source"
+    cfg = json.loads((d / "config.json").read_text())
+    del cfg["target_log_weights"], cfg["params"]["class_prior"]
+    cfg["format_version"] = 3
+    (d / "config.json").write_text(json.dumps(cfg))
+    old = Assessor.load(d)
+    assert old.class_prior is None and np.array_equal(old.target_log_weights_, np.zeros(3))
+    cfg["format_version"] = 4
+    cfg["target_log_weights"] = [0.0, "x"]
+    (d / "config.json").write_text(json.dumps(cfg))
+    with pytest.raises(AssessorError, match="target_log_weights must be 3 finite numbers"):
+        Assessor.load(d)
+
+
+def test_an_unknown_class_prior_is_named(tiny_pre, tiny_data):
+    src, adapt, _ = tiny_data
+    with pytest.raises(AssessorError, match="class_prior='uniform'"):
+        Assessor(class_prior="uniform", preprocessing=tiny_pre).fit(src, adapt)

@@ -92,3 +92,20 @@ def test_train_to_missing_directory_fails_early(tmp_path):
                          str(tmp_path / "no" / "model")])
     with pytest.raises(OutputPathError, match="no"):
         args.handler(args)
+
+
+def test_no_class_prior_reaches_the_saved_assessor(tmp_path):
+    src = _file(tmp_path / "src.h5", False, True)
+    tgt = _file(tmp_path / "tgt.h5", True, True)
+    p = _parser()
+    saved = {}
+    for flag in ([], ["--no-class-prior"]):
+        out = tmp_path / ("plain" if flag else "matched")
+        args = p.parse_args(["train-assessor", "--source", str(src), "--target", str(tgt), "--out", str(out),
+                             "--epochs", "1", "--method", "mmd", "--no-progress", *flag])
+        assert args.handler(args) == 0
+        saved[bool(flag)] = json.loads((out / "config.json").read_text())
+    assert saved[False]["params"]["class_prior"] == "source"
+    assert any(w != 0 for w in saved[False]["target_log_weights"])
+    assert saved[True]["params"]["class_prior"] is None
+    assert saved[True]["target_log_weights"] == [0.0, 0.0]

@@ -1,0 +1,54 @@
+"""The class-prior match: hand-computable offsets, the constraint it solves, its bounds and errors."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from twin.transfer import AssessorError
+from twin.transfer.prior import LOG_WEIGHT_LIMIT, apply_log_weights, match_class_prior
+
+
+def test_identical_windows_give_the_hand_computed_offsets():
+    # every window says (0.8, 0.2); a uniform prior needs w1 / w0 = 4, i.e. log w = (-ln 2, +ln 2)
+    p = np.tile([0.8, 0.2], (5, 1))
+    log_w = match_class_prior(p, np.array([0.5, 0.5]))
+    np.testing.assert_allclose(log_w, [-math.log(2), math.log(2)], atol=1e-6)
+    np.testing.assert_allclose(apply_log_weights(p, log_w), 0.5, atol=1e-6)
+
+
+def test_probabilities_that_already_match_need_no_offsets():
+    p = np.array([[0.9, 0.1, 0.0], [0.1, 0.8, 0.1], [0.0, 0.1, 0.9]])
+    np.testing.assert_allclose(match_class_prior(p, np.full(3, 1 / 3)), 0.0, atol=1e-12)
+
+
+def test_the_reweighted_mean_equals_a_non_uniform_prior():
+    rng = np.random.default_rng(0)
+    p = rng.dirichlet([0.5, 1.0, 2.0, 0.7], size=200)
+    prior = np.array([0.4, 0.3, 0.2, 0.1])
+    log_w = match_class_prior(p, prior, tol=1e-9)
+    q = apply_log_weights(p, log_w)
+    np.testing.assert_allclose(q.sum(1), 1.0)
+    np.testing.assert_allclose(q.mean(0), prior, atol=1e-8)
+    assert abs(log_w.mean()) < 1e-9
+    # the ranking within a stage is kept: only the boundaries between stages move
+    assert np.array_equal(np.argsort(q[:, 0]), np.argsort(p[:, 0] / (p * np.exp(log_w)).sum(1)))
+
+
+def test_a_stage_the_data_never_show_gets_a_bounded_weight():
+    p = np.array([[0.5, 0.5, 0.0], [0.4, 0.6, 0.0]])
+    log_w = match_class_prior(p, np.full(3, 1 / 3), max_iter=200)
+    assert np.all(np.isfinite(log_w)) and np.max(np.abs(log_w)) <= LOG_WEIGHT_LIMIT
+    assert log_w[2] == LOG_WEIGHT_LIMIT
+
+
+@pytest.mark.parametrize("p, prior, match", [
+    (np.ones((3, 2)) / 2, np.array([0.5, 0.3, 0.2]), r"\(3, 2\) and \(3,\)"),
+    (np.array([[0.5, np.nan]]), np.array([0.5, 0.5]), "finite"),
+    (np.ones((3, 2)) / 2, np.array([1.0, 0.0]), r"\[1.0, 0.0\]"),
+    (np.ones((3, 2)) / 2, np.array([0.5, 0.6]), r"sum to 1"),
+])
+def test_bad_inputs_are_named(p, prior, match):
+    with pytest.raises(AssessorError, match=match):
+        match_class_prior(p, prior)
