@@ -269,8 +269,9 @@ class Assessor:
             raise AssessorError(f"device={self.device!r} is not a torch device") from None
 
     # ---- data -----------------------------------------------------------------------------------
-    def _prepared(self, data, labels, what: str) -> list[Prepared]:
-        """Records (or raw windows ``(n, window)`` + labels) -> prepared signals."""
+    def _prepared(self, data, labels, what: str, domain: str = "source") -> list[Prepared]:
+        """Records (or raw windows ``(n, window)`` + labels) -> prepared signals; ``domain`` picks
+        the channel of records (:meth:`Preprocessing.channel_of`)."""
         pre = self._pre
         if isinstance(data, np.ndarray) or (isinstance(data, (list, tuple)) and data
                                             and isinstance(data[0], np.ndarray)):
@@ -289,7 +290,7 @@ class Assessor:
             return [Prepared(f"window{i}", x[i], lab[i]) for i in range(x.shape[0])]
         if labels is not None:
             raise AssessorError(f"{what}: labels are read from the records; pass labels only with window arrays")
-        return prepare(data, pre, what)
+        return prepare(data, pre, what, domain)
 
     def _check_source_labels(self, prepared: Sequence[Prepared]) -> int:
         missing = [p.name for p in prepared if p.label is None]
@@ -337,7 +338,7 @@ class Assessor:
         pre, aug = self._pre, self._aug()
         src = self._prepared(source, source_labels, "source")
         k = self._check_source_labels(src)
-        tgt = self._prepared(target_unlabelled, None, "target")
+        tgt = self._prepared(target_unlabelled, None, "target", "target")
         xt, _, _ = windows_of(tgt, pre, "target")
         xs_fixed, _, ys_fixed = windows_of(src, pre, "source")
         # "domain" normalisation: one normaliser per domain, from its own (unlabelled) windows.
@@ -348,7 +349,7 @@ class Assessor:
         mon = None
         if monitor is not None:
             mdata, mlabels = monitor if isinstance(monitor, tuple) else (monitor, None)
-            mx, _, my = windows_of(self._prepared(mdata, mlabels, "monitor"), pre, "monitor")
+            mx, _, my = windows_of(self._prepared(mdata, mlabels, "monitor", "target"), pre, "monitor")
             mon = (self.target_normaliser_(mx), my)
 
         device = self._device()
@@ -492,7 +493,7 @@ class Assessor:
             raise AssessorError(f"{what}: domain must be 'target' or 'source', got {domain!r}")
         pre = self._pre
         is_array = isinstance(data, np.ndarray)
-        prepared = self._prepared(data, None, what)
+        prepared = self._prepared(data, None, what, domain)
         x, rec, lab = windows_of(prepared, pre, what)
         norm = self.target_normaliser_ if domain == "target" else self.source_normaliser_
         return norm(x), rec, lab, prepared, is_array

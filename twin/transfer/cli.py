@@ -22,7 +22,7 @@ def _cmd_train_assessor(args: argparse.Namespace) -> int:
     out = Path(args.out)
     if not out.parent.is_dir():    # before minutes of training, not after
         raise OutputPathError(f"output directory '{out.parent}' does not exist (for '{out}')")
-    level = {"remove_level": args.remove_level}
+    level = {"remove_level": args.remove_level, "channel": args.channel, "target_channel": args.target_channel}
     pre = (transfer.Preprocessing(**level) if args.shaft_speed is None
            else transfer.Preprocessing.for_shaft_speed(args.shaft_speed, **level))
     a = transfer.Assessor(args.method, epochs=args.epochs, seed=args.seed, preprocessing=pre,
@@ -82,6 +82,11 @@ def add_subcommands(sub) -> None:
                    help="remove each window's level and keep only the spectral shape: for pitting, whose early "
                         "stages differ in level by less than the rig's gain scatter (the default keeps the level, "
                         "which carries deep wear)")
+    p.add_argument("--channel", default="accel_pinion_casing",
+                   help="acceleration channel of the source archive (default: accel_pinion_casing)")
+    p.add_argument("--target-channel", metavar="NAME",
+                   help="the rig's name for that channel, if it differs; saved with the assessor, so `twin assess` "
+                        "reads new rig files from it too")
     p.add_argument("--no-class-prior", action="store_true",
                    help="do not match the rig's stage proportions to the archive's after training (use it when the "
                         "rig data are mostly one stage, e.g. a run-to-failure history; default: match them)")

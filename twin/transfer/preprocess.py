@@ -4,7 +4,9 @@ Every record, source or target, goes through the same steps (the settings are sa
 model, so ``assess`` windows new data exactly as training did):
 
 1. **channel** -- one acceleration channel (default ``accel_pinion_casing``); a record without
-   it is an error naming the record and the channel.
+   it is an error naming the record and the channel.  A rig that names its accelerometer
+   differently gives that name as ``target_channel``: rig data (``fit``'s target, ``predict``,
+   ``assess``) are read from it, the twin's data from ``channel``.
 2. **resampling** -- to ``sample_rate`` (default 20 kHz) with
    :func:`twin.measurements.resample_record` (polyphase FIR, anti-aliased, flat to 80 % of the
    new Nyquist frequency).  The rule is a window of two pinion revolutions,
@@ -96,7 +98,9 @@ class Preprocessing:
     Attributes
     ----------
     channel : str
-        Acceleration channel used.
+        Acceleration channel of the twin's (source) data.
+    target_channel : str or None
+        The rig's name for the same channel; ``None`` means the rig uses ``channel`` too.
     sample_rate : float
         Rate the records are resampled to [Hz].
     window : int
@@ -126,10 +130,13 @@ class Preprocessing:
     representation: str = "log_spectrum"
     time_bandwidth: float = 4.0
     remove_level: bool = False
+    target_channel: str | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.channel, str) or not self.channel:
             raise ParameterError(f"channel must be a non-empty string, got {self.channel!r}")
+        if self.target_channel is not None and (not isinstance(self.target_channel, str) or not self.target_channel):
+            raise ParameterError(f"target_channel must be a non-empty string or None, got {self.target_channel!r}")
         if not (isinstance(self.sample_rate, (int, float)) and math.isfinite(self.sample_rate)
                 and self.sample_rate > 0):
             raise ParameterError(f"sample_rate must be a finite number > 0 [Hz], got {self.sample_rate!r}")
@@ -151,6 +158,12 @@ class Preprocessing:
 
     def to_dict(self) -> dict:
         return asdict(self)
+
+    def channel_of(self, domain: str) -> str:
+        """The channel read from ``"source"`` (twin) or ``"target"`` (rig) data."""
+        if domain not in ("source", "target"):
+            raise ParameterError(f"domain must be 'source' or 'target', got {domain!r}")
+        return self.channel if domain == "source" else (self.target_channel or self.channel)
 
     @classmethod
     def for_shaft_speed(cls, speed: float, revolutions: float = 2.0, **settings) -> "Preprocessing":
@@ -350,27 +363,29 @@ def normalise(w: np.ndarray) -> np.ndarray:
     return (w - mu) / np.where(sd > 0, sd, 1.0)
 
 
-def _from_records(records: Iterable, pre: Preprocessing, what: str) -> list[Prepared]:
+def _from_records(records: Iterable, pre: Preprocessing, what: str, channel: str) -> list[Prepared]:
     from twin.measurements import Record, resample_record
 
     out = []
     for rec in records:
         if not isinstance(rec, Record):
             raise AssessorError(f"{what}: expected measurement Records, got {type(rec).__name__}")
-        if pre.channel not in rec.channels:
+        if channel not in rec.channels:
             raise MeasurementError(rec.source or "<memory>", rec.name,
-                                   f"{what}: record has no channel '{pre.channel}' "
+                                   f"{what}: record has no channel '{channel}' "
                                    f"(channels: {', '.join(rec.channels)})")
         if not math.isclose(rec.sample_rate, pre.sample_rate, rel_tol=1e-9):
-            only = Record(rec.name, {pre.channel: rec[pre.channel]}, {pre.channel: rec.units[pre.channel]},
+            only = Record(rec.name, {channel: rec[channel]}, {channel: rec.units[channel]},
                           rec.sample_rate, label=rec.label, source=rec.source)
             rec, _ = resample_record(only, pre.sample_rate)
-        out.append(Prepared(rec.name, np.asarray(rec[pre.channel], dtype=np.float64), rec.label))
+        out.append(Prepared(rec.name, np.asarray(rec[channel], dtype=np.float64), rec.label))
     return out
 
 
-def prepare(data, pre: Preprocessing, what: str = "data") -> list[Prepared]:
+def prepare(data, pre: Preprocessing, what: str = "data", domain: str = "source") -> list[Prepared]:
     """Steps 1-2 for a path, a :class:`~twin.measurements.MeasurementSet`, Records or an Archive.
+
+    ``domain`` ("source" or "target") picks the channel (:meth:`Preprocessing.channel_of`).
 
     Raises
     ------
@@ -382,15 +397,16 @@ def prepare(data, pre: Preprocessing, what: str = "data") -> list[Prepared]:
     from twin.archive import Archive
     from twin.measurements import MeasurementSet, load_measurements
 
+    channel = pre.channel_of(domain)
     if isinstance(data, (str, Path)):
-        data = load_measurements(data, channels=[pre.channel], resample_to=pre.sample_rate)
+        data = load_measurements(data, channels=[channel], resample_to=pre.sample_rate)
     if isinstance(data, Archive):
-        if pre.channel not in data.signals:
+        if channel not in data.signals:
             raise MeasurementError(str(data.path or "<archive>"), None,
-                                   f"{what}: archive has no channel '{pre.channel}' "
+                                   f"{what}: archive has no channel '{channel}' "
                                    f"(channels: {', '.join(data.signals)})")
         from twin.measurements import Record
-        data = [Record(f"{i:06d}", {pre.channel: data.signals[pre.channel][i]}, {pre.channel: "m/s2"},
+        data = [Record(f"{i:06d}", {channel: data.signals[channel][i]}, {channel: "m/s2"},
                        data.sample_rate, label=int(data.labels[i]))
                 for i in range(data.labels.size)]
     if isinstance(data, MeasurementSet):
@@ -398,7 +414,7 @@ def prepare(data, pre: Preprocessing, what: str = "data") -> list[Prepared]:
     if isinstance(data, np.ndarray) or not isinstance(data, (list, tuple)):
         raise AssessorError(f"{what}: expected a measurement file path, MeasurementSet, list of Records or "
                             f"Archive, got {type(data).__name__}")
-    out = _from_records(data, pre, what)
+    out = _from_records(data, pre, what, channel)
     if not out:
         raise AssessorError(f"{what}: no records")
     return out

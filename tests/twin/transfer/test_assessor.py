@@ -70,7 +70,7 @@ def test_save_load_round_trip_gives_identical_predictions(fitted, tiny_data, tmp
     cfg = json.loads((d / "config.json").read_text())
     assert cfg["preprocessing"] == {"channel": "accel_pinion_casing", "sample_rate": FS, "window": 64, "hop": 32,
                                     "normalise": "domain", "representation": "log_spectrum",
-                                    "time_bandwidth": 4.0, "remove_level": False}
+                                    "time_bandwidth": 4.0, "remove_level": False, "target_channel": None}
     back = Assessor.load(d)
     assert back._pre == fitted._pre
     np.testing.assert_array_equal(back.target_normaliser_.centre, fitted.target_normaliser_.centre)
@@ -261,3 +261,18 @@ def test_an_unknown_class_prior_is_named(tiny_pre, tiny_data):
     src, adapt, _ = tiny_data
     with pytest.raises(AssessorError, match="class_prior='uniform'"):
         Assessor(class_prior="uniform", preprocessing=tiny_pre).fit(src, adapt)
+
+
+def test_a_rig_channel_of_another_name_is_read_as_the_twins(tiny_pre, tiny_data, fitted):
+    """``target_channel``: the rig calls its accelerometer "accel_x"; the twin's data keep theirs."""
+    from dataclasses import replace
+    src, _, test = tiny_data
+    rig_adapt = make_records(8, shifted=True, seed=2, labelled=False, channel="accel_x")
+    rig_test = make_records(8, shifted=True, seed=3, channel="accel_x")
+    pre = replace(tiny_pre, target_channel="accel_x")
+    a = tiny_assessor("proposed", pre, seed=3).fit(src, rig_adapt)
+    # the same samples under another name: the same assessor as the one fitted on the default name
+    np.testing.assert_array_equal(a.predict_proba(rig_test), fitted.predict_proba(test))
+    with pytest.raises(MeasurementError, match="no channel 'accel_x'"):
+        a.predict(test)                                     # rig data must carry the rig's name
+    assert a.predict_proba(src, domain="source").shape == (len(src), 3)   # twin data keep theirs

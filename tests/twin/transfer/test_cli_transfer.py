@@ -7,7 +7,7 @@ import json
 import numpy as np
 import pytest
 
-from twin.measurements import Record, write_measurements
+from twin.measurements import Record, load_measurements, write_measurements
 from twin.transfer.cli import add_subcommands
 
 
@@ -109,3 +109,21 @@ def test_no_class_prior_reaches_the_saved_assessor(tmp_path):
     assert any(w != 0 for w in saved[False]["target_log_weights"])
     assert saved[True]["params"]["class_prior"] is None
     assert saved[True]["target_log_weights"] == [0.0, 0.0]
+
+
+def test_target_channel_reaches_the_saved_assessor_and_assess(tmp_path):
+    src = _file(tmp_path / "src.h5", False, True)
+    recs = [Record(r.name, {"acc_rig": r["accel_pinion_casing"]}, {"acc_rig": "m/s2"}, r.sample_rate, label=r.label)
+            for r in load_measurements(_file(tmp_path / "tgt0.h5", True, True)).records]
+    tgt = write_measurements(recs, tmp_path / "tgt.h5")
+    p = _parser()
+    args = p.parse_args(["train-assessor", "--source", str(src), "--target", str(tgt), "--out",
+                         str(tmp_path / "model"), "--epochs", "1", "--method", "cnn", "--target-channel", "acc_rig",
+                         "--no-progress"])
+    assert args.handler(args) == 0
+    cfg = json.loads((tmp_path / "model" / "config.json").read_text())
+    assert cfg["preprocessing"]["channel"] == "accel_pinion_casing"
+    assert cfg["preprocessing"]["target_channel"] == "acc_rig"
+    args = p.parse_args(["assess", str(tmp_path / "model"), str(tgt), "--json", str(tmp_path / "stages.json")])
+    assert args.handler(args) == 0
+    assert len(json.loads((tmp_path / "stages.json").read_text())["records"]) == 6

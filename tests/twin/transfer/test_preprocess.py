@@ -175,3 +175,16 @@ def test_tsne_separates_two_clusters():
     nn = d.argmin(1)
     assert np.all((nn < 30) == (np.arange(60) < 30))          # every nearest neighbour in its own cluster
     np.testing.assert_array_equal(y, tsne(x, perplexity=10, n_iter=300, seed=1))
+
+
+def test_the_rig_channel_defaults_to_the_twins_and_is_checked():
+    from twin.errors import ParameterError
+    from twin.transfer import Preprocessing
+    pre = Preprocessing()
+    assert pre.channel_of("source") == pre.channel_of("target") == "accel_pinion_casing"
+    rig = Preprocessing(target_channel="acc_x")
+    assert (rig.channel_of("source"), rig.channel_of("target")) == ("accel_pinion_casing", "acc_x")
+    with pytest.raises(ParameterError, match="target_channel must be a non-empty string or None, got ''"):
+        Preprocessing(target_channel="")
+    with pytest.raises(ParameterError, match="'rig'"):
+        pre.channel_of("rig")
