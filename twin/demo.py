@@ -260,11 +260,14 @@ def _transfer_demo(out_dir: Path, epochs: int = 15):
         accuracy[method] = float(np.mean([y == w for y, w in windows]))
         if method == "proposed":
             assessed = (asm, test)
+            offsets = a.target_log_weights_
             a.save(out_dir / "assessor")
     print(f"[9/9] Wear-stage assessment of rig records (6 pitting stages; the rig has a mount resonance, "
           f"run-out and another sensor the twin lacks; {epochs} epochs, one seed: "
           f"{time.perf_counter() - t:.0f} s)")
     print("      target test accuracy: " + ", ".join(f"{m} {100 * v:.0f} %" for m, v in accuracy.items()))
+    print("      class-prior match (proposed): stage logit offsets "
+          + " ".join(f"{v:+.2f}" for v in offsets) + " balance the rig's stages as in the archive")
     asm, _ = assessed
     print("      record        true stage   assessed stage   confidence")
     for r in asm.records[::max(1, len(asm.records) // 6)]:
