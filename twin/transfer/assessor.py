@@ -666,7 +666,8 @@ class Assessor:
                 raise AssessorError(f"'{cfg_file}': a domain normaliser has centre shape {np.shape(n.centre)} "
                                     f"and scale {n.scale!r}; expected ({a._pre.window},) or a number, and > 0")
         a.source_normaliser_, a.target_normaliser_ = norms
-        weights = cfg.get("target_log_weights", [0.0] * a.n_classes_) if version >= 4 else [0.0] * a.n_classes_
+        # version 4 always writes the offsets: a file without them is damaged, not "no offsets"
+        weights = cfg.get("target_log_weights") if version >= 4 else [0.0] * a.n_classes_
         ok = isinstance(weights, list) and all(isinstance(v, (int, float)) and not isinstance(v, bool)
                                                for v in weights)
         w = np.asarray(weights, dtype=np.float64) if ok else np.empty(0)

@@ -255,6 +255,10 @@ def test_class_prior_offsets_survive_save_and_load_and_version_3_loads_without(f
     (d / "config.json").write_text(json.dumps(cfg))
     with pytest.raises(AssessorError, match="target_log_weights must be 3 finite numbers"):
         Assessor.load(d)
+    del cfg["target_log_weights"]                            # version 4 without offsets: damaged
+    (d / "config.json").write_text(json.dumps(cfg))
+    with pytest.raises(AssessorError, match="got None"):
+        Assessor.load(d)
 
 
 def test_an_unknown_class_prior_is_named(tiny_pre, tiny_data):
