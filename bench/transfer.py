@@ -76,7 +76,7 @@ def _ceiling(args, tasks) -> None:
     import numpy as np
 
     from twin.errors import OutputPathError
-    from twin.transfer.benchmark import _ceiling_star, _target_ceiling_star, prepare_task, rig_settings
+    from twin.transfer.benchmark import _star, prepare_task, rig_settings, source_ceiling, target_ceiling
 
     if args.data_dir:
         data_dir = Path(args.data_dir)
@@ -87,16 +87,16 @@ def _ceiling(args, tasks) -> None:
         raise OutputPathError(f"output directory '{data_dir.parent}' does not exist (for '{data_dir}')")
     data_dir.mkdir(exist_ok=True)
     if args.target_ceiling:
-        what, star, pick = f"CNN trained on rig '{args.rig}' labels, target test halves", _target_ceiling_star, 1
+        what, fn, pick = f"CNN trained on rig '{args.rig}' labels, target test halves", target_ceiling, 1
     else:
-        what, star, pick = "source-only CNN on held-out source records", _ceiling_star, 0
-    jobs = [(t, str(prepare_task(t, data_dir, rig_settings(t, args.rig))[pick]), s, args.epochs)
+        what, fn, pick = "source-only CNN on held-out source records", source_ceiling, 0
+    jobs = [(fn, t, str(prepare_task(t, data_dir, rig_settings(t, args.rig))[pick]), s, args.epochs)
             for t in tasks for s in range(args.seeds)]
     with ProcessPoolExecutor(max_workers=args.jobs, mp_context=mp.get_context("spawn")) as pool:
-        acc = list(pool.map(star, jobs))
+        acc = list(pool.map(_star, jobs))
     print(f"| task | {what} [%] | per seed |\n|---|---|---|")
     for t in tasks:
-        a = np.array([x for (tk, *_), x in zip(jobs, acc) if tk == t]) * 100
+        a = np.array([x for (_, tk, *_), x in zip(jobs, acc) if tk == t]) * 100
         print(f"| {t} | {a.mean():.1f} +- {a.std(ddof=1) if a.size > 1 else 0:.1f} | {', '.join(f'{v:.1f}' for v in a)} |")
 
 

@@ -61,15 +61,15 @@ def _lda(x: np.ndarray, y: np.ndarray, shrinkage: float):
 
 
 def main() -> None:
+    from twin.measurements import load_measurements
+    from twin.transfer.benchmark import RIGS, prepare_task, rig_settings, task_preprocessing
+    from twin.transfer.preprocess import split_records
+
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--data-dir", required=True, help="the data directory of bench/transfer.py (its --data-dir)")
     ap.add_argument("--task", choices=("pitting", "wear"), default="wear")
-    from twin.measurements import load_measurements
-    from twin.transfer.benchmark import RIGS, prepare_task, rig_settings, task_preprocessing
-
     ap.add_argument("--rig", choices=tuple(RIGS), default="rig")
     args = ap.parse_args()
-    from twin.transfer.preprocess import split_records
 
     src_path, tgt_path = prepare_task(args.task, args.data_dir, rig_settings(args.task, args.rig))
     pre = replace(task_preprocessing(args.task), remove_level=False)

@@ -49,6 +49,7 @@ from twin.transfer.domain import TargetShift
 
 REPO = Path(__file__).resolve().parents[2]
 TASKS = {"pitting": "scenarios/lubricated.yaml", "wear": "scenarios/dry.yaml"}
+CHANNEL = "accel_pinion_casing"     # the one channel the benchmark's data are simulated and read with
 METHODS = ("cnn", "mmd", "proposed")
 
 
@@ -163,7 +164,7 @@ def prepare_task(task: str, data_dir: str | Path, settings: DataSettings | None 
     sc = sc.with_overrides(archive=arc)
     fmu = sc.fmu_path()
     build_archive(sc, src, progress=progress, fmu_path=fmu)
-    run = run_degradation(sc, None, fmu_path=fmu, progress=progress, channels=("accel_pinion_casing",))
+    run = run_degradation(sc, None, fmu_path=fmu, progress=progress, channels=(CHANNEL,))
     make_target_domain(sc, tgt, records_per_stage=settings.target_records_per_stage,
                        record_duration=settings.target_record_duration, seed=settings.target_seed,
                        shift=RIGS[settings.rig], run=run, fmu_path=fmu, progress=progress)
@@ -175,18 +176,27 @@ def prepare_task(task: str, data_dir: str | Path, settings: DataSettings | None 
 _DATA_CACHE: dict = {}
 
 
+def _target_halves(tgt: str, sample_rate: float) -> tuple[list, list]:
+    """(first halves, second halves) of the target records, both still labelled."""
+    from twin.measurements import load_measurements
+    from twin.transfer.preprocess import split_records
+    return split_records(load_measurements(tgt, channels=[CHANNEL], resample_to=sample_rate), 0.5)
+
+
+def _unlabelled(records: list) -> list:
+    from dataclasses import replace
+    return [replace(r, label=None, damage=None) for r in records]
+
+
 def load_task_data(task: str, src: str, tgt: str, sample_rate: float):
     """Source records and the two halves of the target records, loaded once per process."""
     key = (task, src, tgt, sample_rate)
     if key not in _DATA_CACHE:
         from twin.measurements import load_measurements
-        from twin.transfer.preprocess import split_records
-        s = load_measurements(src, channels=["accel_pinion_casing"], resample_to=sample_rate)
-        t = load_measurements(tgt, channels=["accel_pinion_casing"], resample_to=sample_rate)
-        adapt, test = split_records(t, 0.5)
+        s = load_measurements(src, channels=[CHANNEL], resample_to=sample_rate)
+        adapt, test = _target_halves(tgt, sample_rate)
         # The adaptation half is handed to fit() without its labels, so they cannot leak.
-        from dataclasses import replace
-        adapt = [replace(r, label=None, damage=None) for r in adapt]
+        adapt = _unlabelled(adapt)
         _DATA_CACHE[key] = (s, adapt, test)
     return _DATA_CACHE[key]
 
@@ -241,19 +251,17 @@ def source_ceiling(task: str, source: str, seed: int, epochs: int = 80) -> float
     No domain shift at all, so this is what the twin's own stages allow across records (damage
     and operating scatter within a stage): a reference for how far any transfer can go.
     """
-    from dataclasses import replace
-
     from twin.measurements import load_measurements
     from twin.transfer.assessor import Assessor
 
     a = Assessor("cnn", epochs=epochs, seed=seed, preprocessing=task_preprocessing(task), progress=False)
-    recs = list(load_measurements(source, channels=["accel_pinion_casing"], resample_to=a._pre.sample_rate).records)
+    recs = list(load_measurements(source, channels=[CHANNEL], resample_to=a._pre.sample_rate).records)
     by_stage: dict = {}
     for r in recs:
         by_stage.setdefault(r.label, []).append(r)
     train = [r for rs in by_stage.values() for r in rs[0::2]]
     held = [r for rs in by_stage.values() for r in rs[1::2]]
-    a.fit(train, [replace(r, label=None) for r in held])
+    a.fit(train, _unlabelled(held))
     return a.score(held)
 
 
@@ -266,29 +274,18 @@ def target_ceiling(task: str, target: str, seed: int, epochs: int = 80) -> float
     tell the stages apart on this rig at all.  A transfer result near it has little left to gain;
     a target above it asks the rig for more than its records hold.
     """
-    from dataclasses import replace
-
-    from twin.measurements import load_measurements
     from twin.transfer.assessor import Assessor
-    from twin.transfer.preprocess import split_records
 
     a = Assessor("cnn", epochs=epochs, seed=seed, preprocessing=task_preprocessing(task), progress=False)
-    t = load_measurements(target, channels=["accel_pinion_casing"], resample_to=a._pre.sample_rate)
-    adapt, test = split_records(t, 0.5)
-    a.fit(adapt, [replace(r, label=None, damage=None) for r in adapt])
+    adapt, test = _target_halves(target, a._pre.sample_rate)
+    a.fit(adapt, _unlabelled(adapt))
     return a.score(test)
 
 
-def _ceiling_star(args):
-    return source_ceiling(*args)
-
-
-def _target_ceiling_star(args):
-    return target_ceiling(*args)
-
-
-def _train_star(args):
-    return train_one(*args)
+def _star(job):
+    """``fn(*args)`` for ``job = (fn, *args)``: a pool's map takes one argument per job."""
+    fn, *args = job
+    return fn(*args)
 
 
 # ---- the whole benchmark --------------------------------------------------------------------------
@@ -373,13 +370,13 @@ def run_benchmark(out: str | Path, *, tasks: tuple[str, ...] = ("pitting", "wear
     paths = {t: prepare_task(t, data_dir, settings[t], progress=progress) for t in tasks}
     # Seed 0 also returns features for the t-SNE and monitors the target test accuracy per epoch
     # for the learning curves (monitoring only: it never feeds back into training).
-    jobs_list = [(t, m, s, str(paths[t][0]), str(paths[t][1]), epochs, s == 0, s == 0)
+    jobs_list = [(train_one, t, m, s, str(paths[t][0]), str(paths[t][1]), epochs, s == 0, s == 0)
                  for t in tasks for s in range(seeds) for m in methods]
     bar = progress_bar(len(jobs_list), progress, "transfer benchmark", "run")
     results: list[RunResult] = []
     t0 = time.perf_counter()
     with ProcessPoolExecutor(max_workers=jobs, mp_context=mp.get_context("spawn")) as pool:
-        for r in pool.map(_train_star, jobs_list):
+        for r in pool.map(_star, jobs_list):
             results.append(r)
             bar.update(1)
     bar.close()

@@ -22,9 +22,9 @@ def _cmd_train_assessor(args: argparse.Namespace) -> int:
     out = Path(args.out)
     if not out.parent.is_dir():    # before minutes of training, not after
         raise OutputPathError(f"output directory '{out.parent}' does not exist (for '{out}')")
-    level = {"remove_level": args.remove_level, "channel": args.channel, "target_channel": args.target_channel}
-    pre = (transfer.Preprocessing(**level) if args.shaft_speed is None
-           else transfer.Preprocessing.for_shaft_speed(args.shaft_speed, **level))
+    settings = {"remove_level": args.remove_level, "channel": args.channel, "target_channel": args.target_channel}
+    pre = (transfer.Preprocessing(**settings) if args.shaft_speed is None
+           else transfer.Preprocessing.for_shaft_speed(args.shaft_speed, **settings))
     a = transfer.Assessor(args.method, epochs=args.epochs, seed=args.seed, preprocessing=pre,
                           progress=not args.no_progress, class_prior=None if args.no_class_prior else "source")
     a.fit(Path(args.source), Path(args.target))
