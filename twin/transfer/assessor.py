@@ -19,11 +19,7 @@ Methods (``method=``):
 Every method that adapts (all but ``"cnn"``) ends with a **class-prior match**
 (``class_prior="source"``, :mod:`twin.transfer.prior`): per-stage logit offsets, fitted on the
 unlabelled adaptation windows so that the rig's mean stage probabilities equal the twin's stage
-proportions, move the decision boundaries the rig has shifted.  The proposed method applies the
-same match to its pseudo-labels during training: from the end of the warm-up, each epoch starts by
-fitting the offsets of the network as it stands, and the gate of Eq. 19 reads the matched
-probabilities, so the contrastive loss does not learn the shifted boundary.  ``class_prior=None``
-switches both off.
+proportions, move the decision boundaries the rig has shifted.  ``class_prior=None`` switches it off.
 
 Training (paper Table 3 defaults): SGD with momentum 0.9 and weight decay 5e-4, initial learning
 rate ``lr`` = 0.01 annealed as ``lr / (1 + 10 p)^0.75`` over the training progress ``p`` in [0, 1]
@@ -151,9 +147,9 @@ class Assessor:
     class_prior : {"source", None}
         ``"source"``: after training, offset the stage logits on rig data so that the mean stage
         probabilities of the adaptation windows equal the twin's stage proportions
-        (:mod:`twin.transfer.prior`; methods that adapt only); ``"proposed"`` also matches its
-        pseudo-labels so during training.  It assumes the rig's adaptation data cover the stages
-        in about the twin's proportions, as the domain normalisation does.  ``None``: no offsets.
+        (:mod:`twin.transfer.prior`; methods that adapt only).  It assumes the rig's adaptation
+        data cover the stages in about the twin's proportions, as the domain normalisation does.
+        ``None``: no offsets.
 
     Attributes (after ``fit``)
     --------------------------
@@ -161,9 +157,8 @@ class Assessor:
     n_classes_ : int
     classes_ : ndarray (K,)
     history_ : list of dict, one per epoch: ``loss``, ``cls``, ``align``, ``con``, ``source_acc``,
-        ``gate`` (fraction of target windows whose pseudo-label passed), ``lr``,
-        ``pseudo_label_offsets`` (the epoch's class-prior offsets (K,) of the pseudo-labels, or
-        ``None``) and, with ``monitor=``, ``monitor_acc``.
+        ``gate`` (fraction of target windows whose pseudo-label passed), ``lr`` and, with
+        ``monitor=``, ``monitor_acc``.
     n_source_windows_, n_target_windows_ : int
     source_normaliser_, target_normaliser_ : DomainNormaliser
         The per-domain part of the normalisation (identity unless ``normalise="domain"``): the
@@ -372,7 +367,6 @@ class Assessor:
             total = steps * self.epochs
             xt_t = torch.from_numpy(xt).unsqueeze(1).to(device)
             adapt = self.method != "cnn"
-            prior = np.bincount(ys_fixed.astype(np.int64), minlength=k) / ys_fixed.size
             history = []
             self.target_log_weights_ = np.zeros(k)      # the monitor sees the network as trained
             bar = progress_bar(self.epochs, self.progress, f"train {self.method}", "epoch")
@@ -389,12 +383,6 @@ class Assessor:
                 xs_t = torch.from_numpy(xs).unsqueeze(1).to(device)
                 ys_t = torch.from_numpy(ys.astype(np.int64)).to(device)
                 perm = rng.permutation(n_s)
-                pl_offsets = None
-                if self.method == "proposed" and self.class_prior == "source" and epoch >= self.warmup_epochs:
-                    # The rig's shifted boundary biases the pseudo-labels as it biases the verdicts;
-                    # unmatched, the contrastive loss would pull those windows to the wrong stage.
-                    pl_offsets = self._prior_offsets(xt, prior, net)
-                    pl_offsets_t = torch.as_tensor(pl_offsets, dtype=torch.float32, device=device)
                 net.train()
                 sums = dict(loss=0.0, cls=0.0, align=0.0, con=0.0, correct=0, seen=0, gated=0, tseen=0)
                 for b in range(steps):
@@ -417,8 +405,7 @@ class Assessor:
                         align = coral_loss(gs, gt) if self.method == "coral" else mmd_loss(gs, gt)
                         if self.method == "proposed":
                             pt = torch.softmax(lt.detach(), dim=1)
-                            yt, mask = pseudo_label_gate(pt, epoch, self.threshold, self.warmup_epochs,
-                                                         None if pl_offsets is None else pl_offsets_t)
+                            yt, mask = pseudo_label_gate(pt, epoch, self.threshold, self.warmup_epochs)
                             con = class_contrastive_loss(gs, yb, gt, yt, mask, self.margin, self.pairs)
                             sums["gated"] += int(mask.sum())
                             sums["tseen"] += int(mask.numel())
@@ -441,8 +428,7 @@ class Assessor:
                 rec = {"epoch": epoch + 1, "loss": sums["loss"] / seen, "cls": sums["cls"] / seen,
                        "align": sums["align"] / seen, "con": sums["con"] / seen,
                        "source_acc": sums["correct"] / seen,
-                       "gate": sums["gated"] / sums["tseen"] if sums["tseen"] else 0.0, "lr": lr,
-                       "pseudo_label_offsets": None if pl_offsets is None else pl_offsets.tolist()}
+                       "gate": sums["gated"] / sums["tseen"] if sums["tseen"] else 0.0, "lr": lr}
                 if mon is not None:
                     self.network_ = net
                     self.n_classes_ = k
@@ -463,7 +449,9 @@ class Assessor:
         self.classes_ = np.arange(k)
         self.history_ = history
         if adapt and self.class_prior == "source":
-            self.target_log_weights_ = self._prior_offsets(xt, prior, net)
+            from twin.transfer.prior import match_class_prior
+            prior = np.bincount(ys_fixed.astype(np.int64), minlength=k) / ys_fixed.size
+            self.target_log_weights_ = match_class_prior(self._forward(xt)[1], prior)
         self.n_source_windows_ = int(n_s)
         self.n_target_windows_ = int(xt.shape[0])
         return self
@@ -473,14 +461,9 @@ class Assessor:
         if not hasattr(self, "network_"):
             raise AssessorError("this Assessor is not fitted yet: call fit() or Assessor.load()")
 
-    def _prior_offsets(self, xt: np.ndarray, prior: np.ndarray, net) -> np.ndarray:
-        """Class-prior offsets (K,) of ``net`` on the normalised adaptation windows ``xt``."""
-        from twin.transfer.prior import match_class_prior
-        return match_class_prior(self._forward(xt, net)[1], prior)
-
-    def _forward(self, x: np.ndarray, net=None):
+    def _forward(self, x: np.ndarray):
         import torch
-        net = self.network_ if net is None else net
+        net = self.network_
         was_training = net.training
         net.eval()
         dev = next(net.parameters()).device

@@ -16,8 +16,7 @@
   mean over the pairs used rather than the sum, so ``beta`` does not scale with the batch size.
 * :func:`pseudo_label_gate` -- the target pseudo-labels ``y~_t`` that may enter Eq. 19: the
   classifier's arg-max, kept only where its probability is at least ``threshold`` and only from
-  epoch ``warmup_epochs`` on, so that the early, mostly wrong labels cannot lock in; optionally
-  after the class-prior offsets of :mod:`twin.transfer.prior`.
+  epoch ``warmup_epochs`` on, so that the early, mostly wrong labels cannot lock in.
 * :func:`coral_loss` -- CORAL (Sun & Saenko 2016) as a cheap extra baseline.
 
 All functions take torch tensors: features ``(n, d)``, labels ``(n,)`` int64, and return a
@@ -80,24 +79,16 @@ def mmd_loss(source: torch.Tensor, target: torch.Tensor, s2: torch.Tensor | floa
     return (kss + ktt - 2 * kst).clamp_min(0.0)
 
 
-def pseudo_label_gate(probs: torch.Tensor, epoch: int, threshold: float, warmup_epochs: int,
-                      log_weights: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Tensor]:
+def pseudo_label_gate(probs: torch.Tensor, epoch: int, threshold: float, warmup_epochs: int
+                      ) -> tuple[torch.Tensor, torch.Tensor]:
     """Pseudo-labels (n,) and the mask (n,) bool of those allowed into the contrastive loss.
 
     ``probs`` are the classifier's class probabilities (n, K) for target windows.  Nothing passes
     before ``epoch == warmup_epochs`` (epochs count from 0); afterwards a label passes when its
-    probability is ``>= threshold``.  ``log_weights`` (K,), optional, re-weight the probabilities
-    first (``p_k exp(w_k)``, renormalised; :func:`twin.transfer.prior.apply_log_weights`), so the
-    labels and their confidences are those of the class-prior-matched classifier.
+    probability is ``>= threshold``.
     """
     if probs.ndim != 2:
         raise AssessorError(f"pseudo_label_gate: probs must be (n, K), got {tuple(probs.shape)}")
-    if log_weights is not None:
-        if log_weights.shape != (probs.shape[1],):
-            raise AssessorError(f"pseudo_label_gate: log_weights must be ({probs.shape[1]},), "
-                                f"got {tuple(log_weights.shape)}")
-        probs = probs * torch.exp(log_weights - log_weights.max())
-        probs = probs / probs.sum(dim=1, keepdim=True)
     conf, labels = probs.max(dim=1)
     if epoch < warmup_epochs:
         return labels, torch.zeros_like(labels, dtype=torch.bool)

@@ -12,9 +12,7 @@ probabilities ``q_ik = p_ik w_k / sum_j p_ij w_j`` of the unlabelled adaptation 
 the prior ``pi``.  It is the fixed point of the EM prior adjustment of Saerens, Latinne & Decaestecker
 (Neural Computation 14, 2002), run with the target prior held fixed instead of estimated: each
 iteration sets ``w_k <- w_k pi_k / mean_i q_ik``.  Multiplying probabilities by ``w`` is adding
-``log w`` to the logits, i.e. moving the boundaries, not retraining anything.  The assessor uses
-the offsets twice: once after training, for its verdicts on rig data, and, in the proposed method,
-at the start of every epoch after the warm-up, for the pseudo-labels of the contrastive loss.
+``log w`` to the logits, i.e. moving the boundaries, not retraining anything.
 
 It reads no target label.  It does rely on the proportions: on rig data dominated by one stage
 (a run-to-failure history that is mostly healthy) switch it off (``Assessor(class_prior=None)``).

@@ -90,19 +90,6 @@ def test_pseudo_label_gate_threshold_and_warmup():
     assert mask.tolist() == [True, True, True]
 
 
-def test_pseudo_label_gate_reads_the_class_prior_matched_probabilities():
-    """Offsets (ln 4, -ln 4) turn (0.2, 0.8) into (0.8, 0.2) and (0.5, 0.5) into (0.94, 0.06)."""
-    p = torch.tensor([[0.2, 0.8], [0.5, 0.5]], dtype=torch.float64)
-    w = torch.tensor([math.log(4.0), -math.log(4.0)], dtype=torch.float64)
-    labels, mask = pseudo_label_gate(p, epoch=5, threshold=0.9, warmup_epochs=0, log_weights=w)
-    assert labels.tolist() == [0, 0]
-    assert mask.tolist() == [False, True]                     # 0.8 < 0.9 <= 16/17
-    labels, mask = pseudo_label_gate(p, epoch=5, threshold=0.8, warmup_epochs=0, log_weights=torch.zeros(2))
-    assert labels.tolist() == [1, 0] and mask.tolist() == [True, False]
-    with pytest.raises(AssessorError, match=r"log_weights must be \(2,\)"):
-        pseudo_label_gate(p, epoch=5, threshold=0.9, warmup_epochs=0, log_weights=torch.zeros(3))
-
-
 def test_coral_zero_for_same_covariance_and_positive_otherwise():
     g = torch.Generator().manual_seed(2)
     a = torch.randn(50, 3, generator=g)
