@@ -239,10 +239,12 @@ def _transfer_demo(out_dir: Path, epochs: int = 15):
     the demo stays within minutes; the figures over 5 seeds with the paper's 80 epochs are in
     BENCHMARKS.md.
     """
+    import warnings
     from dataclasses import replace
 
     from twin.transfer.assessor import Assessor
     from twin.transfer.benchmark import TASK_SETTINGS, load_task_data, prepare_task, task_preprocessing
+    from twin.transfer.errors import ClassPriorWarning
 
     t = time.perf_counter()
     data = out_dir / "transfer_data"
@@ -251,23 +253,29 @@ def _transfer_demo(out_dir: Path, epochs: int = 15):
     src, tgt = prepare_task("pitting", data, settings, progress=False)
     pre = task_preprocessing("pitting")       # windows of two pinion revolutions, as in the benchmark
     source, adapt, test = load_task_data("pitting", str(src), str(tgt), pre.sample_rate)
-    accuracy, assessed = {}, None
+    accuracy, assessed, notes = {}, None, []
     for method in ("cnn", "mmd", "proposed"):
         a = Assessor(method, epochs=epochs, seed=0, preprocessing=pre, progress=False)
-        a.fit(source, adapt)
+        with warnings.catch_warnings(record=True) as caught:    # printed below, in the step's layout
+            warnings.simplefilter("always", ClassPriorWarning)
+            a.fit(source, adapt)
+        notes += [f"{method}: {w.message}" for w in caught if issubclass(w.category, ClassPriorWarning)]
         asm = a.assess(test)
         windows = [(r.label, w) for r in asm.records for w in r.window_stages]
         accuracy[method] = float(np.mean([y == w for y, w in windows]))
         if method == "proposed":
             assessed = (asm, test)
-            offsets = a.target_log_weights_
+            offsets, moved = a.target_log_weights_, a.class_prior_moved_
             a.save(out_dir / "assessor")
     print(f"[9/9] Wear-stage assessment of rig records (6 pitting stages; the rig has a mount resonance, "
           f"run-out and another sensor the twin lacks; {epochs} epochs, one seed: "
           f"{time.perf_counter() - t:.0f} s)")
     print("      target test accuracy: " + ", ".join(f"{m} {100 * v:.0f} %" for m, v in accuracy.items()))
     print("      class-prior match (proposed): stage logit offsets "
-          + " ".join(f"{v:+.2f}" for v in offsets) + " balance the rig's stages as in the archive")
+          + " ".join(f"{v:+.2f}" for v in offsets) + " balance the rig's stages as in the archive; "
+          f"{100 * moved:.1f} % of the rig's adaptation windows changed stage")
+    for note in notes:
+        print(f"      warning: {note}")
     asm, _ = assessed
     print("      record        true stage   assessed stage   confidence")
     for r in asm.records[::max(1, len(asm.records) // 6)]:

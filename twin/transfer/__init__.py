@@ -10,6 +10,7 @@ import importlib
 
 _WHERE = {"METHODS": "assessor", "Assessment": "assessor", "Assessor": "assessor", "RecordAssessment": "assessor",
           "TargetShift": "domain", "make_target_domain": "domain", "AssessorError": "errors",
+          "ClassPriorWarning": "errors",
           "Augmentation": "preprocess", "Preprocessing": "preprocess", "split_records": "preprocess"}
 
 __all__ = sorted(_WHERE)

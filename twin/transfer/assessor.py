@@ -43,7 +43,7 @@ from pathlib import Path
 
 import numpy as np
 
-from twin.transfer.errors import AssessorError
+from twin.transfer.errors import AssessorError, ClassPriorWarning
 from twin.transfer.preprocess import (Augmentation, DomainNormaliser, Preprocessing, Prepared,
                                       augmented_windows, domain_normaliser, prepare, windows_of)
 
@@ -56,6 +56,10 @@ SAVE_VERSION = 4
 # version 3: no class-prior match (its assessors load with zero offsets, as they were trained)
 _READABLE_VERSIONS = (1, 2, 3, 4)
 CLASS_PRIORS = ("source", None)
+# Share of the adaptation windows the class-prior match may move to another stage before fit warns.
+# On the balanced benchmark and blind rigs it moved 0-4.4 %; on run-to-failure-like subsets of the
+# benchmark rig, where it costs 8-16 points, 10.8-19 % (BENCHMARKS.md, stop 14; 2 seeds per case).
+CLASS_PRIOR_WARN_SHARE = 0.08
 _EVAL_BATCH = 256
 
 
@@ -167,6 +171,11 @@ class Assessor:
         Wall time of the training loop [s].
     target_log_weights_ : ndarray (K,)
         Logit offsets applied to rig (target-domain) data; zeros without a class-prior match.
+    adaptation_stage_counts_ : ndarray (2, K) of int
+        Adaptation windows assessed as each stage, without (row 0) and with (row 1) the offsets.
+    class_prior_moved_ : float
+        Share of the adaptation windows whose stage the offsets changed, in [0, 1].  Above
+        :data:`CLASS_PRIOR_WARN_SHARE`, ``fit`` issues a :class:`~twin.transfer.errors.ClassPriorWarning`.
     """
 
     def __init__(self, method: str = "proposed", *, alpha: float = 0.1, beta: float = 0.1, lr: float = 0.01,
@@ -327,6 +336,12 @@ class Assessor:
         ------
         AssessorError, MeasurementError
             Invalid parameters, shapes, labels, channels (the message names the value).
+
+        Warns
+        -----
+        ClassPriorWarning
+            The class-prior match moved more than :data:`CLASS_PRIOR_WARN_SHARE` of the adaptation
+            windows to another stage (see ``class_prior_moved_``).
         """
         import torch
 
@@ -448,13 +463,34 @@ class Assessor:
         self.n_classes_ = k
         self.classes_ = np.arange(k)
         self.history_ = history
+        p_adapt = self._forward(xt)[1]
         if adapt and self.class_prior == "source":
             from twin.transfer.prior import match_class_prior
             prior = np.bincount(ys_fixed.astype(np.int64), minlength=k) / ys_fixed.size
-            self.target_log_weights_ = match_class_prior(self._forward(xt)[1], prior)
+            self.target_log_weights_ = match_class_prior(p_adapt, prior)
+        self._class_prior_check(p_adapt, prior if adapt and self.class_prior == "source" else None)
         self.n_source_windows_ = int(n_s)
         self.n_target_windows_ = int(xt.shape[0])
         return self
+
+    def _class_prior_check(self, p_adapt: np.ndarray, prior: np.ndarray | None) -> None:
+        """Record how the offsets re-assess the adaptation windows ``p_adapt`` (n, K); warn when they
+        move an unusual share of them (the symptom of rig data that break the match's assumption,
+        or of a rig that shifts the boundaries far)."""
+        from twin.transfer.prior import stage_moves
+        self.adaptation_stage_counts_, self.class_prior_moved_ = stage_moves(p_adapt, self.target_log_weights_)
+        if prior is not None and self.class_prior_moved_ > CLASS_PRIOR_WARN_SHARE:
+            import warnings
+            k = p_adapt.shape[1]
+            counts = ", ".join(map(str, self.adaptation_stage_counts_[0]))
+            warnings.warn(
+                f"the class-prior match moved {100 * self.class_prior_moved_:.1f} % of the {p_adapt.shape[0]} rig "
+                f"adaptation windows to another stage (more than {100 * CLASS_PRIOR_WARN_SHARE:.0f} %). "
+                f"Unmatched, they read as stages 0..{k - 1}: {counts}; the match assumes the proportions "
+                f"{', '.join(f'{v:.2f}' for v in prior)}. Either the rig moves the stage boundaries far (what the "
+                f"match corrects) or its data do not cover the stages in those proportions (a run-to-failure "
+                f"history, say); in that case retrain with class_prior=None (twin train-assessor "
+                f"--no-class-prior).", ClassPriorWarning, stacklevel=3)
 
     # ---- inference ------------------------------------------------------------------------------
     def _check_fitted(self) -> None:
@@ -597,7 +633,9 @@ class Assessor:
                   "fit_time": getattr(self, "fit_time_", None),
                   "source_normaliser": self.source_normaliser_.to_dict(),
                   "target_normaliser": self.target_normaliser_.to_dict(),
-                  "target_log_weights": [float(v) for v in self.target_log_weights_]}
+                  "target_log_weights": [float(v) for v in self.target_log_weights_],
+                  "adaptation_stage_counts": getattr(self, "adaptation_stage_counts_", np.zeros((2, 0))).tolist(),
+                  "class_prior_moved": getattr(self, "class_prior_moved_", None)}
         with atomic_path(d / "weights.pt") as tmp:
             torch.save({k: v.cpu() for k, v in self.network_.state_dict().items()}, tmp)
         with atomic_path(d / "config.json") as tmp:
@@ -675,6 +713,17 @@ class Assessor:
             raise AssessorError(f"'{cfg_file}': target_log_weights must be {a.n_classes_} finite numbers, "
                                 f"got {weights!r}")
         a.target_log_weights_ = w
+        # diagnostics of the match, written since stop 14; an older version-4 file has none
+        if cfg.get("class_prior_moved") is not None:
+            try:
+                a.class_prior_moved_ = float(cfg["class_prior_moved"])
+                a.adaptation_stage_counts_ = np.asarray(cfg["adaptation_stage_counts"], dtype=np.int64)
+            except (KeyError, TypeError, ValueError) as exc:
+                raise AssessorError(f"'{cfg_file}': damaged class-prior diagnostics: {exc!r}") from None
+            if a.adaptation_stage_counts_.shape != (2, a.n_classes_) or not 0 <= a.class_prior_moved_ <= 1:
+                raise AssessorError(f"'{cfg_file}': adaptation_stage_counts must be 2 x {a.n_classes_} and "
+                                    f"class_prior_moved in [0, 1], got {cfg['adaptation_stage_counts']!r} and "
+                                    f"{cfg['class_prior_moved']!r}")
         if cfg.get("fit_time") is not None:
             a.fit_time_ = cfg["fit_time"]
         return a

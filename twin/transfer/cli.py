@@ -27,12 +27,24 @@ def _cmd_train_assessor(args: argparse.Namespace) -> int:
            else transfer.Preprocessing.for_shaft_speed(args.shaft_speed, **settings))
     a = transfer.Assessor(args.method, epochs=args.epochs, seed=args.seed, preprocessing=pre,
                           progress=not args.no_progress, class_prior=None if args.no_class_prior else "source")
-    a.fit(Path(args.source), Path(args.target))
+    import warnings
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", transfer.ClassPriorWarning)
+        a.fit(Path(args.source), Path(args.target))
     a.save(out)
     last = a.history_[-1]
     print(f"{args.method}: {a.n_classes_} stages, {a.n_source_windows_} source / {a.n_target_windows_} target "
           f"windows, {len(a.history_)} epochs in {a.fit_time_:.0f} s; last epoch: loss {last['loss']:.3f}, "
           f"source accuracy {100 * last['source_acc']:.1f} % -> {out}")
+    if a.class_prior == "source" and args.method != "cnn":
+        before, after = (" / ".join(map(str, row)) for row in a.adaptation_stage_counts_)
+        print(f"class-prior match: rig adaptation windows per stage {before} -> {after} "
+              f"({100 * a.class_prior_moved_:.1f} % changed stage)")
+    for w in caught:
+        if issubclass(w.category, transfer.ClassPriorWarning):
+            print(f"warning: {w.message}")
+        else:
+            warnings.showwarning(w.message, w.category, w.filename, w.lineno)
     return 0
 
 

@@ -23,7 +23,7 @@ import numpy as np
 
 from twin.transfer.errors import AssessorError
 
-__all__ = ["LOG_WEIGHT_LIMIT", "apply_log_weights", "match_class_prior"]
+__all__ = ["LOG_WEIGHT_LIMIT", "apply_log_weights", "match_class_prior", "stage_moves"]
 
 # A stage the adaptation data hardly show would need an unbounded weight; e^8 ~ 3000 is far past any
 # boundary shift seen on the benchmark rigs (|log w| <= 3.2) and keeps the correction finite.
@@ -80,3 +80,29 @@ def match_class_prior(proba: np.ndarray, prior: np.ndarray, *, tol: float = 1e-6
         log_w = log_w + np.log(pi / mean)
         log_w = np.clip(log_w - log_w.mean(), -LOG_WEIGHT_LIMIT, LOG_WEIGHT_LIMIT)
     return log_w
+
+
+def stage_moves(proba: np.ndarray, log_weights: np.ndarray) -> tuple[np.ndarray, float]:
+    """How the offsets re-assess windows: counts per stage without and with them, and the share moved.
+
+    Parameters
+    ----------
+    proba : ndarray (n, K)
+        Stage probabilities of the windows, without offsets.
+    log_weights : ndarray (K,)
+        The offsets (:func:`match_class_prior`).
+
+    Returns
+    -------
+    counts : ndarray (2, K) of int
+        Windows assessed as each stage without (row 0) and with (row 1) the offsets.
+    moved : float
+        Share of the windows whose stage the offsets change, in [0, 1].
+    """
+    p = np.asarray(proba, dtype=np.float64)
+    w = np.asarray(log_weights, dtype=np.float64)
+    if p.ndim != 2 or p.shape[0] < 1 or w.shape != (p.shape[1],):
+        raise AssessorError(f"stage moves: probabilities (n, K) and offsets (K,) needed, got {p.shape} and {w.shape}")
+    before, after = p.argmax(1), apply_log_weights(p, w).argmax(1)
+    k = p.shape[1]
+    return np.stack([np.bincount(before, minlength=k), np.bincount(after, minlength=k)]), float(np.mean(before != after))

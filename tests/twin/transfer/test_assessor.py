@@ -11,6 +11,10 @@ from twin.transfer import Assessor, AssessorError
 
 from .conftest import FS, make_records, tiny_assessor
 
+# The tiny rig's gain and hum move a third of its windows under the class-prior match, so every fit
+# on it warns; test_class_prior_diagnostics_and_the_warning checks that warning itself.
+pytestmark = pytest.mark.filterwarnings("ignore::twin.transfer.errors.ClassPriorWarning")
+
 
 @pytest.fixture(scope="module")
 def fitted(tiny_pre, tiny_data):
@@ -258,6 +262,44 @@ def test_class_prior_offsets_survive_save_and_load_and_version_3_loads_without(f
     del cfg["target_log_weights"]                            # version 4 without offsets: damaged
     (d / "config.json").write_text(json.dumps(cfg))
     with pytest.raises(AssessorError, match="got None"):
+        Assessor.load(d)
+
+
+def test_class_prior_diagnostics_and_the_warning(tiny_pre, tiny_data, fitted):
+    """fit records how the match re-assesses the adaptation windows and warns when it moves many:
+    the tiny rig's gain and hum push stage 0 into stage 1, so the match moves about a third."""
+    import warnings
+
+    from twin.transfer import ClassPriorWarning
+    from twin.transfer.assessor import CLASS_PRIOR_WARN_SHARE
+    src, adapt, _ = tiny_data
+    counts = fitted.adaptation_stage_counts_
+    assert counts.shape == (2, 3) and counts.sum(1).tolist() == [fitted.n_target_windows_] * 2
+    assert counts[0, 0] < counts[1, 0]               # stage 0 windows won back by the match
+    assert fitted.class_prior_moved_ > CLASS_PRIOR_WARN_SHARE
+    with pytest.warns(ClassPriorWarning, match=r"moved \d+\.\d % of the \d+ rig adaptation windows.*--no-class-prior"):
+        tiny_assessor("mmd", tiny_pre, seed=3).fit(src, adapt)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ClassPriorWarning)
+        plain = tiny_assessor("mmd", tiny_pre, seed=3, class_prior=None).fit(src, adapt)
+        # a rig without the hum and gain: nothing to move, no warning
+        same = tiny_assessor("mmd", tiny_pre, seed=3).fit(src, make_records(8, seed=2, labelled=False))
+    assert plain.class_prior_moved_ == 0.0
+    assert same.class_prior_moved_ == 0.0
+
+
+def test_class_prior_diagnostics_survive_save_and_load(fitted, tmp_path):
+    d = fitted.save(tmp_path / "diag")
+    back = Assessor.load(d)
+    assert back.class_prior_moved_ == fitted.class_prior_moved_
+    np.testing.assert_array_equal(back.adaptation_stage_counts_, fitted.adaptation_stage_counts_)
+    cfg = json.loads((d / "config.json").read_text())
+    del cfg["class_prior_moved"], cfg["adaptation_stage_counts"]      # written before stop 14
+    (d / "config.json").write_text(json.dumps(cfg))
+    assert not hasattr(Assessor.load(d), "class_prior_moved_")
+    cfg["class_prior_moved"], cfg["adaptation_stage_counts"] = 1.5, [[1, 2, 3]]
+    (d / "config.json").write_text(json.dumps(cfg))
+    with pytest.raises(AssessorError, match="adaptation_stage_counts must be 2 x 3"):
         Assessor.load(d)
 
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from twin.transfer import AssessorError
-from twin.transfer.prior import LOG_WEIGHT_LIMIT, apply_log_weights, match_class_prior
+from twin.transfer.prior import LOG_WEIGHT_LIMIT, apply_log_weights, match_class_prior, stage_moves
 
 
 def test_identical_windows_give_the_hand_computed_offsets():
@@ -52,3 +52,15 @@ def test_a_stage_the_data_never_show_gets_a_bounded_weight():
 def test_bad_inputs_are_named(p, prior, match):
     with pytest.raises(AssessorError, match=match):
         match_class_prior(p, prior)
+
+
+def test_stage_moves_counts_by_hand():
+    # offsets (ln 3, -ln 3) turn (0.4, 0.6) into (0.86, 0.14) but leave (0.05, 0.95) at stage 1
+    p = np.array([[0.4, 0.6], [0.05, 0.95], [0.7, 0.3], [0.45, 0.55]])
+    counts, moved = stage_moves(p, np.array([math.log(3), -math.log(3)]))
+    assert counts.tolist() == [[1, 3], [3, 1]]
+    assert moved == 0.5
+    counts, moved = stage_moves(p, np.zeros(2))
+    assert counts.tolist() == [[1, 3], [1, 3]] and moved == 0.0
+    with pytest.raises(AssessorError, match=r"offsets \(K,\) needed"):
+        stage_moves(p, np.zeros(3))
