@@ -57,8 +57,8 @@ SAVE_VERSION = 4
 _READABLE_VERSIONS = (1, 2, 3, 4)
 CLASS_PRIORS = ("source", None)
 # Share of the adaptation windows the class-prior match may move to another stage before fit warns.
-# On the balanced benchmark and blind rigs it moved 0-4.4 %; on run-to-failure-like subsets of the
-# benchmark rig, where it costs 8-16 points, 10.8-19 % (BENCHMARKS.md, stop 14; 2 seeds per case).
+# On the balanced benchmark and blind rigs it moved 0-6.1 %; on run-to-failure-like subsets of the
+# benchmark rig, where it costs 8-16 points, 8.8-19.7 % (BENCHMARKS.md, stop 14; 5 seeds per case).
 CLASS_PRIOR_WARN_SHARE = 0.08
 _EVAL_BATCH = 256
 
