@@ -239,12 +239,11 @@ def _transfer_demo(out_dir: Path, epochs: int = 15):
     the demo stays within minutes; the figures over 5 seeds with the paper's 80 epochs are in
     BENCHMARKS.md.
     """
-    import warnings
     from dataclasses import replace
 
     from twin.transfer.assessor import Assessor
     from twin.transfer.benchmark import TASK_SETTINGS, load_task_data, prepare_task, task_preprocessing
-    from twin.transfer.errors import ClassPriorWarning
+    from twin.transfer.errors import class_prior_notes
 
     t = time.perf_counter()
     data = out_dir / "transfer_data"
@@ -256,10 +255,9 @@ def _transfer_demo(out_dir: Path, epochs: int = 15):
     accuracy, assessed, notes = {}, None, []
     for method in ("cnn", "mmd", "proposed"):
         a = Assessor(method, epochs=epochs, seed=0, preprocessing=pre, progress=False)
-        with warnings.catch_warnings(record=True) as caught:    # printed below, in the step's layout
-            warnings.simplefilter("always", ClassPriorWarning)
+        with class_prior_notes() as caught:      # printed below, in the step's layout
             a.fit(source, adapt)
-        notes += [f"{method}: {w.message}" for w in caught if issubclass(w.category, ClassPriorWarning)]
+        notes += [f"{method}: {n}" for n in caught]
         asm = a.assess(test)
         windows = [(r.label, w) for r in asm.records for w in r.window_stages]
         accuracy[method] = float(np.mean([y == w for y, w in windows]))

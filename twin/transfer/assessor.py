@@ -463,12 +463,12 @@ class Assessor:
         self.n_classes_ = k
         self.classes_ = np.arange(k)
         self.history_ = history
-        p_adapt = self._forward(xt)[1]
+        p_adapt, prior = self._forward(xt)[1], None
         if adapt and self.class_prior == "source":
             from twin.transfer.prior import match_class_prior
             prior = np.bincount(ys_fixed.astype(np.int64), minlength=k) / ys_fixed.size
             self.target_log_weights_ = match_class_prior(p_adapt, prior)
-        self._class_prior_check(p_adapt, prior if adapt and self.class_prior == "source" else None)
+        self._class_prior_check(p_adapt, prior)
         self.n_source_windows_ = int(n_s)
         self.n_target_windows_ = int(xt.shape[0])
         return self
@@ -634,7 +634,8 @@ class Assessor:
                   "source_normaliser": self.source_normaliser_.to_dict(),
                   "target_normaliser": self.target_normaliser_.to_dict(),
                   "target_log_weights": [float(v) for v in self.target_log_weights_],
-                  "adaptation_stage_counts": getattr(self, "adaptation_stage_counts_", np.zeros((2, 0))).tolist(),
+                  "adaptation_stage_counts": (self.adaptation_stage_counts_.tolist()
+                                              if hasattr(self, "adaptation_stage_counts_") else None),
                   "class_prior_moved": getattr(self, "class_prior_moved_", None)}
         with atomic_path(d / "weights.pt") as tmp:
             torch.save({k: v.cpu() for k, v in self.network_.state_dict().items()}, tmp)

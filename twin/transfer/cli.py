@@ -27,9 +27,8 @@ def _cmd_train_assessor(args: argparse.Namespace) -> int:
            else transfer.Preprocessing.for_shaft_speed(args.shaft_speed, **settings))
     a = transfer.Assessor(args.method, epochs=args.epochs, seed=args.seed, preprocessing=pre,
                           progress=not args.no_progress, class_prior=None if args.no_class_prior else "source")
-    import warnings
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", transfer.ClassPriorWarning)
+    from twin.transfer.errors import class_prior_notes
+    with class_prior_notes() as notes:
         a.fit(Path(args.source), Path(args.target))
     a.save(out)
     last = a.history_[-1]
@@ -40,11 +39,8 @@ def _cmd_train_assessor(args: argparse.Namespace) -> int:
         before, after = (" / ".join(map(str, row)) for row in a.adaptation_stage_counts_)
         print(f"class-prior match: rig adaptation windows per stage {before} -> {after} "
               f"({100 * a.class_prior_moved_:.1f} % changed stage)")
-    for w in caught:
-        if issubclass(w.category, transfer.ClassPriorWarning):
-            print(f"warning: {w.message}")
-        else:
-            warnings.showwarning(w.message, w.category, w.filename, w.lineno)
+    for note in notes:
+        print(f"warning: {note}")
     return 0
 
 
