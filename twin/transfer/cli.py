@@ -116,8 +116,9 @@ def add_subcommands(sub) -> None:
     p.add_argument("--data-dir", help="where the simulated source/target data are cached (default: OUT/data)")
     # The names of benchmark.RIGS, spelt out: importing it would pull numpy into ``twin --help``
     # (tests/twin/transfer/test_cli_transfer.py checks that the two agree).
-    p.add_argument("--rig", choices=("rig", "blind"), default="rig",
-                   help="emulated rig of the target data: the benchmark's (default) or the blind one, fixed "
-                        "after every setting was chosen")
+    p.add_argument("--rig", choices=("rig", "blind", "lumped"), default="rig",
+                   help="emulated rig of the target data: the benchmark's (default), the blind one fixed "
+                        "after every setting was chosen, or 'lumped', an independent simulator of the gearbox "
+                        "(twin.transfer.lumped) that shares no code with the twin")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bars")
     p.set_defaults(handler=_cmd_benchmark_transfer)

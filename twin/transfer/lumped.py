@@ -1,0 +1,348 @@
+"""A second, independent simulator of the test gearbox: "measured" data the twin did not make.
+
+The issue asks that the assessor be judged on target data that did not come from our simulator.
+The emulated rigs of :mod:`twin.transfer.domain` vary the twin's own 21-DOF FMU, so they share its
+mesh-stiffness table, its wear and pitting mappings and its shaft-bearing-pedestal dynamics.  This
+module shares none of that code or those parameters: it is a different *model family* of the same
+gearbox, written from the gear datasheet alone.  Its results are therefore a test of how far the
+assessor's robustness rests on physics rather than on the twin's particular equations.
+
+=============================  =====================================================================
+part                           this simulator (defaults in :class:`LumpedRig`)
+=============================  =====================================================================
+structure                      one degree of freedom: the dynamic transmission error ``x`` [m] along
+                               the line of action, ``m_e x'' = F0 - F_mesh``; no shafts, bearings,
+                               pedestals or drive line (the twin has 21 DOF)
+gear bodies                    solid steel disks of the pitch radius and face width,
+                               ``m_e = 1 / (rb1^2/I1 + rb2^2/I2)``
+pair stiffness                 ISO 6336-1 single-pair stiffness ``c' b`` (14 N/(mm um)) at mid path,
+                               falling to 60 % at the path's ends as ``0.6 + 0.4 sin(pi u)``
+contact                        unilateral, per tooth pair: ``f_j = k_j (x - e_j + beta x')`` while
+                               ``x > e_j``, 0 otherwise; ``beta`` gives 8 % of critical damping
+tooth errors                   per-tooth pitch error (normal, 2 um sd) and pinion run-out (6 um peak to
+                               peak), fixed for the gearbox, at a random start angle per record
+wear                           Archard profile ``e(u) = h w_i s(u)``, ``s ~ |u - u_pitch|`` times the
+                               load share (1 in the single-pair zone, 1/2 in the double-pair zones),
+                               mean 1 over the path; ``h`` the mean wear depth, ``w_i`` a per-tooth
+                               factor (sd 10 %) fixed for the gearbox
+pitting                        lost contact width: ``k_j -> k_j (1 - d_i(u))``, local density
+                               ``d_i(u) = D a_i b(u)`` clipped to 0.95, ``b`` a Gaussian band centred
+                               in the pinion's dedendum single-pair zone (mean 1 over the path),
+                               ``a_i`` per-tooth factors (gamma, sd 50 %) fixed for the gearbox
+transfer path                  the dynamic mesh force drives four casing modes (1.35, 2.9, 5.2, 8.4 kHz,
+                               2-6 % damping); the channel is their summed acceleration
+acquisition                    51.2 kHz (the twin writes 100 kHz), per-record gain (10 % log-normal),
+                               white noise 8 % of the record RMS, speed and load scatter 2 % / 10 %
+=============================  =====================================================================
+
+The stage variable keeps its meaning: ``D`` is the pitted fraction of the active flank area, ``h``
+the mean wear depth of the pinion flank, both drawn within the scenario's stages by the archive's
+own rule (:func:`twin.archive.stage_damage`).  The integration is a fixed-step RK4 at four times the
+acquisition rate (4.9 us, below the 5 us the 21-DOF model needs), vectorised over records; the
+casing response is filtered at that rate and decimated with an anti-alias FIR.
+
+Nothing here was tuned to the assessor: the defaults were set from the datasheet and textbook
+values once, before the first assessment was run on it.
+"""
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+
+from twin.errors import ParameterError, ScenarioError
+
+__all__ = ["LumpedRig", "make_lumped_target", "mesh_geometry"]
+
+STEEL_DENSITY = 7850.0          # kg/m3
+ISO_SINGLE_PAIR_STIFFNESS = 14e9    # N/m per m of face width (ISO 6336-1 c' = 14 N/(mm um))
+
+
+@dataclass(frozen=True)
+class LumpedRig:
+    """The independent simulator's gearbox, casing and acquisition (module docstring for the physics).
+
+    Attributes
+    ----------
+    teeth : tuple of int
+        Pinion and gear tooth numbers.
+    module, pressure_angle, face_width : float
+        Normal module [m], pressure angle [rad], face width [m].
+    damping_ratio : float
+        Mesh damping as a fraction of critical [-].
+    pitch_error, runout : float
+        Per-tooth pitch error sd [m]; pinion run-out peak to peak [m].
+    wear_tooth_scatter, pitting_tooth_scatter : float
+        Relative sd of the per-tooth wear and pitting factors [-].
+    pit_band_width : float
+        Sd of the pitting band along the path of contact, as a fraction of it [-].
+    modes_hz, modes_damping, modes_gain : tuple of float
+        Casing modes: frequency [Hz], damping ratio [-], relative participation [-].
+    sample_rate : float
+        Acquisition rate [Hz].
+    substeps : int
+        RK4 steps per acquired sample.
+    gain_error, noise, speed_scatter, load_scatter : float
+        As in :class:`twin.transfer.domain.TargetShift`.
+    """
+
+    teeth: tuple = (19, 52)
+    module: float = 3e-3
+    pressure_angle: float = math.radians(20.0)
+    face_width: float = 0.020
+    damping_ratio: float = 0.08
+    pitch_error: float = 2e-6
+    runout: float = 6e-6
+    wear_tooth_scatter: float = 0.10
+    pitting_tooth_scatter: float = 0.5
+    pit_band_width: float = 0.12
+    modes_hz: tuple = (1350.0, 2900.0, 5200.0, 8400.0)
+    modes_damping: tuple = (0.03, 0.04, 0.05, 0.06)
+    modes_gain: tuple = (0.6, 1.0, 0.7, 0.4)
+    sample_rate: float = 51200.0
+    substeps: int = 4
+    gain_error: float = 0.10
+    noise: float = 0.08
+    speed_scatter: float = 0.02
+    load_scatter: float = 0.10
+
+    def __post_init__(self) -> None:
+        problems = []
+        if (len(self.teeth) != 2 or not all(isinstance(z, int) and z >= 10 for z in self.teeth)):
+            problems.append(f"teeth must be two integers >= 10, got {self.teeth!r}")
+        for name in ("module", "pressure_angle", "face_width", "damping_ratio", "sample_rate"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+                problems.append(f"{name} must be a finite number > 0, got {v!r}")
+        for name in ("pitch_error", "runout", "wear_tooth_scatter", "pitting_tooth_scatter", "pit_band_width",
+                     "gain_error", "noise", "speed_scatter", "load_scatter"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
+                problems.append(f"{name} must be a finite number >= 0, got {v!r}")
+        if not (isinstance(self.substeps, int) and self.substeps >= 1):
+            problems.append(f"substeps must be a positive integer, got {self.substeps!r}")
+        modes = (self.modes_hz, self.modes_damping, self.modes_gain)
+        if len({len(m) for m in modes}) != 1 or not self.modes_hz:
+            problems.append("modes_hz, modes_damping and modes_gain must have the same, non-zero length")
+        elif any(not 0 < f < self.sample_rate / 2 for f in self.modes_hz) or any(d <= 0 for d in self.modes_damping):
+            problems.append(f"casing modes must lie in (0, {self.sample_rate / 2:g}) Hz with damping > 0, "
+                            f"got {self.modes_hz!r} / {self.modes_damping!r}")
+        if problems:
+            raise ParameterError("LumpedRig: " + "; ".join(problems))
+
+
+@dataclass(frozen=True)
+class MeshGeometry:
+    """Involute spur-pair quantities derived from the datasheet."""
+
+    contact_ratio: float        # transverse contact ratio [-]
+    roll_pitch: float           # roll position of the pitch point on the path (0 start, 1 end) [-]
+    base_radii: tuple           # (rb1, rb2) [m]
+    equivalent_mass: float      # m_e [kg]
+    pair_stiffness: float       # c' b, peak single-pair stiffness [N/m]
+
+
+def mesh_geometry(rig: LumpedRig) -> MeshGeometry:
+    """The standard involute relations (addendum = one module, no profile shift)."""
+    z1, z2 = rig.teeth
+    r1, r2 = 0.5 * rig.module * z1, 0.5 * rig.module * z2
+    rb1, rb2 = r1 * math.cos(rig.pressure_angle), r2 * math.cos(rig.pressure_angle)
+    ra1, ra2 = r1 + rig.module, r2 + rig.module
+    approach2 = math.sqrt(ra2 ** 2 - rb2 ** 2)
+    path = math.sqrt(ra1 ** 2 - rb1 ** 2) + approach2 - (r1 + r2) * math.sin(rig.pressure_angle)
+    eps = path / (math.pi * rig.module * math.cos(rig.pressure_angle))
+    start = (r1 + r2) * math.sin(rig.pressure_angle) - approach2        # from T1, the pinion root end
+    roll_pitch = (r1 * math.sin(rig.pressure_angle) - start) / path
+    inertia = [0.5 * STEEL_DENSITY * math.pi * rig.face_width * r ** 4 for r in (r1, r2)]
+    m_e = 1.0 / (rb1 ** 2 / inertia[0] + rb2 ** 2 / inertia[1])
+    return MeshGeometry(eps, roll_pitch, (rb1, rb2), m_e, ISO_SINGLE_PAIR_STIFFNESS * rig.face_width)
+
+
+def _profile_shapes(g: MeshGeometry, band_width: float, n: int = 2001):
+    """(u grid, Archard wear shape, pitting band), both with mean 1 over the path of contact."""
+    u = np.linspace(0.0, 1.0, n)
+    eps = g.contact_ratio
+    single = (u >= (eps - 1) / eps) & (u <= 1 / eps)
+    wear = np.abs(u - g.roll_pitch) * np.where(single, 1.0, 0.5)
+    centre = 0.5 * ((eps - 1) / eps + g.roll_pitch)      # the dedendum single-pair zone, below pitch
+    band = np.exp(-0.5 * ((u - centre) / max(band_width, 1e-3)) ** 2)
+    return u, wear / wear.mean(), band / band.mean()
+
+
+def simulate_lumped(rig: LumpedRig, speeds, loads, damages, kind: str, duration: float, *, gear_seed: int,
+                    start_angles=None, settle: float = 0.05) -> np.ndarray:
+    """Casing acceleration of records of the lumped model, before gain and noise.
+
+    Parameters
+    ----------
+    speeds, loads, damages : array_like, shape (R,)
+        Pinion speed [Hz], brake (output) torque [N.m], and the stage variable (pitting density
+        [-] or mean wear depth [m]) per record.
+    kind : {"pitting_density", "wear_depth"}
+    duration : float
+        Record length after ``settle`` [s].
+    gear_seed : int
+        Seeds the gearbox's tooth errors and per-tooth factors: one seed, one gearbox.
+    start_angles : array_like, shape (R,), optional
+        Pinion angle at the start of each record [rad] (default 0).
+
+    Returns
+    -------
+    ndarray, shape (R, round(duration * rig.sample_rate))
+        Acceleration [arbitrary but consistent units, m/s2 per N of mesh force].
+    """
+    from scipy.signal import bilinear, decimate, lfilter
+
+    if kind not in ("pitting_density", "wear_depth"):
+        raise ParameterError(f"damage kind must be 'pitting_density' or 'wear_depth', got {kind!r}")
+    speeds, loads, damages = (np.asarray(a, dtype=float) for a in (speeds, loads, damages))
+    if not (speeds.shape == loads.shape == damages.shape and speeds.ndim == 1):
+        raise ParameterError("speeds, loads and damages must be 1-D arrays of one length")
+    if np.any(speeds <= 0) or np.any(loads <= 0) or np.any(damages < 0):
+        raise ParameterError("speeds and loads must be > 0 and damages >= 0")
+    g = mesh_geometry(rig)
+    z1 = rig.teeth[0]
+    rng = np.random.default_rng(gear_seed)
+    pitch_err = rig.pitch_error * rng.standard_normal(z1)
+    wear_factor = 1.0 + rig.wear_tooth_scatter * rng.standard_normal(z1)
+    shape_k = 1.0 / max(rig.pitting_tooth_scatter, 1e-3) ** 2
+    pit_factor = rng.gamma(shape_k, 1.0 / shape_k, z1)
+    runout_phase = rng.uniform(0, 2 * np.pi)
+    start_angle = np.zeros_like(speeds) if start_angles is None else np.asarray(start_angles, dtype=float)
+    if start_angle.shape != speeds.shape:
+        raise ParameterError("start_angles must have one angle per record")
+
+    u_grid, wear_shape, band = _profile_shapes(g, rig.pit_band_width)
+    wear_depth = damages if kind == "wear_depth" else np.zeros_like(damages)
+    density = damages if kind == "pitting_density" else np.zeros_like(damages)
+    eps, m_e, k_peak = g.contact_ratio, g.equivalent_mass, g.pair_stiffness
+    omega_n = math.sqrt(k_peak * eps / m_e)
+    beta = 2 * rig.damping_ratio / omega_n
+    f0 = loads / g.base_radii[1]                                  # N, static mesh force
+    n_pairs = int(math.ceil(eps))
+    j = np.arange(n_pairs)
+
+    def mesh_force(t, x, v):
+        theta = 2 * np.pi * speeds * t + start_angle              # (R,)
+        p = theta * z1 / (2 * np.pi)
+        n = np.floor(p)
+        u = ((p - n)[:, None] + j) / eps                          # (R, J)
+        tooth = ((n[:, None] - j) % z1).astype(np.intp)
+        active = u < 1.0
+        uc = np.minimum(u, 1.0)
+        k = k_peak * (0.6 + 0.4 * np.sin(np.pi * uc))
+        d = np.minimum(0.95, density[:, None] * pit_factor[tooth] * np.interp(uc, u_grid, band))
+        k = k * (1.0 - d)
+        e = (wear_depth[:, None] * wear_factor[tooth] * np.interp(uc, u_grid, wear_shape) + pitch_err[tooth]
+             + (0.5 * rig.runout * (1 - np.cos(theta + runout_phase)))[:, None])
+        delta = x[:, None] - e
+        f = np.where(active & (delta > 0), np.maximum(k * (delta + beta * v[:, None]), 0.0), 0.0)
+        return f.sum(axis=1), e.min(axis=1, where=active, initial=np.inf)
+
+    h = 1.0 / (rig.sample_rate * rig.substeps)
+    n_settle = int(round(settle / h))
+    n_keep = int(round(duration * rig.sample_rate)) * rig.substeps
+    # start at the static deflection on the leading pair, so the transient is short
+    _, e0 = mesh_force(0.0, np.zeros_like(f0), np.zeros_like(f0))
+    x = e0 + f0 / (k_peak * eps)
+    v = np.zeros_like(x)
+    force = np.empty((speeds.size, n_keep))
+    for step in range(n_settle + n_keep):
+        t = step * h
+        fa, _ = mesh_force(t, x, v)
+        a1 = (f0 - fa) / m_e
+        fb, _ = mesh_force(t + h / 2, x + h / 2 * v, v + h / 2 * a1)
+        a2 = (f0 - fb) / m_e
+        fc, _ = mesh_force(t + h / 2, x + h / 2 * (v + h / 2 * a1), v + h / 2 * a2)
+        a3 = (f0 - fc) / m_e
+        fd, _ = mesh_force(t + h, x + h * (v + h / 2 * a2), v + h * a3)
+        a4 = (f0 - fd) / m_e
+        x, v = x + h * (v + h / 6 * (a1 + a2 + a3)), v + h / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
+        if step >= n_settle:
+            force[:, step - n_settle] = fa
+        if not np.all(np.isfinite(x)):
+            from twin.errors import SimulationError
+            raise SimulationError(f"the lumped model diverged at t = {t:.4g} s")
+    force -= force.mean(axis=1, keepdims=True)
+    fs = rig.sample_rate * rig.substeps
+    acc = np.zeros_like(force)
+    for fm, zeta, gain in zip(rig.modes_hz, rig.modes_damping, rig.modes_gain):
+        w = 2 * fs * math.tan(math.pi * fm / fs)                  # pre-warped [rad/s]
+        b, a = bilinear([1.0, 0.0, 0.0], [1.0, 2 * zeta * w, w ** 2], fs=fs)
+        acc += gain * lfilter(b, a, force, axis=1)
+    if rig.substeps > 1:
+        acc = decimate(acc, rig.substeps, ftype="fir", axis=1, zero_phase=True)
+    return acc
+
+
+def make_lumped_target(source_scenario, output: str | Path, *, records_per_stage: int = 15,
+                       record_duration: float = 0.4, seed: int = 3, rig: LumpedRig | None = None,
+                       progress: bool = True) -> Path:
+    """Simulate the target domain of ``source_scenario``'s stages on the lumped model; write it.
+
+    The counterpart of :func:`twin.transfer.domain.make_target_domain` with the same file layout:
+    channel ``accel_pinion_casing`` [m/s2, arbitrary scale] at ``rig.sample_rate``, attributes
+    ``label``, ``damage`` (evaluation only), ``nominal_speed``, ``load``; metadata ``stages``,
+    ``damage_kind``, ``lumped_rig`` (JSON).  Only the scenario's stages, damage kind (its
+    degradation model) and nominal operating point are read; its FMU is not used.
+    """
+    from twin.archive import nominal_operating_point, stage_damage
+    from twin.measurements import MeasurementSet, Record, write_measurements
+    from twin.measurements.write import _check_h5_path
+
+    rig = rig or LumpedRig()
+    if not isinstance(records_per_stage, int) or records_per_stage < 1:
+        raise ParameterError(f"records_per_stage must be a positive integer, got {records_per_stage!r}")
+    if not (isinstance(record_duration, (int, float)) and record_duration > 0):
+        raise ParameterError(f"record_duration must be > 0 [s], got {record_duration!r}")
+    spec = source_scenario.archive
+    if spec is None:
+        raise ScenarioError([(str(source_scenario.source), "archive", "the scenario has no archive block")])
+    model = (source_scenario.degradation or {}).get("model")
+    kinds = {"pitting": "pitting_density", "wear": "wear_depth"}
+    if model not in kinds:
+        raise ScenarioError([(str(source_scenario.source), "degradation.model",
+                              f"the lumped rig simulates 'pitting' or 'wear', got {model!r}")])
+    target = _check_h5_path(output)
+    bounds = [float(b) for b in spec["stages"]]
+    nominal_speed, nominal_load = nominal_operating_point(source_scenario)
+    seq_draw, seq_gear, seq_noise = np.random.SeedSequence(seed).spawn(3)
+    draw = np.random.default_rng(seq_draw)
+    gear_seed = int(seq_gear.generate_state(1)[0])
+    meta = []
+    for s, (lo, hi) in enumerate(zip(bounds, bounds[1:])):
+        for _ in range(records_per_stage):
+            d = stage_damage(draw, lo, hi, spec)
+            f = nominal_speed * (1 + rig.speed_scatter * float(draw.standard_normal()))
+            t_load = nominal_load * (1 + rig.load_scatter * float(draw.standard_normal()))
+            gain = float(np.exp(rig.gain_error * draw.standard_normal()))
+            angle = float(draw.uniform(0, 2 * np.pi))     # where the shaft happens to be
+            meta.append((s, d, f, t_load, gain, angle))
+    s_, d_, f_, l_, g_, a_ = (np.array(c) for c in zip(*meta))
+    acc = np.empty((len(meta), int(round(record_duration * rig.sample_rate))))
+    chunk = 30      # records integrated together: vectorised, and a bar that moves
+    from twin._progress import progress_bar
+    bar = progress_bar(len(meta), progress, "lumped rig", "record")
+    try:
+        for i in range(0, len(meta), chunk):
+            sl = slice(i, i + chunk)
+            acc[sl] = simulate_lumped(rig, f_[sl], l_[sl], d_[sl], kinds[model], float(record_duration),
+                                      gear_seed=gear_seed, start_angles=a_[sl])
+            bar.update(acc[sl].shape[0])
+    finally:
+        bar.close()
+    noise_rng = np.random.default_rng(seq_noise)
+    records = []
+    for k in range(len(meta)):
+        x = g_[k] * acc[k]
+        x = x + noise_rng.normal(0.0, rig.noise * float(np.sqrt(np.mean(x ** 2))), size=x.shape)
+        records.append(Record(f"rec{k:05d}", {"accel_pinion_casing": x}, {"accel_pinion_casing": "m/s2"},
+                              rig.sample_rate, nominal_speed=float(f_[k]), load=float(l_[k]), label=int(s_[k]),
+                              damage=float(d_[k])))
+    metadata = {"stages": np.asarray(bounds), "damage_kind": kinds[model], "lumped_rig": json.dumps(asdict(rig)),
+                "seed": int(seed), "source_scenario": source_scenario.name,
+                "note": "independent lumped simulator (twin.transfer.lumped); labels and damage are for evaluation only"}
+    return write_measurements(MeasurementSet(tuple(records), None, (), metadata), target)
