@@ -97,6 +97,35 @@ def test_prepare_task_keeps_each_rigs_data_apart_and_reuses_it(tmp_path, monkeyp
     assert rig[0].read_text() == "3" and blind[0].read_text() == "32"                       # the blind pair untouched
 
 
+def test_the_lumped_rig_is_simulated_by_the_independent_model_not_the_fmu(tmp_path, monkeypatch):
+    import twin.archive
+    import twin.degradation_run
+    import twin.scenario
+    import twin.transfer.domain
+    import twin.transfer.lumped
+    from twin.transfer.benchmark import prepare_task
+
+    calls = []
+
+    def refuse(*a, **kw):
+        raise AssertionError("the lumped rig must not run the twin's degradation or target domain")
+
+    def make_lumped_target(sc, path, *, rig, seed, records_per_stage, record_duration, **kw):
+        calls.append((path.name, rig, seed, records_per_stage, record_duration))
+        path.write_text("lumped")
+
+    monkeypatch.setattr(twin.scenario.Scenario, "fmu_path", lambda self: tmp_path / "model.fmu")
+    monkeypatch.setattr(twin.archive, "build_archive", lambda sc, path, **kw: path.write_text("source"))
+    monkeypatch.setattr(twin.degradation_run, "run_degradation", refuse)
+    monkeypatch.setattr(twin.transfer.domain, "make_target_domain", refuse)
+    monkeypatch.setattr(twin.transfer.lumped, "make_lumped_target", make_lumped_target)
+    src, tgt = prepare_task("pitting", tmp_path, rig_settings("pitting", "lumped"), progress=False)
+    assert (src.name, tgt.name) == ("source_pitting_lumped.h5", "target_pitting_lumped.h5")
+    s = TASK_SETTINGS["pitting"]
+    assert calls == [("target_pitting_lumped.h5", RIGS["lumped"], 3, s.target_records_per_stage,
+                      s.target_record_duration)]
+
+
 def _rig_file(tmp_path, name, shuffle_labels=False):
     from twin.measurements import MeasurementSet, write_measurements
 
