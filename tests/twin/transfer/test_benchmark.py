@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+import numpy as np
 import pytest
 
 from twin.errors import ParameterError
@@ -59,6 +60,27 @@ def test_summarise_pairs_methods_by_seed():
     assert s["paired"]["mmd-cnn"]["paired_t_p"] < 0.05
     table = markdown_table(summarise(runs))
     assert "| wear | mmd | 91.3 +- 1.5 |" in table and "| wear | proposed-mmd | +0.7 | 2/3 |" in table
+
+
+def test_stage_order_scores_tell_one_stage_late_from_random():
+    from twin.transfer.benchmark import stage_order_scores
+
+    late = [[0, 10, 0, 0], [0, 0, 10, 0], [0, 0, 0, 10], [0, 0, 0, 10]]     # every stage read one too late
+    within, rho = stage_order_scores(late)
+    assert within == 1.0
+    # hand-computed: 40 windows, true ranks 0..3 in blocks of 10, assessed 1, 2, 3, 3
+    t = np.repeat([0, 1, 2, 3], 10).astype(float)
+    a = np.repeat([1, 2, 3, 3], 10).astype(float)
+    from scipy.stats import rankdata
+    assert rho == pytest.approx(np.corrcoef(rankdata(t), rankdata(a))[0, 1])
+    swapped = [[0, 0, 0, 10], [0, 0, 10, 0], [0, 10, 0, 0], [10, 0, 0, 0]]   # the order reversed
+    within, rho = stage_order_scores(swapped)
+    assert within == 0.5 and rho == pytest.approx(-1.0)
+    assert np.isnan(stage_order_scores([[5, 0], [5, 0]])[1])                 # one verdict for all: no order
+    with pytest.raises(ParameterError, match="square"):
+        stage_order_scores([[1, 2, 3]])
+    runs = [RunResult("wear", "mmd", s, 0.25, 0.25, 1.0, 1.0, late, []) for s in range(2)]
+    assert "| 100.0 | 0.95 |" in markdown_table(summarise(runs))
 
 
 def test_prepare_task_keeps_each_rigs_data_apart_and_reuses_it(tmp_path, monkeypatch):
