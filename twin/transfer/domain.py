@@ -122,6 +122,21 @@ def resonator(x: np.ndarray, sample_rate: float, f0: float, q: float) -> np.ndar
     return lfilter(b, a, x, axis=-1)
 
 
+def check_target_request(source_scenario, output, records_per_stage, record_duration):
+    """Check what every target-domain simulator is asked, before any simulation; return the
+    scenario's archive block and the checked output path (``.h5``/``.hdf5``)."""
+    from twin.measurements.write import _check_h5_path
+
+    if not isinstance(records_per_stage, int) or records_per_stage < 1:
+        raise ParameterError(f"records_per_stage must be a positive integer, got {records_per_stage!r}")
+    if not (isinstance(record_duration, (int, float)) and record_duration > 0):
+        raise ParameterError(f"record_duration must be > 0 [s], got {record_duration!r}")
+    spec = source_scenario.archive
+    if spec is None:
+        raise ScenarioError([(str(source_scenario.source), "archive", "the scenario has no archive block")])
+    return spec, _check_h5_path(output)     # fail on a bad path before minutes of simulation
+
+
 def make_target_domain(source_scenario, output: str | Path, *, records_per_stage: int = 12,
                        record_duration: float = 0.4, seed: int = 1, shift: TargetShift | None = None,
                        run=None, fmu_path: Path | None = None, executor=None, progress: bool = True) -> Path:
@@ -156,18 +171,10 @@ def make_target_domain(source_scenario, output: str | Path, *, records_per_stage
                               simulate_records, stage_damage)
     from twin.fmu import FMU
     from twin.measurements import MeasurementSet, Record, write_measurements
-    from twin.measurements.write import _check_h5_path
     from twin.operating import operating_point
 
     shift = shift or TargetShift()
-    if not isinstance(records_per_stage, int) or records_per_stage < 1:
-        raise ParameterError(f"records_per_stage must be a positive integer, got {records_per_stage!r}")
-    if not (isinstance(record_duration, (int, float)) and record_duration > 0):
-        raise ParameterError(f"record_duration must be > 0 [s], got {record_duration!r}")
-    spec = source_scenario.archive
-    if spec is None:
-        raise ScenarioError([(str(source_scenario.source), "archive", "the scenario has no archive block")])
-    target = _check_h5_path(output)     # fail on a bad path before minutes of simulation
+    spec, target = check_target_request(source_scenario, output, records_per_stage, record_duration)
     fmu_file = fmu_path or source_scenario.fmu_path()
     if run is None:
         from twin.degradation_run import run_degradation

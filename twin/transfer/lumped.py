@@ -291,22 +291,15 @@ def make_lumped_target(source_scenario, output: str | Path, *, records_per_stage
     """
     from twin.archive import nominal_operating_point, stage_damage
     from twin.measurements import MeasurementSet, Record, write_measurements
-    from twin.measurements.write import _check_h5_path
+    from twin.transfer.domain import check_target_request
 
     rig = rig or LumpedRig()
-    if not isinstance(records_per_stage, int) or records_per_stage < 1:
-        raise ParameterError(f"records_per_stage must be a positive integer, got {records_per_stage!r}")
-    if not (isinstance(record_duration, (int, float)) and record_duration > 0):
-        raise ParameterError(f"record_duration must be > 0 [s], got {record_duration!r}")
-    spec = source_scenario.archive
-    if spec is None:
-        raise ScenarioError([(str(source_scenario.source), "archive", "the scenario has no archive block")])
+    spec, target = check_target_request(source_scenario, output, records_per_stage, record_duration)
     model = (source_scenario.degradation or {}).get("model")
     kinds = {"pitting": "pitting_density", "wear": "wear_depth"}
     if model not in kinds:
         raise ScenarioError([(str(source_scenario.source), "degradation.model",
                               f"the lumped rig simulates 'pitting' or 'wear', got {model!r}")])
-    target = _check_h5_path(output)
     bounds = [float(b) for b in spec["stages"]]
     nominal_speed, nominal_load = nominal_operating_point(source_scenario)
     seq_draw, seq_gear, seq_noise = np.random.SeedSequence(seed).spawn(3)
