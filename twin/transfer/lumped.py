@@ -55,7 +55,7 @@ import numpy as np
 
 from twin.errors import ParameterError, ScenarioError
 
-__all__ = ["LumpedRig", "make_lumped_target", "mesh_geometry"]
+__all__ = ["LumpedRig", "make_lumped_target", "mesh_geometry", "simulate_lumped"]
 
 STEEL_DENSITY = 7850.0          # kg/m3
 ISO_SINGLE_PAIR_STIFFNESS = 14e9    # N/m per m of face width (ISO 6336-1 c' = 14 N/(mm um))
@@ -216,8 +216,6 @@ def simulate_lumped(rig: LumpedRig, speeds, loads, damages, kind: str, duration:
         raise ParameterError("start_angles must have one angle per record")
 
     u_grid, wear_shape, band = _profile_shapes(g, rig.pit_band_width)
-    wear_depth = damages if kind == "wear_depth" else np.zeros_like(damages)
-    density = damages if kind == "pitting_density" else np.zeros_like(damages)
     eps, m_e, k_peak = g.contact_ratio, g.equivalent_mass, g.pair_stiffness
     omega_n = math.sqrt(k_peak * eps / m_e)
     beta = 2 * rig.damping_ratio / omega_n
@@ -225,40 +223,49 @@ def simulate_lumped(rig: LumpedRig, speeds, loads, damages, kind: str, duration:
     n_pairs = int(math.ceil(eps))
     j = np.arange(n_pairs)
 
-    def mesh_force(t, x, v):
+    # The contact state depends on time only, so RK4's two mid-point stages share one, and only the
+    # damage term of the record's kind is evaluated (the other is zero).
+    def contact(t):
+        """(pair stiffness, flank deviation, pair in contact), each (R, J), at time ``t``."""
         theta = 2 * np.pi * speeds * t + start_angle              # (R,)
         p = theta * z1 / (2 * np.pi)
         n = np.floor(p)
         u = ((p - n)[:, None] + j) / eps                          # (R, J)
         tooth = ((n[:, None] - j) % z1).astype(np.intp)
-        active = u < 1.0
         uc = np.minimum(u, 1.0)
         k = k_peak * (0.6 + 0.4 * np.sin(np.pi * uc))
-        d = np.minimum(0.95, density[:, None] * pit_factor[tooth] * np.interp(uc, u_grid, band))
-        k = k * (1.0 - d)
-        e = (wear_depth[:, None] * wear_factor[tooth] * np.interp(uc, u_grid, wear_shape) + pitch_err[tooth]
-             + (0.5 * rig.runout * (1 - np.cos(theta + runout_phase)))[:, None])
+        runout = (0.5 * rig.runout * (1 - np.cos(theta + runout_phase)))[:, None]
+        if kind == "pitting_density":
+            k = k * (1.0 - np.minimum(0.95, damages[:, None] * pit_factor[tooth] * np.interp(uc, u_grid, band)))
+            e = pitch_err[tooth] + runout
+        else:
+            e = damages[:, None] * wear_factor[tooth] * np.interp(uc, u_grid, wear_shape) + pitch_err[tooth] + runout
+        return k, e, u < 1.0
+
+    def mesh_force(state, x, v):
+        k, e, active = state
         delta = x[:, None] - e
         f = np.where(active & (delta > 0), np.maximum(k * (delta + beta * v[:, None]), 0.0), 0.0)
-        return f.sum(axis=1), e.min(axis=1, where=active, initial=np.inf)
+        return f.sum(axis=1)
 
     h = 1.0 / (rig.sample_rate * rig.substeps)
     n_settle = int(round(settle / h))
     n_keep = int(round(duration * rig.sample_rate)) * rig.substeps
     # start at the static deflection on the leading pair, so the transient is short
-    _, e0 = mesh_force(0.0, np.zeros_like(f0), np.zeros_like(f0))
-    x = e0 + f0 / (k_peak * eps)
+    _, e_start, active_start = contact(0.0)
+    x = e_start.min(axis=1, where=active_start, initial=np.inf) + f0 / (k_peak * eps)
     v = np.zeros_like(x)
     force = np.empty((speeds.size, n_keep))
     for step in range(n_settle + n_keep):
         t = step * h
-        fa, _ = mesh_force(t, x, v)
+        mid = contact(t + h / 2)
+        fa = mesh_force(contact(t), x, v)
         a1 = (f0 - fa) / m_e
-        fb, _ = mesh_force(t + h / 2, x + h / 2 * v, v + h / 2 * a1)
+        fb = mesh_force(mid, x + h / 2 * v, v + h / 2 * a1)
         a2 = (f0 - fb) / m_e
-        fc, _ = mesh_force(t + h / 2, x + h / 2 * (v + h / 2 * a1), v + h / 2 * a2)
+        fc = mesh_force(mid, x + h / 2 * (v + h / 2 * a1), v + h / 2 * a2)
         a3 = (f0 - fc) / m_e
-        fd, _ = mesh_force(t + h, x + h * (v + h / 2 * a2), v + h * a3)
+        fd = mesh_force(contact(t + h), x + h * (v + h / 2 * a2), v + h * a3)
         a4 = (f0 - fd) / m_e
         x, v = x + h * (v + h / 6 * (a1 + a2 + a3)), v + h / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
         if step >= n_settle:
@@ -289,6 +296,7 @@ def make_lumped_target(source_scenario, output: str | Path, *, records_per_stage
     ``damage_kind``, ``lumped_rig`` (JSON).  Only the scenario's stages, damage kind (its
     degradation model) and nominal operating point are read; its FMU is not used.
     """
+    from twin._progress import progress_bar
     from twin.archive import nominal_operating_point, stage_damage
     from twin.measurements import MeasurementSet, Record, write_measurements
     from twin.transfer.domain import check_target_request
@@ -317,7 +325,6 @@ def make_lumped_target(source_scenario, output: str | Path, *, records_per_stage
     s_, d_, f_, l_, g_, a_ = (np.array(c) for c in zip(*meta))
     acc = np.empty((len(meta), int(round(record_duration * rig.sample_rate))))
     chunk = 30      # records integrated together: vectorised, and a bar that moves
-    from twin._progress import progress_bar
     bar = progress_bar(len(meta), progress, "lumped rig", "record")
     try:
         for i in range(0, len(meta), chunk):
