@@ -259,8 +259,7 @@ def _transfer_demo(out_dir: Path, epochs: int = 15):
             a.fit(source, adapt)
         notes += [f"{method}: {n}" for n in caught]
         asm = a.assess(test)
-        windows = [(r.label, w) for r in asm.records for w in r.window_stages]
-        accuracy[method] = float(np.mean([y == w for y, w in windows]))
+        accuracy[method] = asm.window_accuracy
         if method == "proposed":
             assessed = (asm, test)
             offsets, moved = a.target_log_weights_, a.class_prior_moved_
@@ -302,12 +301,10 @@ def _independent_rig_demo(data: Path, settings, pre, epochs: int) -> float:
     with class_prior_notes() as caught:
         a.fit(source, adapt)
     asm = a.assess(test)
-    y = np.concatenate([[r.label] * len(r.window_stages) for r in asm.records])
-    p = np.concatenate([r.window_stages for r in asm.records])
-    within, rho = stage_order_scores(confusion_matrix(y, p, a.n_classes_))
+    within, _ = stage_order_scores(confusion_matrix(*asm.window_verdicts(), a.n_classes_))
     print(f"      an independent simulator of the gearbox (twin.transfer.lumped, no code shared with the twin; "
-          f"{time.perf_counter() - t:.0f} s): proposed {100 * np.mean(y == p):.0f} % exact, "
+          f"{time.perf_counter() - t:.0f} s): proposed {100 * asm.window_accuracy:.0f} % exact, "
           f"{100 * within:.0f} % within one stage (5 seeds and why: BENCHMARKS.md, stop 15)")
     for note in caught:
         print(f"      warning: {note}")
-    return float(np.mean(y == p))
+    return asm.window_accuracy

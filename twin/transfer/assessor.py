@@ -108,6 +108,21 @@ class Assessment:
     record_accuracy: float | None
     window_accuracy: float | None
 
+    def window_verdicts(self) -> tuple[np.ndarray, np.ndarray]:
+        """(true stage, assessed stage) of every window, record by record, shape (n_windows,) each.
+
+        Raises
+        ------
+        AssessorError
+            A record without a label.
+        """
+        unlabelled = [r.name for r in self.records if r.label is None]
+        if unlabelled:
+            raise AssessorError(f"window_verdicts: record(s) {unlabelled[:5]} have no label")
+        true = np.concatenate([np.full(len(r.window_stages), r.label, dtype=np.int64) for r in self.records])
+        assessed = np.concatenate([np.asarray(r.window_stages, dtype=np.int64) for r in self.records])
+        return true, assessed
+
     def to_dict(self) -> dict:
         return {"n_stages": self.n_stages, "record_accuracy": self.record_accuracy,
                 "window_accuracy": self.window_accuracy, "records": [r.to_dict() for r in self.records]}

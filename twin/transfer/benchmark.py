@@ -239,8 +239,7 @@ def train_one(task: str, method: str, seed: int, source: str, target: str, epoch
     s, adapt, test = load_task_data(task, source, target, a._pre.sample_rate)
     a.fit(s, adapt, monitor=(test, None) if monitor else None)
     asm = a.assess(test)
-    y = np.concatenate([[r.label] * len(r.window_stages) for r in asm.records])
-    p = np.concatenate([r.window_stages for r in asm.records])
+    y, p = asm.window_verdicts()
     src_acc = a.score(s) if a._pre.normalise != "domain" else float(np.mean(a.predict(s, domain="source")
                                                                              == [r.label for r in s]))
     emb = {}

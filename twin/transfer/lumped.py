@@ -201,8 +201,11 @@ def simulate_lumped(rig: LumpedRig, speeds, loads, damages, kind: str, duration:
     speeds, loads, damages = (np.asarray(a, dtype=float) for a in (speeds, loads, damages))
     if not (speeds.shape == loads.shape == damages.shape and speeds.ndim == 1):
         raise ParameterError("speeds, loads and damages must be 1-D arrays of one length")
-    if np.any(speeds <= 0) or np.any(loads <= 0) or np.any(damages < 0):
-        raise ParameterError("speeds and loads must be > 0 and damages >= 0")
+    bad = [f"{name} {a[~ok].tolist()[:5]}" for name, a, ok in (
+        ("speeds", speeds, np.isfinite(speeds) & (speeds > 0)), ("loads", loads, np.isfinite(loads) & (loads > 0)),
+        ("damages", damages, np.isfinite(damages) & (damages >= 0))) if not ok.all()]
+    if bad:
+        raise ParameterError("speeds and loads must be finite and > 0, damages finite and >= 0; got " + ", ".join(bad))
     g = mesh_geometry(rig)
     z1 = rig.teeth[0]
     rng = np.random.default_rng(gear_seed)

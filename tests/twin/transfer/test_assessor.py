@@ -68,6 +68,22 @@ def test_predict_shapes(fitted, tiny_data):
     assert len(a.records[0].window_stages) == (384 - 64) // 32 + 1
 
 
+def test_window_verdicts_pair_each_window_with_its_records_label(fitted, tiny_data):
+    from dataclasses import replace
+
+    _, _, test = tiny_data
+    a = fitted.assess(test)
+    true, assessed = a.window_verdicts()
+    n = [len(r.window_stages) for r in a.records]
+    assert true.shape == assessed.shape == (sum(n),)
+    np.testing.assert_array_equal(true[:n[0]], a.records[0].label)
+    np.testing.assert_array_equal(assessed[:n[0]], a.records[0].window_stages)
+    assert np.mean(true == assessed) == pytest.approx(a.window_accuracy)
+    unlabelled = fitted.assess([replace(r, label=None) for r in test])
+    with pytest.raises(AssessorError, match="no label"):
+        unlabelled.window_verdicts()
+
+
 def test_save_load_round_trip_gives_identical_predictions(fitted, tiny_data, tmp_path):
     _, _, test = tiny_data
     d = fitted.save(tmp_path / "assessor")
