@@ -9,7 +9,11 @@
    uniformly in the stage, interpolates the mesh parameters at each value between the
    updates around it, and scatters the operating point (speed and load, relative normal
    scatter) with a per-record seed;
-3. simulates the records in parallel (local processes by default, Dask when the scenario's
+3. optionally gives each record its own pinion (``pitch_error``, ``runout``,
+   ``tooth_damage_scatter``; :func:`tooth_errors`): random manufacturing errors and an uneven
+   spread of the damage over the teeth, drawn from a stream of its own, so an archive without
+   these keys is unchanged by them;
+4. simulates the records in parallel (local processes by default, Dask when the scenario's
    ``executor`` says so), each ``settle_time`` + ``record_duration`` seconds long, keeps the
    last ``record_duration`` seconds, and adds white measurement noise relative to the record's RMS.
 
@@ -107,6 +111,81 @@ def stage_damage(draw: np.random.Generator, lo: float, hi: float, spec) -> float
     return float(draw.uniform(lo, hi))
 
 
+TOOTH_ERROR_KEYS = ("pitch_error", "runout", "tooth_damage_scatter")
+PITTING_LOSS_CAP = 0.95     # a tooth keeps at least 5 % of its pair stiffness, as a pitted flank does
+
+
+def tooth_errors(draw: np.random.Generator, spec, teeth: int, healthy: dict, damaged: dict) -> dict[str, float]:
+    """Per-pinion-tooth FMU parameters of one record's gear: manufacturing errors and uneven damage.
+
+    Every real pinion has pitch errors and some run-out, and its damage is not the same on every
+    tooth (pits start on single teeth).  Both make the vibration differ from tooth to tooth, i.e.
+    put energy at shaft-order sidebands of the mesh harmonics, which a twin with identical teeth
+    does not have.  Each record draws a pinion of its own, with each magnitude uniform between
+    zero and the archive's bound, so the archive covers gears from perfect to the bound:
+
+    * ``pitch_error`` [m]: bound of the sd of the per-tooth pitch deviations (normal, independent);
+    * ``runout`` [m]: bound of the peak-to-peak run-out, a once-per-revolution sinusoid of random
+      phase over the teeth;
+    * ``tooth_damage_scatter`` [-]: bound of the relative sd of per-tooth damage factors c_i
+      (gamma distributed, mean 1, so the stage's mean damage is kept).  Pitting: tooth i loses
+      min(c_i L, 0.95) of its pair stiffness where the uniform damage loses L (the mean relative
+      ``k_pair`` loss), written as ``tooth_stiffness_factor[i]`` = (1 - min(c_i L, 0.95)) / (1 - L)
+      on top of the uniform ``k_pair``.  Wear: tooth i is worn c_i times the mean depth, written as
+      the extra offset (c_i - 1) x mean ``profile_deviation``.  A scalar per tooth approximates
+      the damage's shape along the flank by the uniform one's.
+
+    The offsets are ``tooth_deviation_offset[1..teeth]`` [m], shifted so that the least-cut tooth
+    has zero (a common offset only moves the static deflection).
+
+    Parameters
+    ----------
+    draw : the generator of the gear draws (one call per record).
+    spec : the archive block (the three keys above, each >= 0; absent = 0).
+    teeth : pinion tooth count (the FMU's ``tooth_deviation_offset`` array size).
+    healthy, damaged : FMU mesh parameters (``k_pair[j]``, ``profile_deviation[j]``) of the healthy
+        flank and at the record's damage.
+
+    Returns
+    -------
+    dict: ``tooth_deviation_offset[i]`` [m] and ``tooth_stiffness_factor[i]`` [-], i = 1..teeth.
+    """
+    pitch_bound, runout_bound, scatter_bound = (float(spec.get(k, 0.0)) for k in TOOTH_ERROR_KEYS)
+    pitch = draw.uniform(0.0, pitch_bound) * draw.standard_normal(teeth)
+    runout = draw.uniform(0.0, runout_bound)
+    phase = draw.uniform(0.0, 2 * np.pi)
+    offset = pitch + 0.5 * runout * (1.0 - np.cos(2 * np.pi * np.arange(teeth) / teeth + phase))
+    scatter = draw.uniform(0.0, scatter_bound)
+    c = draw.gamma(1.0 / scatter ** 2, scatter ** 2, teeth) if scatter > 0 else np.ones(teeth)
+    factor = np.ones(teeth)
+    k_keys = [k for k in healthy if k.startswith("k_pair[")]
+    k_healthy = sum(healthy[k] for k in k_keys)
+    loss = 1.0 - sum(damaged[k] for k in k_keys) / k_healthy if k_keys and k_healthy > 0 else 0.0
+    if loss > 0:
+        factor = (1.0 - np.minimum(c * loss, PITTING_LOSS_CAP)) / (1.0 - loss)
+    depth = [v for k, v in damaged.items() if k.startswith("profile_deviation[")]
+    mean_depth = float(np.mean(depth)) if depth else 0.0
+    if mean_depth > 0:
+        offset = offset + (c - 1.0) * mean_depth
+    offset = offset - offset.min()
+    out = {f"tooth_deviation_offset[{i + 1}]": float(v) for i, v in enumerate(offset)}
+    out.update({f"tooth_stiffness_factor[{i + 1}]": float(v) for i, v in enumerate(factor)})
+    return out
+
+
+def pinion_teeth(fmu_path) -> int:
+    """Number of ``tooth_deviation_offset[i]`` parameters of the FMU; SimulationError if it has none."""
+    from twin.fmu import FMU
+    with FMU(fmu_path) as fmu:
+        names = {v.name for v in fmu.parameters}
+    teeth = sum(1 for n in names if n.startswith("tooth_deviation_offset["))
+    if teeth == 0 or any(f"tooth_stiffness_factor[{i}]" not in names for i in range(1, teeth + 1)):
+        raise SimulationError(f"the FMU {fmu_path} has no per-tooth parameters (tooth_deviation_offset[i], "
+                              f"tooth_stiffness_factor[i]); remove {', '.join(TOOTH_ERROR_KEYS)} from the archive "
+                              "block or use a model that has them")
+    return teeth
+
+
 def nominal_operating_point(scenario: Scenario) -> tuple[float, float]:
     """Drive speed [Hz] and brake load [N.m] at the scenario's start (20 Hz / 20 N.m if not given)."""
     t0 = scenario.start_time
@@ -170,6 +249,9 @@ def build_archive(scenario: Scenario, output: str | Path | None = None, *, progr
     seq = np.random.SeedSequence(scenario.seed)
     draw = np.random.default_rng(seq.spawn(1)[0])
     record_seeds = seq.spawn(len(bounds) * per_stage + 1)[1:]
+    # The gears have their own stream: turning the tooth errors on or off leaves every other draw.
+    gear_draw = np.random.default_rng(seq.spawn(1)[0])
+    teeth = pinion_teeth(fmu_file) if any(float(spec.get(k, 0.0)) > 0 for k in TOOTH_ERROR_KEYS) else 0
     tasks, labels, dmg, speeds, loads = [], [], [], [], []
     k = 0
     for s, (lo, hi) in enumerate(zip(bounds, bounds[1:])):
@@ -178,7 +260,13 @@ def build_archive(scenario: Scenario, output: str | Path | None = None, *, progr
             f = nominal_speed * (1 + speed_sd * float(draw.standard_normal()))
             t_load = nominal_load * (1 + load_sd * float(draw.standard_normal()))
             start, inputs = operating_point(f, t_load)   # each record starts at its own steady point
-            p = {**scenario.parameters, **interpolate_parameters(damages, params, d), **start}
+            mesh = interpolate_parameters(damages, params, d)
+            p = {**scenario.parameters, **mesh, **start}
+            if teeth:
+                gear = tooth_errors(gear_draw, spec, teeth, params[0], mesh)
+                # on top of any per-tooth damage the scenario itself sets
+                p.update({n: v * scenario.parameters.get(n, 1.0) if n.startswith("tooth_stiffness")
+                          else v + scenario.parameters.get(n, 0.0) for n, v in gear.items()})
             tasks.append(RecordTask(k, str(fmu_file), p, inputs, settle, duration, scenario.output_interval,
                                     channels, noise, int(record_seeds[k].generate_state(1)[0])))
             labels.append(s)

@@ -144,6 +144,12 @@ SCHEMA: dict[str, Any] = {
                                                    "points of an endurance test (the paper's stages)"},
                 "damage_scatter": {**_NONNEG, "description": "snapshot sampling: standard deviation of the damage "
                                                             "as a fraction of the stage width (default 0.1)"},
+                "pitch_error": {**_NONNEG, "description": "m: each record's pinion has per-tooth pitch errors with "
+                                                         "an sd drawn uniformly up to this (default 0)"},
+                "runout": {**_NONNEG, "description": "m: each record's pinion has a run-out, peak to peak, drawn "
+                                                    "uniformly up to this (default 0)"},
+                "tooth_damage_scatter": {**_NONNEG, "description": "relative sd of the damage from tooth to tooth, "
+                                                                  "drawn per record uniformly up to this (default 0)"},
             },
         },
         "calibration": CALIBRATION_SCHEMA,

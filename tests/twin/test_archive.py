@@ -83,3 +83,88 @@ def test_snapshot_sampling_centres_records_on_their_stage():
     assert abs(snap.mean() - 0.15) < 1e-3 and abs(snap.std() - 0.01) < 1e-3
     uni = np.array([stage_damage(rng, 0.1, 0.2, {}) for _ in range(2000)])
     assert abs(uni.std() - 0.1 / np.sqrt(12)) < 2e-3
+
+
+class _FixedDraw:
+    """A generator whose draws are known: uniform -> its upper bound, normals and gammas as given."""
+
+    def __init__(self, normals, gammas):
+        self.normals, self.gammas = np.asarray(normals, float), np.asarray(gammas, float)
+
+    def uniform(self, lo, hi):
+        return hi
+
+    def standard_normal(self, n):
+        return self.normals[:n]
+
+    def gamma(self, shape, scale, n):
+        return self.gammas[:n]
+
+
+def test_tooth_errors_by_hand():
+    from twin.archive import tooth_errors
+    teeth = 4
+    healthy = {"k_pair[1]": 2.0, "k_pair[2]": 2.0, "profile_deviation[1]": 0.0, "profile_deviation[2]": 0.0}
+    pitted = {**healthy, "k_pair[1]": 1.6, "k_pair[2]": 1.6}                           # L = 0.2
+    draw = _FixedDraw([1.0, -1.0, 0.0, 2.0], [1.0, 3.0, 6.0, 0.5])
+    spec = {"pitch_error": 1e-6, "runout": 0.0, "tooth_damage_scatter": 0.5}
+    out = tooth_errors(draw, spec, teeth, healthy, pitted)
+    # run-out 0; the uniform phase draw returns 2 pi, which does not matter at zero run-out
+    offsets = [out[f"tooth_deviation_offset[{i}]"] for i in range(1, 5)]
+    np.testing.assert_allclose(offsets, [2e-6, 0.0, 1e-6, 3e-6], atol=1e-18)       # pitch, shifted to min 0
+    factors = [out[f"tooth_stiffness_factor[{i}]"] for i in range(1, 5)]
+    # (1 - min(c L, 0.95)) / (1 - L): c = 1 keeps the uniform loss; c = 6 is capped at 95 % loss
+    np.testing.assert_allclose(factors, [1.0, 0.4 / 0.8, 0.05 / 0.8, 0.9 / 0.8])
+
+    worn = {**healthy, "profile_deviation[1]": 10e-6, "profile_deviation[2]": 30e-6}  # mean 20 um
+    out = tooth_errors(_FixedDraw([0.0] * 4, [1.0, 1.5, 0.5, 1.0]), {"tooth_damage_scatter": 0.5}, teeth,
+                       healthy, worn)
+    np.testing.assert_allclose([out[f"tooth_deviation_offset[{i}]"] for i in range(1, 5)],
+                               [10e-6, 20e-6, 0.0, 10e-6], atol=1e-18)                # (c - 1) 20 um, min 0
+    assert all(out[f"tooth_stiffness_factor[{i}]"] == 1.0 for i in range(1, 5))
+
+
+def test_tooth_errors_runout_and_identical_teeth():
+    from twin.archive import tooth_errors
+    rng = np.random.default_rng(3)
+    healthy = {"k_pair[1]": 1.0}
+    none = tooth_errors(rng, {}, 19, healthy, healthy)
+    assert set(none.values()) <= {0.0, 1.0} and len(none) == 38
+    out = tooth_errors(rng, {"runout": 8e-6}, 19, healthy, healthy)
+    offsets = np.array([out[f"tooth_deviation_offset[{i}]"] for i in range(1, 20)])
+    assert offsets.min() == 0.0 and 0 < np.ptp(offsets) <= 8e-6
+    # a once-per-revolution sinusoid: all of its spectrum sits in the first order
+    spectrum = np.abs(np.fft.rfft(offsets))
+    assert spectrum[1] > 20 * spectrum[2:].max()
+
+
+def test_archive_with_tooth_errors_keeps_every_other_draw(archive_pair, gearbox_fmu):
+    a, _ = archive_pair
+    sc = _small(workers=2)
+    arc = {**sc.archive, "pitch_error": 2e-6, "runout": 10e-6, "tooth_damage_scatter": 0.5}
+    b = build_archive(sc.with_overrides(archive=arc), None, fmu_path=gearbox_fmu, progress=False)
+    for name in ("labels", "damage", "speed", "load"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
+    x, y = a.signals["accel_pinion_casing"], b.signals["accel_pinion_casing"]
+    assert np.all(np.isfinite(y)) and not np.allclose(x, y, rtol=0.05)
+    c = build_archive(sc.with_overrides(archive=arc, executor={"type": "local", "workers": 1}), None,
+                      fmu_path=gearbox_fmu, progress=False)
+    np.testing.assert_array_equal(y, c.signals["accel_pinion_casing"])
+
+
+def test_tooth_errors_need_a_model_with_per_tooth_parameters(two_mass_fmu):
+    from twin.archive import pinion_teeth
+    with pytest.raises(SimulationError, match="no per-tooth parameters"):
+        pinion_teeth(two_mass_fmu)
+
+
+@pytest.mark.parametrize("key", ["pitch_error", "runout", "tooth_damage_scatter"])
+def test_negative_tooth_error_bound_is_a_scenario_error(key):
+    import yaml
+
+    from twin.errors import ScenarioError
+    from twin.scenario import scenario_from_dict
+    raw = yaml.safe_load((REPO / "scenarios" / "lubricated.yaml").read_text())
+    raw["archive"][key] = -1e-6
+    with pytest.raises(ScenarioError, match=key):
+        scenario_from_dict(raw)
