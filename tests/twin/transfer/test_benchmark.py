@@ -83,6 +83,30 @@ def test_stage_order_scores_tell_one_stage_late_from_random():
     assert "| 100.0 | 0.95 |" in markdown_table(summarise(runs))
 
 
+def test_the_archive_gets_each_tasks_tooth_errors(tmp_path, monkeypatch):
+    """The data settings' gear bounds reach the archive block that build_archive reads."""
+    import twin.archive
+    import twin.degradation_run
+    import twin.scenario
+    import twin.transfer.domain
+    from twin.transfer.benchmark import prepare_task
+
+    seen = {}
+
+    def build_archive(sc, path, **kw):
+        seen[path.name] = {k: sc.archive.get(k) for k in twin.archive.TOOTH_ERROR_KEYS}
+        path.write_text("source")
+
+    monkeypatch.setattr(twin.scenario.Scenario, "fmu_path", lambda self: tmp_path / "model.fmu")
+    monkeypatch.setattr(twin.archive, "build_archive", build_archive)
+    monkeypatch.setattr(twin.degradation_run, "run_degradation", lambda *a, **kw: None)
+    monkeypatch.setattr(twin.transfer.domain, "make_target_domain", lambda sc, path, **kw: path.write_text("t"))
+    prepare_task("pitting", tmp_path, progress=False)
+    prepare_task("wear", tmp_path, replace(TASK_SETTINGS["wear"], source_runout=0.0), progress=False)
+    assert seen["source_pitting.h5"] == {"pitch_error": 0.0, "runout": 10e-6, "tooth_damage_scatter": 0.5}
+    assert seen["source_wear.h5"] == {"pitch_error": 2e-6, "runout": 0.0, "tooth_damage_scatter": 0.1}
+
+
 def test_prepare_task_keeps_each_rigs_data_apart_and_reuses_it(tmp_path, monkeypatch):
     """The cache logic only: the simulations are replaced by recorders that write marker files."""
     import twin.archive
