@@ -115,6 +115,12 @@ TOOTH_ERROR_KEYS = ("pitch_error", "runout", "tooth_damage_scatter")
 PITTING_LOSS_CAP = 0.95     # a tooth keeps at least 5 % of its pair stiffness, as a pitted flank does
 
 
+def runout_deviation(runout: float, phase: float, teeth: int) -> np.ndarray:
+    """(teeth,) extra material loss [m] of an eccentric pinion's teeth: a once-per-revolution
+    sinusoid, ``runout`` peak to peak, >= 0, tooth 1 at angle ``phase`` [rad]."""
+    return 0.5 * runout * (1.0 - np.cos(2 * np.pi * np.arange(teeth) / teeth + phase))
+
+
 def tooth_errors(draw: np.random.Generator, spec, teeth: int, healthy: dict, damaged: dict) -> dict[str, float]:
     """Per-pinion-tooth FMU parameters of one record's gear: manufacturing errors and uneven damage.
 
@@ -154,7 +160,7 @@ def tooth_errors(draw: np.random.Generator, spec, teeth: int, healthy: dict, dam
     pitch = draw.uniform(0.0, pitch_bound) * draw.standard_normal(teeth)
     runout = draw.uniform(0.0, runout_bound)
     phase = draw.uniform(0.0, 2 * np.pi)
-    offset = pitch + 0.5 * runout * (1.0 - np.cos(2 * np.pi * np.arange(teeth) / teeth + phase))
+    offset = pitch + runout_deviation(runout, phase, teeth)
     scatter = draw.uniform(0.0, scatter_bound)
     c = draw.gamma(1.0 / scatter ** 2, scatter ** 2, teeth) if scatter > 0 else np.ones(teeth)
     factor = np.ones(teeth)

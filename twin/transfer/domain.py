@@ -101,8 +101,8 @@ class TargetShift:
 
 def runout_offsets(runout: float, phase: float, teeth: int = N_PINION_TEETH) -> dict[str, float]:
     """``tooth_deviation_offset[1..teeth]`` [m] of an eccentric pinion (>= 0, ``runout`` peak to peak)."""
-    i = np.arange(teeth)
-    dev = 0.5 * runout * (1.0 - np.cos(2 * np.pi * i / teeth + phase))
+    from twin.archive import runout_deviation
+    dev = runout_deviation(runout, phase, teeth)
     return {f"tooth_deviation_offset[{k + 1}]": float(d) for k, d in enumerate(dev)}
 
 
