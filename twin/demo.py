@@ -273,7 +273,9 @@ def _transfer_demo(out_dir: Path, epochs: int = 15):
           f"{100 * moved:.1f} % of the rig's adaptation windows changed stage")
     print(f"      each archive record has a pinion of its own: run-out up to {1e6 * settings.source_runout:.0f} um, "
           f"pitting spread over the teeth with a relative sd up to {settings.source_tooth_damage_scatter:.1f}, "
-          f"pitch errors up to {1e6 * settings.source_pitch_error:.0f} um (twin.archive.tooth_errors)")
+          + (f"pitch errors up to {1e6 * settings.source_pitch_error:.0f} um" if settings.source_pitch_error > 0
+             else "no pitch errors (they hide pitting at this load: BENCHMARKS.md, stop 16)")
+          + " (twin.archive.tooth_errors)")
     for note in notes:
         print(f"      warning: {note}")
     asm, _ = assessed
