@@ -179,6 +179,26 @@ def tooth_errors(draw: np.random.Generator, spec, teeth: int, healthy: dict, dam
     return out
 
 
+def tooth_error_bounds(scenario: Scenario) -> tuple[float, float, float]:
+    """The archive block's (``pitch_error``, ``runout``, ``tooth_damage_scatter``) bounds, absent = 0.
+
+    The scenario schema checks them in a file; a block built in code (``with_overrides``) is
+    checked here, so a negative or non-numeric bound is a :class:`ScenarioError` naming every bad
+    key rather than a silently flipped gear.
+    """
+    spec = scenario.archive or {}
+    bounds, problems = [], []
+    for key in TOOTH_ERROR_KEYS:
+        value = spec.get(key, 0.0)
+        ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value) and value >= 0
+        if not ok:
+            problems.append((str(scenario.source), f"archive.{key}", f"must be a finite number >= 0, got {value!r}"))
+        bounds.append(float(value) if ok else 0.0)
+    if problems:
+        raise ScenarioError(problems)
+    return tuple(bounds)
+
+
 def pinion_teeth(fmu_path) -> int:
     """Number of ``tooth_deviation_offset[i]`` parameters of the FMU; SimulationError if it has none."""
     from twin.fmu import FMU
@@ -236,6 +256,7 @@ def build_archive(scenario: Scenario, output: str | Path | None = None, *, progr
         from twin.results import check_output_path
         check_output_path(path)
     fmu_file = fmu_path or scenario.fmu_path()
+    gear_bounds = tooth_error_bounds(scenario)      # before the degradation run, which takes a while
     run = run_degradation(scenario, None, fmu_path=fmu_file, progress=progress, channels=("accel_pinion_casing",))
     damages = run.damage
     if np.any(np.diff(damages) < 0):
@@ -257,7 +278,7 @@ def build_archive(scenario: Scenario, output: str | Path | None = None, *, progr
     record_seeds = seq.spawn(len(bounds) * per_stage + 1)[1:]
     # The gears have their own stream: turning the tooth errors on or off leaves every other draw.
     gear_draw = np.random.default_rng(seq.spawn(1)[0])
-    teeth = pinion_teeth(fmu_file) if any(float(spec.get(k, 0.0)) > 0 for k in TOOTH_ERROR_KEYS) else 0
+    teeth = pinion_teeth(fmu_file) if any(b > 0 for b in gear_bounds) else 0
     tasks, labels, dmg, speeds, loads = [], [], [], [], []
     k = 0
     for s, (lo, hi) in enumerate(zip(bounds, bounds[1:])):

@@ -168,3 +168,21 @@ def test_negative_tooth_error_bound_is_a_scenario_error(key):
     raw["archive"][key] = -1e-6
     with pytest.raises(ScenarioError, match=key):
         scenario_from_dict(raw)
+
+
+def test_bad_tooth_error_bounds_set_in_code_are_named_before_any_simulation(tmp_path, monkeypatch, gearbox_fmu):
+    import twin.degradation_run
+    from twin.errors import ScenarioError
+
+    def no_run(*a, **kw):
+        raise AssertionError("the degradation run must not start")
+
+    monkeypatch.setattr(twin.degradation_run, "run_degradation", no_run)
+    sc = _small()
+    arc = {**sc.archive, "runout": -1e-6, "pitch_error": "2 um", "tooth_damage_scatter": 0.3}
+    out = tmp_path / "a.h5"
+    out.write_bytes(b"kept")
+    with pytest.raises(ScenarioError, match="archive.runout") as err:
+        build_archive(sc.with_overrides(archive=arc), out, fmu_path=gearbox_fmu, progress=False)
+    assert "archive.pitch_error" in str(err.value) and "tooth_damage_scatter" not in str(err.value)
+    assert out.read_bytes() == b"kept"
