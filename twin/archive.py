@@ -12,7 +12,8 @@
 3. optionally gives each record its own pinion (``pitch_error``, ``runout``,
    ``tooth_damage_scatter``; :func:`tooth_errors`): random manufacturing errors and an uneven
    spread of the damage over the teeth, drawn from a stream of its own, so an archive without
-   these keys is unchanged by them;
+   these keys is unchanged by them.  Each record keeps its drawn pinion as ``gear_*`` record
+   attributes (:func:`gear_attributes`), so a record names the gear it was simulated with;
 4. simulates the records in parallel (local processes by default, Dask when the scenario's
    ``executor`` says so), each ``settle_time`` + ``record_duration`` seconds long, keeps the
    last ``record_duration`` seconds, and adds white measurement noise relative to the record's RMS.
@@ -82,6 +83,9 @@ class Archive:
     stages: tuple               # stage boundaries
     damage_kind: str            # "pitting_density" or "wear_depth"
     path: Path | None = None
+    # per record, the drawn pinion when the archive has tooth errors: its ``gear_*`` record
+    # attributes (PinionDraw.attributes, plus the per-tooth arrays set in the FMU); None without
+    gears: tuple | None = None
 
 
 def interpolate_parameters(damages: np.ndarray, parameter_sets: list[dict], value: float) -> dict:
@@ -121,6 +125,73 @@ def runout_deviation(runout: float, phase: float, teeth: int) -> np.ndarray:
     return 0.5 * runout * (1.0 - np.cos(2 * np.pi * np.arange(teeth) / teeth + phase))
 
 
+@dataclass(frozen=True)
+class PinionDraw:
+    """One record's drawn pinion (:func:`draw_pinion`), before it meets the record's damage.
+
+    Attributes
+    ----------
+    pitch_error_sd : float
+        Drawn sd of the per-tooth pitch deviations [m].
+    runout : float
+        Drawn peak-to-peak run-out [m].
+    runout_phase : float
+        Angle of tooth 1 on the run-out sinusoid [rad].
+    tooth_damage_scatter : float
+        Drawn relative sd of the per-tooth damage factors [-].
+    pitch_deviation : ndarray (teeth,)
+        Per-tooth pitch deviations [m] (unshifted).
+    damage_factors : ndarray (teeth,)
+        Per-tooth damage factors c_i [-], mean 1 in distribution.
+    """
+
+    pitch_error_sd: float
+    runout: float
+    runout_phase: float
+    tooth_damage_scatter: float
+    pitch_deviation: np.ndarray
+    damage_factors: np.ndarray
+
+    def attributes(self) -> dict:
+        """The drawn magnitudes as record attributes (``gear_`` prefix, SI units)."""
+        return {"gear_pitch_error_sd": self.pitch_error_sd, "gear_runout": self.runout,
+                "gear_runout_phase": self.runout_phase, "gear_tooth_damage_scatter": self.tooth_damage_scatter}
+
+
+def draw_pinion(draw: np.random.Generator, spec, teeth: int) -> PinionDraw:
+    """Draw one record's pinion within the archive block's bounds (see :func:`tooth_errors`)."""
+    pitch_bound, runout_bound, scatter_bound = (float(spec.get(k, 0.0)) for k in TOOTH_ERROR_KEYS)
+    pitch_sd = draw.uniform(0.0, pitch_bound)
+    pitch = pitch_sd * draw.standard_normal(teeth)
+    runout = draw.uniform(0.0, runout_bound)
+    phase = draw.uniform(0.0, 2 * np.pi)
+    scatter = draw.uniform(0.0, scatter_bound)
+    c = draw.gamma(1.0 / scatter ** 2, scatter ** 2, teeth) if scatter > 0 else np.ones(teeth)
+    return PinionDraw(float(pitch_sd), float(runout), float(phase), float(scatter), np.asarray(pitch, float),
+                      np.asarray(c, float))
+
+
+def pinion_parameters(pinion: PinionDraw, healthy: dict, damaged: dict) -> dict[str, float]:
+    """Per-tooth FMU parameters of a drawn pinion at a record's damage (see :func:`tooth_errors`)."""
+    teeth = pinion.pitch_deviation.size
+    c = pinion.damage_factors
+    offset = pinion.pitch_deviation + runout_deviation(pinion.runout, pinion.runout_phase, teeth)
+    factor = np.ones(teeth)
+    k_keys = [k for k in healthy if k.startswith("k_pair[")]
+    k_healthy = sum(healthy[k] for k in k_keys)
+    loss = 1.0 - sum(damaged[k] for k in k_keys) / k_healthy if k_keys and k_healthy > 0 else 0.0
+    if loss > 0:
+        factor = (1.0 - np.minimum(c * loss, PITTING_LOSS_CAP)) / (1.0 - loss)
+    depth = [v for k, v in damaged.items() if k.startswith("profile_deviation[")]
+    mean_depth = float(np.mean(depth)) if depth else 0.0
+    if mean_depth > 0:
+        offset = offset + (c - 1.0) * mean_depth
+    offset = offset - offset.min()
+    out = {f"tooth_deviation_offset[{i + 1}]": float(v) for i, v in enumerate(offset)}
+    out.update({f"tooth_stiffness_factor[{i + 1}]": float(v) for i, v in enumerate(factor)})
+    return out
+
+
 def tooth_errors(draw: np.random.Generator, spec, teeth: int, healthy: dict, damaged: dict) -> dict[str, float]:
     """Per-pinion-tooth FMU parameters of one record's gear: manufacturing errors and uneven damage.
 
@@ -156,26 +227,18 @@ def tooth_errors(draw: np.random.Generator, spec, teeth: int, healthy: dict, dam
     -------
     dict: ``tooth_deviation_offset[i]`` [m] and ``tooth_stiffness_factor[i]`` [-], i = 1..teeth.
     """
-    pitch_bound, runout_bound, scatter_bound = (float(spec.get(k, 0.0)) for k in TOOTH_ERROR_KEYS)
-    pitch = draw.uniform(0.0, pitch_bound) * draw.standard_normal(teeth)
-    runout = draw.uniform(0.0, runout_bound)
-    phase = draw.uniform(0.0, 2 * np.pi)
-    offset = pitch + runout_deviation(runout, phase, teeth)
-    scatter = draw.uniform(0.0, scatter_bound)
-    c = draw.gamma(1.0 / scatter ** 2, scatter ** 2, teeth) if scatter > 0 else np.ones(teeth)
-    factor = np.ones(teeth)
-    k_keys = [k for k in healthy if k.startswith("k_pair[")]
-    k_healthy = sum(healthy[k] for k in k_keys)
-    loss = 1.0 - sum(damaged[k] for k in k_keys) / k_healthy if k_keys and k_healthy > 0 else 0.0
-    if loss > 0:
-        factor = (1.0 - np.minimum(c * loss, PITTING_LOSS_CAP)) / (1.0 - loss)
-    depth = [v for k, v in damaged.items() if k.startswith("profile_deviation[")]
-    mean_depth = float(np.mean(depth)) if depth else 0.0
-    if mean_depth > 0:
-        offset = offset + (c - 1.0) * mean_depth
-    offset = offset - offset.min()
-    out = {f"tooth_deviation_offset[{i + 1}]": float(v) for i, v in enumerate(offset)}
-    out.update({f"tooth_stiffness_factor[{i + 1}]": float(v) for i, v in enumerate(factor)})
+    return pinion_parameters(draw_pinion(draw, spec, teeth), healthy, damaged)
+
+
+GEAR_ARRAYS = ("tooth_deviation_offset", "tooth_stiffness_factor")
+
+
+def gear_attributes(pinion: PinionDraw, parameters: dict, teeth: int) -> dict:
+    """A record's ``gear_*`` attributes: the drawn magnitudes and the (teeth,) arrays set in the FMU
+    (``gear_tooth_deviation_offset`` [m], ``gear_tooth_stiffness_factor`` [-])."""
+    out = pinion.attributes()
+    for name in GEAR_ARRAYS:
+        out[f"gear_{name}"] = np.array([parameters[f"{name}[{i}]"] for i in range(1, teeth + 1)])
     return out
 
 
@@ -279,7 +342,7 @@ def build_archive(scenario: Scenario, output: str | Path | None = None, *, progr
     # The gears have their own stream: turning the tooth errors on or off leaves every other draw.
     gear_draw = np.random.default_rng(seq.spawn(1)[0])
     teeth = pinion_teeth(fmu_file) if any(b > 0 for b in gear_bounds) else 0
-    tasks, labels, dmg, speeds, loads = [], [], [], [], []
+    tasks, labels, dmg, speeds, loads, gears = [], [], [], [], [], []
     k = 0
     for s, (lo, hi) in enumerate(zip(bounds, bounds[1:])):
         for _ in range(per_stage):
@@ -290,10 +353,13 @@ def build_archive(scenario: Scenario, output: str | Path | None = None, *, progr
             mesh = interpolate_parameters(damages, params, d)
             p = {**scenario.parameters, **mesh, **start}
             if teeth:
-                gear = tooth_errors(gear_draw, spec, teeth, params[0], mesh)
+                pinion = draw_pinion(gear_draw, spec, teeth)
+                gear = pinion_parameters(pinion, params[0], mesh)
                 # on top of any per-tooth damage the scenario itself sets
-                p.update({n: v * scenario.parameters.get(n, 1.0) if n.startswith("tooth_stiffness")
-                          else v + scenario.parameters.get(n, 0.0) for n, v in gear.items()})
+                gear = {n: v * scenario.parameters.get(n, 1.0) if n.startswith("tooth_stiffness")
+                        else v + scenario.parameters.get(n, 0.0) for n, v in gear.items()}
+                p.update(gear)
+                gears.append(gear_attributes(pinion, gear, teeth))
             tasks.append(RecordTask(k, str(fmu_file), p, inputs, settle, duration, scenario.output_interval,
                                     channels, noise, int(record_seeds[k].generate_state(1)[0])))
             labels.append(s)
@@ -305,7 +371,7 @@ def build_archive(scenario: Scenario, output: str | Path | None = None, *, progr
     signals = {c: np.stack([r[c] for r in results]) for c in channels}
     kind = "pitting_density" if run.model == "pitting" else "wear_depth"
     archive = Archive(np.array(labels), np.array(dmg), np.array(speeds), np.array(loads), signals,
-                      scenario.sample_rate, tuple(bounds), kind, path)
+                      scenario.sample_rate, tuple(bounds), kind, path, tuple(gears) if teeth else None)
     if path is not None:
         write_archive(archive, path, scenario, run)
     return archive
@@ -333,6 +399,8 @@ def write_archive(archive: Archive, path: Path, scenario: Scenario, run=None) ->
                 g.attrs["sample_rate"] = archive.sample_rate
                 g.attrs["nominal_speed"] = float(archive.speed[i])
                 g.attrs["load"] = float(archive.load[i])
+                for name, value in (archive.gears[i] if archive.gears is not None else {}).items():
+                    g.attrs[name] = value
                 for c, arr in archive.signals.items():
                     ds = g.create_dataset(c, data=arr[i])
                     ds.attrs["unit"] = "m/s2" if c.startswith("accel") else ""
@@ -354,7 +422,9 @@ def read_archive(path: str | Path) -> Archive:
         channels = list(first)
         signals = {c: np.stack([f["records"][k][c][:] for k in keys]) for c in channels}
         attrs = [f["records"][k].attrs for k in keys]
+        gears = tuple({n: (a[n] if np.ndim(a[n]) else float(a[n])) for n in a if n.startswith("gear_")}
+                      for a in attrs)
         return Archive(np.array([a["label"] for a in attrs]), np.array([a["damage"] for a in attrs]),
                        np.array([a["nominal_speed"] for a in attrs]), np.array([a["load"] for a in attrs]),
                        signals, float(f.attrs["sample_rate"]), tuple(f.attrs["stages"]),
-                       str(f.attrs["damage_kind"]), path)
+                       str(f.attrs["damage_kind"]), path, gears if any(gears) else None)

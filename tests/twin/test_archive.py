@@ -150,6 +150,54 @@ def test_archive_with_tooth_errors_keeps_every_other_draw(archive_pair, gearbox_
     c = build_archive(sc.with_overrides(archive=arc, executor={"type": "local", "workers": 1}), None,
                       fmu_path=gearbox_fmu, progress=False)
     np.testing.assert_array_equal(y, c.signals["accel_pinion_casing"])
+    assert a.gears is None and len(b.gears) == 4
+
+
+def test_each_record_names_the_gear_it_was_simulated_with(gearbox_fmu, tmp_path):
+    from twin.archive import draw_pinion, pinion_parameters, tooth_errors
+    from twin.measurements import load_measurements
+    sc = _small()
+    bounds = {"pitch_error": 2e-6, "runout": 10e-6, "tooth_damage_scatter": 0.5}
+    # the scenario's own per-tooth values combine with the drawn ones: factors multiply, offsets add
+    own = {"tooth_stiffness_factor[3]": 0.5, "tooth_deviation_offset[3]": 1e-6}
+    sc = sc.with_overrides(archive={**sc.archive, **bounds}, parameters={**sc.parameters, **own})
+    path = tmp_path / "a.h5"
+    a = build_archive(sc, path, fmu_path=gearbox_fmu, progress=False)
+    back = read_archive(path)
+    # the same draws, replayed: the stored gear is the one each record was simulated with
+    seq = np.random.SeedSequence(sc.seed)
+    seq.spawn(1 + 3 * 2 + 1)         # the record draws and seeds come first (twin.archive.build_archive)
+    replay = np.random.default_rng(seq.spawn(1)[0])
+    for g, h in zip(a.gears, back.gears):
+        pinion = draw_pinion(replay, bounds, 19)
+        assert 0 <= g["gear_runout"] <= 10e-6 and 0 <= g["gear_pitch_error_sd"] <= 2e-6
+        assert 0 <= g["gear_tooth_damage_scatter"] <= 0.5 and 0 <= g["gear_runout_phase"] < 2 * np.pi
+        assert g["gear_runout"] == pinion.runout and g["gear_runout_phase"] == pinion.runout_phase
+        offsets, factors = g["gear_tooth_deviation_offset"], g["gear_tooth_stiffness_factor"]
+        assert offsets.shape == factors.shape == (19,)
+        assert offsets.min() == pytest.approx(0.0, abs=1e-6) and np.any(factors != 1.0)
+        assert set(h) == set(g)
+        for name in g:
+            np.testing.assert_array_equal(h[name], g[name])
+    plain = build_archive(sc.with_overrides(parameters={k: v for k, v in sc.parameters.items() if k not in own}),
+                          None, fmu_path=gearbox_fmu, progress=False)
+    # (not exactly: the weaker tooth also changes the degradation run, hence the mesh, slightly)
+    for g, p in zip(a.gears, plain.gears):
+        np.testing.assert_allclose(g["gear_tooth_stiffness_factor"][2], 0.5 * p["gear_tooth_stiffness_factor"][2],
+                                   rtol=1e-3)
+        np.testing.assert_allclose(g["gear_tooth_deviation_offset"][2] - g["gear_tooth_deviation_offset"][0],
+                                   p["gear_tooth_deviation_offset"][2] - p["gear_tooth_deviation_offset"][0] + 1e-6,
+                                   rtol=1e-3)
+    # the split draw/parameters is the one-call tooth_errors
+    rng1, rng2 = np.random.default_rng(5), np.random.default_rng(5)
+    healthy = {"k_pair[1]": 1.0, "profile_deviation[1]": 0.0}
+    pitted = {"k_pair[1]": 0.9, "profile_deviation[1]": 0.0}
+    assert tooth_errors(rng1, bounds, 19, healthy, pitted) == pinion_parameters(draw_pinion(rng2, bounds, 19),
+                                                                                healthy, pitted)
+    # the gear reaches the measurement layout's metadata, and nothing there mistakes it for a typo
+    mset = load_measurements(path)
+    np.testing.assert_array_equal(mset[0].metadata["gear_tooth_stiffness_factor"],
+                                  a.gears[0]["gear_tooth_stiffness_factor"])
 
 
 def test_tooth_errors_need_a_model_with_per_tooth_parameters(two_mass_fmu):
