@@ -1,6 +1,6 @@
 """Benchmark: transfer from the twin's archive to an emulated rig, CNN vs MMD vs proposed.
 
-    python bench/transfer.py [--seeds 5] [--task both] [--epochs 80] [--jobs 2] [--out bench_out/transfer]
+    python bench/transfer.py [--seeds 5] [--first-seed 0] [--task both] [--epochs 80] [--jobs 2] [--out bench_out/transfer]
                              [--rig rig|blind] [--source-ceiling | --target-ceiling]
 
 Builds (or reuses, in OUT/data) the source archives of scenarios/lubricated.yaml (6 pitting
@@ -32,6 +32,8 @@ def main() -> None:
 
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--seeds", type=int, default=5)
+    ap.add_argument("--first-seed", type=int, default=0,
+                    help="first seed; --first-seed 5 --seeds 5 adds seeds 5-9 to a 5-seed run")
     ap.add_argument("--task", choices=("pitting", "wear", "both"), default="both")
     ap.add_argument("--epochs", type=int, default=80)
     ap.add_argument("--jobs", type=int, default=2)
@@ -46,6 +48,8 @@ def main() -> None:
                     help="instead: a CNN trained on the rig's own labelled first halves, tested on the "
                          "second halves (no transfer), per seed")
     args = ap.parse_args()
+    if args.first_seed < 0:
+        ap.error(f"--first-seed must be >= 0, got {args.first_seed}")
     import torch
 
     from twin.transfer.benchmark import markdown_table, run_benchmark
@@ -58,12 +62,12 @@ def main() -> None:
         return
     t = time.perf_counter()
     summary = run_benchmark(out, tasks=tasks, seeds=args.seeds, epochs=args.epochs, jobs=args.jobs,
-                            data_dir=args.data_dir, rig=args.rig)
+                            data_dir=args.data_dir, rig=args.rig, first_seed=args.first_seed)
     wall = time.perf_counter() - t
     cpu = next((ln.split(":", 1)[1].strip() for ln in open("/proc/cpuinfo") if ln.startswith("model name")), "?")
     print(f"Machine: {cpu}, {len(os.sched_getaffinity(0))} cores, Python {platform.python_version()}, "
           f"torch {torch.__version__} (CPU, 1 thread per training run, {args.jobs} runs in parallel)")
-    print(f"{args.seeds} seeds x 3 methods x {len(tasks)} task(s), {args.epochs} epochs, rig '{args.rig}'; "
+    print(f"{args.seeds} seeds ({args.first_seed}-{args.first_seed + args.seeds - 1}) x 3 methods x {len(tasks)} task(s), {args.epochs} epochs, rig '{args.rig}'; "
           f"total wall time {wall:.0f} s\n")
     print(markdown_table(summary))
     print(f"\nfigures and report.html -> {out}")
@@ -91,7 +95,7 @@ def _ceiling(args, tasks) -> None:
     else:
         what, fn, pick = "source-only CNN on held-out source records", source_ceiling, 0
     jobs = [(fn, t, str(prepare_task(t, data_dir, rig_settings(t, args.rig))[pick]), s, args.epochs)
-            for t in tasks for s in range(args.seeds)]
+            for t in tasks for s in range(args.first_seed, args.first_seed + args.seeds)]
     with ProcessPoolExecutor(max_workers=args.jobs, mp_context=mp.get_context("spawn")) as pool:
         acc = list(pool.map(_star, jobs))
     print(f"| task | {what} [%] | per seed |\n|---|---|---|")

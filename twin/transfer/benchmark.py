@@ -395,12 +395,27 @@ def markdown_table(summary: dict) -> str:
     return "\n".join(lines)
 
 
+def training_jobs(tasks: tuple[str, ...], methods: tuple[str, ...], seeds: int, first_seed: int,
+                  paths: dict[str, tuple[Path, Path]], epochs: int) -> list[tuple]:
+    """The ``train_one`` calls of a benchmark: seeds ``first_seed .. first_seed + seeds - 1``.
+
+    The first seed also returns features for the t-SNE and monitors the target test accuracy per
+    epoch for the learning curves (monitoring only: it never feeds back into training).
+    """
+    return [(train_one, t, m, s, str(paths[t][0]), str(paths[t][1]), epochs, s == first_seed, s == first_seed)
+            for t in tasks for s in range(first_seed, first_seed + seeds) for m in methods]
+
+
 def run_benchmark(out: str | Path, *, tasks: tuple[str, ...] = ("pitting", "wear"), seeds: int = 5,
                   methods: tuple[str, ...] = METHODS, epochs: int = 80, jobs: int = 2,
                   data_dir: str | Path | None = None, settings: dict[str, DataSettings] | None = None,
-                  rig: str = "rig", progress: bool = True) -> dict:
+                  rig: str = "rig", progress: bool = True, first_seed: int = 0) -> dict:
     """Run every (task, method, seed), write ``results.json``, ``summary.md``, figures and
     ``report.html`` into ``out``; return the summary (see :func:`summarise`).
+
+    The seeds are ``first_seed .. first_seed + seeds - 1``: ``first_seed=5, seeds=5`` adds seeds
+    5-9 to an earlier 5-seed run without repeating it (each seed gives the same run on the same
+    machine, so the two ``results.json`` can be pooled).
 
     ``jobs`` training runs go in parallel, each in its own process on one torch thread (so the
     fit times are single-core times).  ``rig`` picks the emulated rig (:data:`RIGS`) for the tasks
@@ -421,16 +436,15 @@ def run_benchmark(out: str | Path, *, tasks: tuple[str, ...] = ("pitting", "wear
     if bad:
         raise ParameterError(f"unknown task or method {bad[0]!r}; tasks: {', '.join(TASKS)}; "
                              f"methods: cnn, mmd, proposed, coral")
-    if not isinstance(seeds, int) or seeds < 1:
+    if isinstance(seeds, bool) or not isinstance(seeds, int) or seeds < 1:
         raise ParameterError(f"seeds must be a positive integer, got {seeds!r}")
+    if isinstance(first_seed, bool) or not isinstance(first_seed, int) or first_seed < 0:
+        raise ParameterError(f"first_seed must be an integer >= 0, got {first_seed!r}")
     data_dir = Path(data_dir) if data_dir is not None else out / "data"
     data_dir.mkdir(exist_ok=True)
     settings = {t: (settings or {}).get(t) or rig_settings(t, rig) for t in tasks}
     paths = {t: prepare_task(t, data_dir, settings[t], progress=progress) for t in tasks}
-    # Seed 0 also returns features for the t-SNE and monitors the target test accuracy per epoch
-    # for the learning curves (monitoring only: it never feeds back into training).
-    jobs_list = [(train_one, t, m, s, str(paths[t][0]), str(paths[t][1]), epochs, s == 0, s == 0)
-                 for t in tasks for s in range(seeds) for m in methods]
+    jobs_list = training_jobs(tasks, methods, seeds, first_seed, paths, epochs)
     bar = progress_bar(len(jobs_list), progress, "transfer benchmark", "run")
     results: list[RunResult] = []
     t0 = time.perf_counter()
@@ -455,11 +469,12 @@ def _write_outputs(out: Path, results: list[RunResult], summary: dict, epochs: i
     blocks = [("Summary (target test = second halves of the rig records; last epoch; "
                f"{epochs} epochs; wall time {wall:.0f} s)", table)]
     for task in summary:
-        first = {r.method: r for r in results if r.task == task and r.seed == 0}
+        s0 = min(r.seed for r in results if r.task == task)
+        first = {r.method: r for r in results if r.task == task and r.seed == s0}
         cm = report.plot_confusion({m: np.array(r.confusion) for m, r in first.items()},
-                                   out / f"confusion_{task}.png", f"{task}: target test windows, seed 0")
+                                   out / f"confusion_{task}.png", f"{task}: target test windows, seed {s0}")
         lc = report.plot_learning_curves({m: r.history for m, r in first.items()}, out / f"curves_{task}.png",
-                                         f"{task}: learning curves, seed 0")
+                                         f"{task}: learning curves, seed {s0}")
         panels = {}
         for m, r in first.items():
             e = r.embedding
@@ -471,10 +486,10 @@ def _write_outputs(out: Path, results: list[RunResult], summary: dict, epochs: i
                          np.r_[np.zeros(len(e["source"]), bool), np.ones(len(e["target"]), bool)])
         blocks += [(f"{task}: confusion matrices", cm.name), (f"{task}: learning curves", lc.name)]
         if panels:
-            ts = report.plot_tsne(panels, out / f"tsne_{task}.png", f"{task}: t-SNE of G features, seed 0")
+            ts = report.plot_tsne(panels, out / f"tsne_{task}.png", f"{task}: t-SNE of G features, seed {s0}")
             blocks.append((f"{task}: t-SNE", ts.name))
     report.write_html(out / "report.html", "Transfer benchmark: CNN vs MMD vs proposed", blocks)
-    payload = {"summary": summary, "epochs": epochs, "wall_time": wall, "data": {t: asdict(v) for t, v in settings.items()},
+    payload = {"summary": summary, "epochs": epochs, "seeds": sorted({r.seed for r in results}), "wall_time": wall, "data": {t: asdict(v) for t, v in settings.items()},
                "runs": [{k: v for k, v in asdict(r).items() if k != "embedding"} for r in results]}
     with atomic_path(out / "results.json") as tmp:
         Path(tmp).write_text(json.dumps(payload, indent=1))

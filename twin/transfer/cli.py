@@ -66,7 +66,7 @@ def _cmd_benchmark_transfer(args: argparse.Namespace) -> int:
     tasks = ("pitting", "wear") if args.task == "both" else (args.task,)
     summary = bench.run_benchmark(Path(args.out), tasks=tasks, seeds=args.seeds, epochs=args.epochs,
                                   jobs=args.jobs, data_dir=Path(args.data_dir) if args.data_dir else None,
-                                  rig=args.rig, progress=not args.no_progress)
+                                  rig=args.rig, progress=not args.no_progress, first_seed=args.first_seed)
     print(bench.markdown_table(summary))
     print(f"report -> {Path(args.out) / 'report.html'}")
     return 0
@@ -110,6 +110,8 @@ def add_subcommands(sub) -> None:
     p = sub.add_parser("benchmark-transfer", help="CNN vs MMD vs proposed on twin -> emulated rig, over seeds")
     p.add_argument("--out", required=True, help="output directory (results.json, summary.md, report.html)")
     p.add_argument("--seeds", type=int, default=5, help="seeds per method (default: 5)")
+    p.add_argument("--first-seed", type=int, default=0,
+                   help="first seed (default: 0); --first-seed 5 --seeds 5 adds seeds 5-9 to a 5-seed run")
     p.add_argument("--task", choices=("pitting", "wear", "both"), default="both")
     p.add_argument("--epochs", type=int, default=80, help="epochs per training run (default: 80)")
     p.add_argument("--jobs", type=int, default=2, help="training runs in parallel (default: 2)")

@@ -47,7 +47,8 @@ def test_registers_three_commands():
     p = _parser()
     assert p.parse_args(["assess", "a", "m.h5"]).handler.__name__ == "_cmd_assess"
     args = p.parse_args(["benchmark-transfer", "--out", "x"])
-    assert (args.seeds, args.task, args.epochs) == (5, "both", 80)
+    assert (args.seeds, args.first_seed, args.task, args.epochs) == (5, 0, "both", 80)
+    assert p.parse_args(["benchmark-transfer", "--out", "x", "--first-seed", "5"]).first_seed == 5
     with pytest.raises(SystemExit):
         p.parse_args(["train-assessor", "--source", "s.h5", "--target", "t.h5", "--out", "o", "--method", "dann"])
 
