@@ -431,7 +431,6 @@ def run_benchmark(out: str | Path, *, tasks: tuple[str, ...] = ("pitting", "wear
     _check_rig(rig)
     if not out.parent.is_dir():
         raise OutputPathError(f"output directory '{out.parent}' does not exist (for '{out}')")
-    out.mkdir(exist_ok=True)
     bad = [t for t in tasks if t not in TASKS] + [m for m in methods if m not in METHODS + ("coral",)]
     if bad:
         raise ParameterError(f"unknown task or method {bad[0]!r}; tasks: {', '.join(TASKS)}; "
@@ -440,6 +439,7 @@ def run_benchmark(out: str | Path, *, tasks: tuple[str, ...] = ("pitting", "wear
         raise ParameterError(f"seeds must be a positive integer, got {seeds!r}")
     if isinstance(first_seed, bool) or not isinstance(first_seed, int) or first_seed < 0:
         raise ParameterError(f"first_seed must be an integer >= 0, got {first_seed!r}")
+    out.mkdir(exist_ok=True)        # only once every argument is known good: a typo leaves no trace
     data_dir = Path(data_dir) if data_dir is not None else out / "data"
     data_dir.mkdir(exist_ok=True)
     settings = {t: (settings or {}).get(t) or rig_settings(t, rig) for t in tasks}

@@ -55,7 +55,11 @@ def test_first_seed_adds_later_seeds_and_is_checked_before_any_data_are_built(tm
     for bad in (-1, 1.5, True):
         with pytest.raises(ParameterError, match="first_seed"):
             run_benchmark(tmp_path / "out", first_seed=bad, progress=False)
-    assert not (tmp_path / "out" / "data").exists()
+    with pytest.raises(ParameterError, match="seeds"):
+        run_benchmark(tmp_path / "out", seeds=0, progress=False)
+    with pytest.raises(ParameterError, match="'dann'"):
+        run_benchmark(tmp_path / "out", methods=("dann",), progress=False)
+    assert not (tmp_path / "out").exists()
 
 
 def _run(method, seed, acc):
