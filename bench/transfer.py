@@ -48,8 +48,12 @@ def main() -> None:
                     help="instead: a CNN trained on the rig's own labelled first halves, tested on the "
                          "second halves (no transfer), per seed")
     args = ap.parse_args()
-    if args.first_seed < 0:
-        ap.error(f"--first-seed must be >= 0, got {args.first_seed}")
+    from twin.errors import ParameterError
+    from twin.transfer.benchmark import seed_range
+    try:        # checked here too: the ceiling references do not go through run_benchmark
+        args.seed_range = seed_range(args.seeds, args.first_seed)
+    except ParameterError as e:
+        ap.error(str(e))
     import torch
 
     from twin.transfer.benchmark import markdown_table, run_benchmark
@@ -67,7 +71,7 @@ def main() -> None:
     cpu = next((ln.split(":", 1)[1].strip() for ln in open("/proc/cpuinfo") if ln.startswith("model name")), "?")
     print(f"Machine: {cpu}, {len(os.sched_getaffinity(0))} cores, Python {platform.python_version()}, "
           f"torch {torch.__version__} (CPU, 1 thread per training run, {args.jobs} runs in parallel)")
-    print(f"{args.seeds} seeds ({args.first_seed}-{args.first_seed + args.seeds - 1}) x 3 methods x {len(tasks)} task(s), {args.epochs} epochs, rig '{args.rig}'; "
+    print(f"{args.seeds} seeds ({args.seed_range[0]}-{args.seed_range[-1]}) x 3 methods x {len(tasks)} task(s), {args.epochs} epochs, rig '{args.rig}'; "
           f"total wall time {wall:.0f} s\n")
     print(markdown_table(summary))
     print(f"\nfigures and report.html -> {out}")
@@ -95,7 +99,7 @@ def _ceiling(args, tasks) -> None:
     else:
         what, fn, pick = "source-only CNN on held-out source records", source_ceiling, 0
     jobs = [(fn, t, str(prepare_task(t, data_dir, rig_settings(t, args.rig))[pick]), s, args.epochs)
-            for t in tasks for s in range(args.first_seed, args.first_seed + args.seeds)]
+            for t in tasks for s in args.seed_range]
     with ProcessPoolExecutor(max_workers=args.jobs, mp_context=mp.get_context("spawn")) as pool:
         acc = list(pool.map(_star, jobs))
     print(f"| task | {what} [%] | per seed |\n|---|---|---|")

@@ -395,15 +395,24 @@ def markdown_table(summary: dict) -> str:
     return "\n".join(lines)
 
 
+def seed_range(seeds: int, first_seed: int = 0) -> range:
+    """The seeds of a run, ``first_seed .. first_seed + seeds - 1``; ParameterError names a bad count or start."""
+    if isinstance(seeds, bool) or not isinstance(seeds, int) or seeds < 1:
+        raise ParameterError(f"seeds must be a positive integer, got {seeds!r}")
+    if isinstance(first_seed, bool) or not isinstance(first_seed, int) or first_seed < 0:
+        raise ParameterError(f"first_seed must be an integer >= 0, got {first_seed!r}")
+    return range(first_seed, first_seed + seeds)
+
+
 def training_jobs(tasks: tuple[str, ...], methods: tuple[str, ...], seeds: int, first_seed: int,
                   paths: dict[str, tuple[Path, Path]], epochs: int) -> list[tuple]:
-    """The ``train_one`` calls of a benchmark: seeds ``first_seed .. first_seed + seeds - 1``.
+    """The ``train_one`` calls of a benchmark, over :func:`seed_range`.
 
     The first seed also returns features for the t-SNE and monitors the target test accuracy per
     epoch for the learning curves (monitoring only: it never feeds back into training).
     """
     return [(train_one, t, m, s, str(paths[t][0]), str(paths[t][1]), epochs, s == first_seed, s == first_seed)
-            for t in tasks for s in range(first_seed, first_seed + seeds) for m in methods]
+            for t in tasks for s in seed_range(seeds, first_seed) for m in methods]
 
 
 def run_benchmark(out: str | Path, *, tasks: tuple[str, ...] = ("pitting", "wear"), seeds: int = 5,
@@ -435,10 +444,7 @@ def run_benchmark(out: str | Path, *, tasks: tuple[str, ...] = ("pitting", "wear
     if bad:
         raise ParameterError(f"unknown task or method {bad[0]!r}; tasks: {', '.join(TASKS)}; "
                              f"methods: cnn, mmd, proposed, coral")
-    if isinstance(seeds, bool) or not isinstance(seeds, int) or seeds < 1:
-        raise ParameterError(f"seeds must be a positive integer, got {seeds!r}")
-    if isinstance(first_seed, bool) or not isinstance(first_seed, int) or first_seed < 0:
-        raise ParameterError(f"first_seed must be an integer >= 0, got {first_seed!r}")
+    seed_range(seeds, first_seed)
     out.mkdir(exist_ok=True)        # only once every argument is known good: a typo leaves no trace
     data_dir = Path(data_dir) if data_dir is not None else out / "data"
     data_dir.mkdir(exist_ok=True)
@@ -489,7 +495,7 @@ def _write_outputs(out: Path, results: list[RunResult], summary: dict, epochs: i
             ts = report.plot_tsne(panels, out / f"tsne_{task}.png", f"{task}: t-SNE of G features, seed {s0}")
             blocks.append((f"{task}: t-SNE", ts.name))
     report.write_html(out / "report.html", "Transfer benchmark: CNN vs MMD vs proposed", blocks)
-    payload = {"summary": summary, "epochs": epochs, "seeds": sorted({r.seed for r in results}), "wall_time": wall, "data": {t: asdict(v) for t, v in settings.items()},
+    payload = {"summary": summary, "epochs": epochs, "wall_time": wall, "data": {t: asdict(v) for t, v in settings.items()},
                "runs": [{k: v for k, v in asdict(r).items() if k != "embedding"} for r in results]}
     with atomic_path(out / "results.json") as tmp:
         Path(tmp).write_text(json.dumps(payload, indent=1))
