@@ -461,12 +461,14 @@ def run_benchmark(out: str | Path, *, tasks: tuple[str, ...] = ("pitting", "wear
     bar.close()
     wall = time.perf_counter() - t0
     summary = summarise(results)
-    _write_outputs(out, results, summary, epochs, wall, settings)
+    _write_outputs(out, results, summary, epochs, wall, settings, first_seed)
     return summary
 
 
 def _write_outputs(out: Path, results: list[RunResult], summary: dict, epochs: int, wall: float,
-                   settings: dict[str, DataSettings]) -> None:
+                   settings: dict[str, DataSettings], first_seed: int) -> None:
+    # The figures show the run's first seed: only its jobs returned features and learning curves
+    # (training_jobs).
     from twin._atomic import atomic_path
     from twin.transfer import report
     from twin.transfer.tsne import tsne
@@ -475,12 +477,11 @@ def _write_outputs(out: Path, results: list[RunResult], summary: dict, epochs: i
     blocks = [("Summary (target test = second halves of the rig records; last epoch; "
                f"{epochs} epochs; wall time {wall:.0f} s)", table)]
     for task in summary:
-        s0 = min(r.seed for r in results if r.task == task)
-        first = {r.method: r for r in results if r.task == task and r.seed == s0}
+        first = {r.method: r for r in results if r.task == task and r.seed == first_seed}
         cm = report.plot_confusion({m: np.array(r.confusion) for m, r in first.items()},
-                                   out / f"confusion_{task}.png", f"{task}: target test windows, seed {s0}")
+                                   out / f"confusion_{task}.png", f"{task}: target test windows, seed {first_seed}")
         lc = report.plot_learning_curves({m: r.history for m, r in first.items()}, out / f"curves_{task}.png",
-                                         f"{task}: learning curves, seed {s0}")
+                                         f"{task}: learning curves, seed {first_seed}")
         panels = {}
         for m, r in first.items():
             e = r.embedding
@@ -492,7 +493,7 @@ def _write_outputs(out: Path, results: list[RunResult], summary: dict, epochs: i
                          np.r_[np.zeros(len(e["source"]), bool), np.ones(len(e["target"]), bool)])
         blocks += [(f"{task}: confusion matrices", cm.name), (f"{task}: learning curves", lc.name)]
         if panels:
-            ts = report.plot_tsne(panels, out / f"tsne_{task}.png", f"{task}: t-SNE of G features, seed {s0}")
+            ts = report.plot_tsne(panels, out / f"tsne_{task}.png", f"{task}: t-SNE of G features, seed {first_seed}")
             blocks.append((f"{task}: t-SNE", ts.name))
     report.write_html(out / "report.html", "Transfer benchmark: CNN vs MMD vs proposed", blocks)
     payload = {"summary": summary, "epochs": epochs, "wall_time": wall, "data": {t: asdict(v) for t, v in settings.items()},
