@@ -80,6 +80,45 @@ def test_summarise_pairs_methods_by_seed():
     assert "| wear | mmd | 91.3 +- 1.5 |" in table and "| wear | proposed-mmd | +0.7 | 2/3 |" in table
 
 
+def test_the_report_draws_its_figures_from_the_runs_first_seed(tmp_path, monkeypatch):
+    """A run of seeds 3-4 (``first_seed=3``): the figures show seed 3, whose jobs alone carry
+    features and learning curves, and say so in their titles."""
+    import json
+
+    from twin.transfer import benchmark, report
+
+    rng = np.random.default_rng(0)
+    history = [{"epoch": 1, "loss": 1.0, "cls": 1.0, "align": 0.0, "con": 0.0, "source_acc": 0.5, "gate": 0.0,
+                "lr": 0.01, "monitor_acc": 0.4}]
+
+    def run(method, seed):
+        first = seed == 3
+        emb = ({"source": rng.normal(size=(20, 6)), "source_stage": np.repeat([0, 1], 10),
+                "target": rng.normal(size=(12, 6)), "target_stage": np.repeat([0, 1], 6)} if first else {})
+        confusion = [[6, 0], [0, 6]] if first else [[0, 6], [6, 0]]
+        return RunResult("wear", method, seed, 0.9, 0.9, 1.0, 10.0, confusion, history if first else [], emb)
+
+    results = [run(m, s) for s in (3, 4) for m in ("mmd", "proposed")]
+    drawn = {}
+    for name in ("plot_confusion", "plot_learning_curves", "plot_tsne"):
+        def spy(panels, path, title="", _name=name, _real=getattr(report, name)):
+            drawn[_name] = (dict(panels), title)
+            return _real(panels, path, title)
+        monkeypatch.setattr(report, name, spy)
+    benchmark._write_outputs(tmp_path, results, summarise(results), 1, 1.0, {"wear": TASK_SETTINGS["wear"]}, 3)
+    confusion, title = drawn["plot_confusion"]
+    assert set(confusion) == {"mmd", "proposed"} and "seed 3" in title
+    assert all(np.array_equal(c, [[6, 0], [0, 6]]) for c in confusion.values())
+    curves, title = drawn["plot_learning_curves"]
+    assert all(h == history for h in curves.values()) and "seed 3" in title
+    assert set(drawn["plot_tsne"][0]) == {"mmd", "proposed"} and "seed 3" in drawn["plot_tsne"][1]
+    for name in ("confusion_wear.png", "curves_wear.png", "tsne_wear.png", "report.html", "summary.md"):
+        assert (tmp_path / name).stat().st_size > 0
+    saved = json.loads((tmp_path / "results.json").read_text())
+    assert sorted((r["seed"], r["method"]) for r in saved["runs"]) == [(3, "mmd"), (3, "proposed"),
+                                                                        (4, "mmd"), (4, "proposed")]
+
+
 def test_stage_order_scores_tell_one_stage_late_from_random():
     from twin.transfer.benchmark import stage_order_scores
 
