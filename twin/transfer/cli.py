@@ -46,6 +46,9 @@ def _cmd_train_assessor(args: argparse.Namespace) -> int:
 
 def _cmd_assess(args: argparse.Namespace) -> int:
     transfer = _lib("twin.transfer")
+    if args.json:
+        from twin._atomic import check_parent
+        check_parent(args.json)     # before the assessment is printed, not after
     a = transfer.Assessor.load(Path(args.assessor))
     res = a.assess(Path(args.measurements))
     for r in res.records:

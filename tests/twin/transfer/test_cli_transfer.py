@@ -96,6 +96,18 @@ def test_train_to_missing_directory_fails_early(tmp_path):
         args.handler(args)
 
 
+def test_assess_checks_its_json_path_before_it_loads_or_prints_anything(tmp_path, capsys):
+    from twin.errors import OutputPathError
+    p = _parser()
+    # the assessor and measurements do not exist either: the output path is refused first
+    for bad, match in ((tmp_path / "no" / "stages.json", "does not exist"), (tmp_path, "is a directory")):
+        args = p.parse_args(["assess", str(tmp_path / "model"), str(tmp_path / "m.h5"), "--json", str(bad)])
+        with pytest.raises(OutputPathError, match=match):
+            args.handler(args)
+    assert capsys.readouterr().out == ""
+    assert not (tmp_path / "no").exists()
+
+
 def test_no_class_prior_reaches_the_saved_assessor(tmp_path):
     src = _file(tmp_path / "src.h5", False, True)
     tgt = _file(tmp_path / "tgt.h5", True, True)
