@@ -71,8 +71,8 @@ def main() -> None:
     cpu = next((ln.split(":", 1)[1].strip() for ln in open("/proc/cpuinfo") if ln.startswith("model name")), "?")
     print(f"Machine: {cpu}, {len(os.sched_getaffinity(0))} cores, Python {platform.python_version()}, "
           f"torch {torch.__version__} (CPU, 1 thread per training run, {args.jobs} runs in parallel)")
-    print(f"{args.seeds} seeds ({args.seed_range[0]}-{args.seed_range[-1]}) x 3 methods x {len(tasks)} task(s), {args.epochs} epochs, rig '{args.rig}'; "
-          f"total wall time {wall:.0f} s\n")
+    print(f"{args.seeds} seeds ({args.seed_range[0]}-{args.seed_range[-1]}) x 3 methods x {len(tasks)} task(s), "
+          f"{args.epochs} epochs, rig '{args.rig}'; total wall time {wall:.0f} s\n")
     print(markdown_table(summary))
     print(f"\nfigures and report.html -> {out}")
 

@@ -404,15 +404,15 @@ def seed_range(seeds: int, first_seed: int = 0) -> range:
     return range(first_seed, first_seed + seeds)
 
 
-def training_jobs(tasks: tuple[str, ...], methods: tuple[str, ...], seeds: int, first_seed: int,
+def training_jobs(tasks: tuple[str, ...], methods: tuple[str, ...], seeds: range,
                   paths: dict[str, tuple[Path, Path]], epochs: int) -> list[tuple]:
-    """The ``train_one`` calls of a benchmark, over :func:`seed_range`.
+    """The ``train_one`` calls of a benchmark over ``seeds`` (a :func:`seed_range`).
 
     The first seed also returns features for the t-SNE and monitors the target test accuracy per
     epoch for the learning curves (monitoring only: it never feeds back into training).
     """
-    return [(train_one, t, m, s, str(paths[t][0]), str(paths[t][1]), epochs, s == first_seed, s == first_seed)
-            for t in tasks for s in seed_range(seeds, first_seed) for m in methods]
+    return [(train_one, t, m, s, str(paths[t][0]), str(paths[t][1]), epochs, s == seeds[0], s == seeds[0])
+            for t in tasks for s in seeds for m in methods]
 
 
 def run_benchmark(out: str | Path, *, tasks: tuple[str, ...] = ("pitting", "wear"), seeds: int = 5,
@@ -444,13 +444,13 @@ def run_benchmark(out: str | Path, *, tasks: tuple[str, ...] = ("pitting", "wear
     if bad:
         raise ParameterError(f"unknown task or method {bad[0]!r}; tasks: {', '.join(TASKS)}; "
                              f"methods: cnn, mmd, proposed, coral")
-    seed_range(seeds, first_seed)
+    run_seeds = seed_range(seeds, first_seed)
     out.mkdir(exist_ok=True)        # only once every argument is known good: a typo leaves no trace
     data_dir = Path(data_dir) if data_dir is not None else out / "data"
     data_dir.mkdir(exist_ok=True)
     settings = {t: (settings or {}).get(t) or rig_settings(t, rig) for t in tasks}
     paths = {t: prepare_task(t, data_dir, settings[t], progress=progress) for t in tasks}
-    jobs_list = training_jobs(tasks, methods, seeds, first_seed, paths, epochs)
+    jobs_list = training_jobs(tasks, methods, run_seeds, paths, epochs)
     bar = progress_bar(len(jobs_list), progress, "transfer benchmark", "run")
     results: list[RunResult] = []
     t0 = time.perf_counter()
@@ -461,7 +461,7 @@ def run_benchmark(out: str | Path, *, tasks: tuple[str, ...] = ("pitting", "wear
     bar.close()
     wall = time.perf_counter() - t0
     summary = summarise(results)
-    _write_outputs(out, results, summary, epochs, wall, settings, first_seed)
+    _write_outputs(out, results, summary, epochs, wall, settings, run_seeds[0])
     return summary
 
 

@@ -10,7 +10,8 @@ import pytest
 
 from twin.errors import ParameterError
 from twin.transfer.benchmark import (RIGS, TASK_SETTINGS, DataSettings, RunResult, markdown_table, rig_settings,
-                                     run_benchmark, summarise, task_preprocessing, train_one, training_jobs)
+                                     run_benchmark, seed_range, summarise, task_preprocessing, train_one,
+                                     training_jobs)
 
 
 def test_task_preprocessing_windows_two_revolutions_at_each_tests_speed():
@@ -47,7 +48,7 @@ def test_unknown_rig_is_refused_before_any_data_are_built(tmp_path):
 
 def test_first_seed_adds_later_seeds_and_is_checked_before_any_data_are_built(tmp_path):
     paths = {"wear": (Path("s.h5"), Path("t.h5"))}
-    jobs = training_jobs(("wear",), ("mmd", "proposed"), 3, 5, paths, 80)
+    jobs = training_jobs(("wear",), ("mmd", "proposed"), seed_range(3, 5), paths, 80)
     assert [(j[1], j[2], j[3]) for j in jobs] == [("wear", m, s) for s in (5, 6, 7) for m in ("mmd", "proposed")]
     # features and the monitored learning curve come from the first seed of the run, whatever it is
     assert [(j[3], j[7], j[8]) for j in jobs[::2]] == [(5, True, True), (6, False, False), (7, False, False)]
