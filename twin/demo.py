@@ -262,7 +262,7 @@ def _transfer_demo(out_dir: Path, epochs: int = 15):
         accuracy[method] = asm.window_accuracy
         if method == "proposed":
             assessed = (asm, test)
-            offsets, moved = a.target_log_weights_, a.class_prior_moved_
+            offsets, moved, drop = a.target_log_weights_, a.class_prior_moved_, a.class_prior_confidence_drop_
             a.save(out_dir / "assessor")
     print(f"[9/9] Wear-stage assessment of rig records (6 pitting stages; the rig has a mount resonance, "
           f"run-out and another sensor the twin lacks; {epochs} epochs, one seed: "
@@ -270,7 +270,8 @@ def _transfer_demo(out_dir: Path, epochs: int = 15):
     print("      target test accuracy: " + ", ".join(f"{m} {100 * v:.0f} %" for m, v in accuracy.items()))
     print("      class-prior match (proposed): stage logit offsets "
           + " ".join(f"{v:+.2f}" for v in offsets) + " balance the rig's stages as in the archive; "
-          f"{100 * moved:.1f} % of the rig's adaptation windows changed stage")
+          f"{100 * moved:.1f} % of the rig's adaptation windows changed stage, their mean confidence "
+          f"{-100 * drop:+.1f} points")
     print(f"      each archive record has a pinion of its own: run-out up to {1e6 * settings.source_runout:.0f} um, "
           f"pitting spread over the teeth with a relative sd up to {settings.source_tooth_damage_scatter:.1f}, "
           + (f"pitch errors up to {1e6 * settings.source_pitch_error:.0f} um" if settings.source_pitch_error > 0

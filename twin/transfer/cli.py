@@ -38,7 +38,8 @@ def _cmd_train_assessor(args: argparse.Namespace) -> int:
     if a.class_prior == "source" and args.method != "cnn":
         before, after = (" / ".join(map(str, row)) for row in a.adaptation_stage_counts_)
         print(f"class-prior match: rig adaptation windows per stage {before} -> {after} "
-              f"({100 * a.class_prior_moved_:.1f} % changed stage)")
+              f"({100 * a.class_prior_moved_:.1f} % changed stage; mean confidence "
+              f"{-100 * a.class_prior_confidence_drop_:+.1f} points)")
     for note in notes:
         print(f"warning: {note}")
     return 0

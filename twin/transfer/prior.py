@@ -16,6 +16,14 @@ iteration sets ``w_k <- w_k pi_k / mean_i q_ik``.  Multiplying probabilities by 
 
 It reads no target label.  It does rely on the proportions: on rig data dominated by one stage
 (a run-to-failure history that is mostly healthy) switch it off (``Assessor(class_prior=None)``).
+
+:func:`confidence_drop` tells the two cases apart after the fact.  A rig that shifts a boundary
+leaves windows near it that the classifier is unsure of, and the match moves those: the mean
+confidence barely changes.  Rig data whose stage mix differs from the prior (or that do not fall
+into the twin's stages at all) hold stages the classifier reads confidently in the "wrong"
+proportions, and the match can only meet the prior by pushing confident windows over a boundary:
+the mean confidence falls.  On the benchmark's rigs (BENCHMARKS.md, stop 20) the first case cost
+at most 1.9 points of mean confidence and the second at least 6.6.
 """
 from __future__ import annotations
 
@@ -23,7 +31,7 @@ import numpy as np
 
 from twin.transfer.errors import AssessorError
 
-__all__ = ["LOG_WEIGHT_LIMIT", "apply_log_weights", "match_class_prior", "stage_moves"]
+__all__ = ["LOG_WEIGHT_LIMIT", "apply_log_weights", "confidence_drop", "match_class_prior", "stage_moves"]
 
 # A stage the adaptation data hardly show would need an unbounded weight; e^8 ~ 3000 is far past any
 # boundary shift seen on the benchmark rigs (|log w| <= 3.2) and keeps the correction finite.
@@ -82,6 +90,14 @@ def match_class_prior(proba: np.ndarray, prior: np.ndarray, *, tol: float = 1e-6
     return log_w
 
 
+def _windows_and_offsets(what: str, proba, log_weights) -> tuple[np.ndarray, np.ndarray]:
+    p = np.asarray(proba, dtype=np.float64)
+    w = np.asarray(log_weights, dtype=np.float64)
+    if p.ndim != 2 or p.shape[0] < 1 or w.shape != (p.shape[1],):
+        raise AssessorError(f"{what}: probabilities (n, K) and offsets (K,) needed, got {p.shape} and {w.shape}")
+    return p, w
+
+
 def stage_moves(proba: np.ndarray, log_weights: np.ndarray) -> tuple[np.ndarray, float]:
     """How the offsets re-assess windows: counts per stage without and with them, and the share moved.
 
@@ -99,10 +115,27 @@ def stage_moves(proba: np.ndarray, log_weights: np.ndarray) -> tuple[np.ndarray,
     moved : float
         Share of the windows whose stage the offsets change, in [0, 1].
     """
-    p = np.asarray(proba, dtype=np.float64)
-    w = np.asarray(log_weights, dtype=np.float64)
-    if p.ndim != 2 or p.shape[0] < 1 or w.shape != (p.shape[1],):
-        raise AssessorError(f"stage moves: probabilities (n, K) and offsets (K,) needed, got {p.shape} and {w.shape}")
+    p, w = _windows_and_offsets("stage moves", proba, log_weights)
     before, after = p.argmax(1), apply_log_weights(p, w).argmax(1)
     k = p.shape[1]
     return np.stack([np.bincount(before, minlength=k), np.bincount(after, minlength=k)]), float(np.mean(before != after))
+
+
+def confidence_drop(proba: np.ndarray, log_weights: np.ndarray) -> float:
+    """How much the offsets lower the windows' mean confidence (largest stage probability).
+
+    Parameters
+    ----------
+    proba : ndarray (n, K)
+        Stage probabilities of the windows, without offsets.
+    log_weights : ndarray (K,)
+        The offsets (:func:`match_class_prior`).
+
+    Returns
+    -------
+    float
+        ``mean_i max_k p_ik - mean_i max_k q_ik`` with ``q`` the re-weighted probabilities, in
+        (-1, 1); positive when the offsets make the windows less certain.
+    """
+    p, w = _windows_and_offsets("confidence drop", proba, log_weights)
+    return float(p.max(axis=1).mean() - apply_log_weights(p, w).max(axis=1).mean())

@@ -282,35 +282,88 @@ def test_class_prior_offsets_survive_save_and_load_and_version_3_loads_without(f
 
 
 def test_class_prior_diagnostics_and_the_warning(tiny_pre, tiny_data, fitted):
-    """fit records how the match re-assesses the adaptation windows and warns when it moves many:
-    the tiny rig's gain and hum push stage 0 into stage 1, so the match moves about a third."""
+    """fit records how the match re-assesses the adaptation windows and warns when it costs them
+    much confidence: the tiny rig's gain and hum push stage 0 into stage 1, read with confidence,
+    so the match moves about a third of the windows against the network's certainty."""
     import warnings
 
     from twin.transfer import ClassPriorWarning
-    from twin.transfer.assessor import CLASS_PRIOR_WARN_SHARE
+    from twin.transfer.assessor import CLASS_PRIOR_WARN_DROP
     src, adapt, _ = tiny_data
     counts = fitted.adaptation_stage_counts_
     assert counts.shape == (2, 3) and counts.sum(1).tolist() == [fitted.n_target_windows_] * 2
     assert counts[0, 0] < counts[1, 0]               # stage 0 windows won back by the match
-    assert fitted.class_prior_moved_ > CLASS_PRIOR_WARN_SHARE
-    with pytest.warns(ClassPriorWarning, match=r"moved \d+\.\d % of the \d+ rig adaptation windows.*--no-class-prior"):
+    assert fitted.class_prior_moved_ > 0.2
+    assert fitted.class_prior_confidence_drop_ > CLASS_PRIOR_WARN_DROP
+    with pytest.warns(ClassPriorWarning, match=r"lowered the mean confidence of the \d+ rig adaptation windows by "
+                                               r"\d+\.\d points.*moved \d+\.\d %.*--no-class-prior"):
         tiny_assessor("mmd", tiny_pre, seed=3).fit(src, adapt)
     with warnings.catch_warnings():
         warnings.simplefilter("error", ClassPriorWarning)
         plain = tiny_assessor("mmd", tiny_pre, seed=3, class_prior=None).fit(src, adapt)
         # a rig without the hum and gain: nothing to move, no warning
         same = tiny_assessor("mmd", tiny_pre, seed=3).fit(src, make_records(8, seed=2, labelled=False))
-    assert plain.class_prior_moved_ == 0.0
-    assert same.class_prior_moved_ == 0.0
+    assert plain.class_prior_moved_ == 0.0 and plain.class_prior_confidence_drop_ == pytest.approx(0.0, abs=1e-6)
+    assert same.class_prior_moved_ == 0.0 and same.class_prior_confidence_drop_ < CLASS_PRIOR_WARN_DROP
+
+
+def _checked(p: np.ndarray) -> Assessor:
+    """An assessor whose class-prior match was fitted to the adaptation probabilities ``p`` (n, 2)
+    with a balanced prior, as ``fit`` does after training."""
+    from twin.transfer.prior import match_class_prior
+    a = Assessor("mmd")
+    prior = np.array([0.5, 0.5])
+    a.target_log_weights_ = match_class_prior(p, prior)
+    a._class_prior_check(p, prior)
+    return a
+
+
+def test_a_shifted_boundary_moves_unsure_windows_without_a_warning():
+    """Balanced rig data (50 windows per stage) whose boundary the rig has shifted: 30 stage-1
+    windows read as stage 0, unsure.  The match moves them back (30 %, far more than stop 14's 8 %
+    rule allowed) but costs little confidence, so fit stays quiet."""
+    import warnings
+
+    from twin.transfer import ClassPriorWarning
+    from twin.transfer.assessor import CLASS_PRIOR_WARN_DROP
+    p0 = np.concatenate([np.linspace(0.85, 0.95, 40), np.linspace(0.05, 0.15, 30), np.linspace(0.51, 0.6, 30)])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ClassPriorWarning)
+        a = _checked(np.stack([p0, 1 - p0], axis=1))
+    assert a.adaptation_stage_counts_.tolist() == [[70, 30], [40, 60]]
+    assert a.class_prior_moved_ == pytest.approx(0.3)
+    assert 0 < a.class_prior_confidence_drop_ < CLASS_PRIOR_WARN_DROP
+
+
+def test_an_imbalanced_rig_set_costs_confidence_and_warns():
+    """Run-to-failure-like rig data, 70 windows of stage 0 and 30 of stage 1, all read with
+    confidence.  A balanced prior is met by making every stage-0 window less sure; no window changes
+    stage, so stop 14's rule (share moved) saw nothing."""
+    from twin.transfer import ClassPriorWarning
+    from twin.transfer.assessor import CLASS_PRIOR_WARN_DROP
+    p0 = np.concatenate([np.linspace(0.9, 0.99, 70), np.linspace(0.01, 0.1, 30)])
+    with pytest.warns(ClassPriorWarning, match=r"proportions 0\.50, 0\.50"):
+        a = _checked(np.stack([p0, 1 - p0], axis=1))
+    assert a.adaptation_stage_counts_.tolist() == [[70, 30], [70, 30]] and a.class_prior_moved_ == 0.0
+    assert a.class_prior_confidence_drop_ > CLASS_PRIOR_WARN_DROP
 
 
 def test_class_prior_diagnostics_survive_save_and_load(fitted, tmp_path):
     d = fitted.save(tmp_path / "diag")
     back = Assessor.load(d)
     assert back.class_prior_moved_ == fitted.class_prior_moved_
+    assert back.class_prior_confidence_drop_ == fitted.class_prior_confidence_drop_
     np.testing.assert_array_equal(back.adaptation_stage_counts_, fitted.adaptation_stage_counts_)
     cfg = json.loads((d / "config.json").read_text())
-    del cfg["class_prior_moved"], cfg["adaptation_stage_counts"]      # written before stop 14
+    del cfg["class_prior_confidence_drop"]                             # written before stop 20
+    (d / "config.json").write_text(json.dumps(cfg))
+    back = Assessor.load(d)
+    assert back.class_prior_moved_ == fitted.class_prior_moved_ and not hasattr(back, "class_prior_confidence_drop_")
+    cfg["class_prior_confidence_drop"] = "high"
+    (d / "config.json").write_text(json.dumps(cfg))
+    with pytest.raises(AssessorError, match=r"class_prior_confidence_drop must be a number in \(-1, 1\), got 'high'"):
+        Assessor.load(d)
+    del cfg["class_prior_confidence_drop"], cfg["class_prior_moved"], cfg["adaptation_stage_counts"]  # before stop 14
     (d / "config.json").write_text(json.dumps(cfg))
     assert not hasattr(Assessor.load(d), "class_prior_moved_")
     cfg["class_prior_moved"], cfg["adaptation_stage_counts"] = 1.5, [[1, 2, 3]]

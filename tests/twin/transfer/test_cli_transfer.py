@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from twin.measurements import Record, load_measurements, write_measurements
-from twin.transfer.assessor import CLASS_PRIOR_WARN_SHARE
+from twin.transfer.assessor import CLASS_PRIOR_WARN_DROP
 from twin.transfer.cli import add_subcommands
 
 
@@ -127,20 +127,23 @@ def test_no_class_prior_reaches_the_saved_assessor(tmp_path):
 
 def test_train_assessor_reports_the_class_prior_match_and_warns_on_one_stage_rig_data(tmp_path, capsys):
     """A rig file holding only stage 0 breaks the match's assumption; the CLI says so on stdout, as
-    one 'warning:' line naming the switch, not as a Python traceback-style warning."""
+    one 'warning:' line naming the switch, not as a Python traceback-style warning.  20 epochs, so the
+    network reads the stage with confidence and the match has to take it away (after 2 epochs it is
+    unsure, and moving its windows costs too little confidence to warn)."""
     src = _file(tmp_path / "src.h5", False, True)
     one_stage = [r for r in load_measurements(_file(tmp_path / "all.h5", True, False)).records if r.name.startswith("s0")]
     tgt = write_measurements(one_stage, tmp_path / "tgt.h5")
     p = _parser()
     args = p.parse_args(["train-assessor", "--source", str(src), "--target", str(tgt), "--out",
-                         str(tmp_path / "model"), "--epochs", "2", "--method", "mmd", "--no-progress"])
+                         str(tmp_path / "model"), "--epochs", "20", "--method", "mmd", "--no-progress"])
     assert args.handler(args) == 0
     out, err = capsys.readouterr()
     assert "class-prior match: rig adaptation windows per stage" in out
-    assert "warning: the class-prior match moved" in out and "--no-class-prior" in out
+    assert "changed stage; mean confidence -" in out
+    assert "warning: the class-prior match lowered the mean confidence" in out and "--no-class-prior" in out
     assert "ClassPriorWarning" not in err
     cfg = json.loads((tmp_path / "model" / "config.json").read_text())
-    assert cfg["class_prior_moved"] > CLASS_PRIOR_WARN_SHARE
+    assert cfg["class_prior_confidence_drop"] > CLASS_PRIOR_WARN_DROP
     args = p.parse_args(["train-assessor", "--source", str(src), "--target", str(tgt), "--out",
                          str(tmp_path / "plain"), "--epochs", "2", "--method", "mmd", "--no-progress",
                          "--no-class-prior"])

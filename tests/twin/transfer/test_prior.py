@@ -1,4 +1,5 @@
-"""The class-prior match: hand-computable offsets, the constraint it solves, its bounds and errors."""
+"""The class-prior match: hand-computable offsets, the constraint it solves, its bounds and errors,
+and the two diagnostics of what it did (windows moved, confidence lost)."""
 from __future__ import annotations
 
 import math
@@ -7,7 +8,7 @@ import numpy as np
 import pytest
 
 from twin.transfer import AssessorError
-from twin.transfer.prior import LOG_WEIGHT_LIMIT, apply_log_weights, match_class_prior, stage_moves
+from twin.transfer.prior import LOG_WEIGHT_LIMIT, apply_log_weights, confidence_drop, match_class_prior, stage_moves
 
 
 def test_identical_windows_give_the_hand_computed_offsets():
@@ -64,3 +65,14 @@ def test_stage_moves_counts_by_hand():
     assert counts.tolist() == [[1, 3], [1, 3]] and moved == 0.0
     with pytest.raises(AssessorError, match=r"offsets \(K,\) needed"):
         stage_moves(p, np.zeros(3))
+
+
+def test_confidence_drop_by_hand():
+    # (0.8, 0.2) under offsets (-ln 2, +ln 2) becomes (0.5, 0.5): each window loses 0.3 of confidence;
+    # (0.1, 0.9) becomes (0.1 / 3.7, 3.6 / 3.7) and gains 3.6 / 3.7 - 0.9
+    p = np.array([[0.8, 0.2], [0.8, 0.2], [0.1, 0.9]])
+    log_w = np.array([-math.log(2), math.log(2)])
+    assert confidence_drop(p, log_w) == pytest.approx((0.3 + 0.3 - (3.6 / 3.7 - 0.9)) / 3, abs=1e-12)
+    assert confidence_drop(p, np.zeros(2)) == 0.0
+    with pytest.raises(AssessorError, match=r"confidence drop: .*offsets \(K,\) needed"):
+        confidence_drop(p, np.zeros(3))
