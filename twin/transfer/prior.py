@@ -22,8 +22,8 @@ leaves windows near it that the classifier is unsure of, and the match moves tho
 confidence barely changes.  Rig data whose stage mix differs from the prior (or that do not fall
 into the twin's stages at all) hold stages the classifier reads confidently in the "wrong"
 proportions, and the match can only meet the prior by pushing confident windows over a boundary:
-the mean confidence falls.  On the benchmark's rigs (BENCHMARKS.md, stop 20) the first case cost
-at most 1.9 points of mean confidence and the second at least 6.6.
+the mean confidence falls.  On the benchmark's rigs (BENCHMARKS.md, stop 20; 54 runs) the first
+case cost at most 1.9 points of mean confidence and the second at least 5.3.
 """
 from __future__ import annotations
 
