@@ -61,7 +61,7 @@ CLASS_PRIORS = ("source", None)
 # (BENCHMARKS.md, stop 20): on the balanced benchmark and blind rigs the match cost at most 0.019, on
 # run-to-failure-like subsets of the benchmark rig, where it costs 7-16 points of accuracy, at least
 # 0.066.  Unseen imbalanced sets afterwards: at least 0.053.  The share of windows moved (stop 14's
-# statistic, 8 %) overlapped: up to 14 % balanced against from 7.8 % imbalanced.
+# statistic, 8 %) overlapped: up to 14 % on balanced data, from 7.8 % on imbalanced.
 CLASS_PRIOR_WARN_DROP = 0.04
 _EVAL_BATCH = 256
 

@@ -124,12 +124,7 @@ def stage_moves(proba: np.ndarray, log_weights: np.ndarray) -> tuple[np.ndarray,
 def confidence_drop(proba: np.ndarray, log_weights: np.ndarray) -> float:
     """How much the offsets lower the windows' mean confidence (largest stage probability).
 
-    Parameters
-    ----------
-    proba : ndarray (n, K)
-        Stage probabilities of the windows, without offsets.
-    log_weights : ndarray (K,)
-        The offsets (:func:`match_class_prior`).
+    ``proba`` (n, K) and ``log_weights`` (K,) as in :func:`stage_moves`.
 
     Returns
     -------
