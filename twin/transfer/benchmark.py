@@ -246,6 +246,7 @@ class RunResult:
     confusion: list                 # (K, K) target test windows
     history: list
     embedding: dict = field(default_factory=dict)     # features for t-SNE (first seed only)
+    class_prior_drop: float | None = None   # fit's class_prior_confidence_drop_; None without a match (CNN)
 
 
 def train_one(task: str, method: str, seed: int, source: str, target: str, epochs: int = 80,
@@ -271,7 +272,8 @@ def train_one(task: str, method: str, seed: int, source: str, target: str, epoch
         emb = {"source": fs[pick], "source_stage": ys[pick], "target": a.transform(test), "target_stage": y}
     return RunResult(task, method, seed, float(np.mean(y == p)), float(asm.record_accuracy),
                      float(src_acc), float(a.fit_time_), confusion_matrix(y, p, a.n_classes_).tolist(),
-                     a.history_, emb)
+                     a.history_, emb,
+                     a.class_prior_confidence_drop_ if method != "cnn" and a.class_prior is not None else None)
 
 
 def source_ceiling(task: str, source: str, seed: int, epochs: int = 80) -> float:
@@ -341,7 +343,8 @@ def summarise(results: list[RunResult]) -> dict:
                        "within_one_mean": float(np.mean([o[0] for o in order])),
                        "spearman_mean": float(np.nanmean([o[1] for o in order])) if any(
                            np.isfinite(o[1]) for o in order) else float("nan"),
-                       "fit_time_mean": float(t.mean()), "fit_time_max": float(t.max())}
+                       "fit_time_mean": float(t.mean()), "fit_time_max": float(t.max()),
+                       "class_prior_warnings": _warnings(rs)}
         pairs = {}
         for a, b in (("cnn", "mmd"), ("mmd", "proposed"), ("cnn", "proposed")):
             if a in rows and b in rows and rows[a]["seeds"] == rows[b]["seeds"]:
@@ -351,6 +354,13 @@ def summarise(results: list[RunResult]) -> dict:
                                      "paired_t_p": p}
         out[task] = {"methods": rows, "paired": pairs}
     return out
+
+
+def _warnings(runs: list[RunResult]) -> int | None:
+    """How many runs' class-prior match passed fit's warning threshold; None when none had a match."""
+    from twin.transfer.assessor import CLASS_PRIOR_WARN_DROP
+    drops = [r.class_prior_drop for r in runs if r.class_prior_drop is not None]
+    return sum(d > CLASS_PRIOR_WARN_DROP for d in drops) if drops else None
 
 
 def stage_order_scores(confusion) -> tuple[float, float]:
@@ -377,16 +387,19 @@ def stage_order_scores(confusion) -> tuple[float, float]:
 def markdown_table(summary: dict) -> str:
     """The figures as a Markdown table (accuracy in %, mean +- std over seeds)."""
     lines = ["| task | method | target test windows [%] | target test records [%] | source (train) [%] | "
-             "fit time mean / max [s] | within one stage [%] | rank correlation |", "|---|---|---|---|---|---|---|---|"]
+             "fit time mean / max [s] | within one stage [%] | rank correlation | class-prior warnings |",
+             "|---|---|---|---|---|---|---|---|---|"]
     for task, s in summary.items():
         for m, r in s["methods"].items():
             # summaries written before the stage-order columns lack them
             within, rho = r.get("within_one_mean", float("nan")), r.get("spearman_mean", float("nan"))
+            warned = r.get("class_prior_warnings")      # absent before stop 20, None without a match
+            warned = "n/a" if warned is None else f"{warned}/{len(r['seeds'])}"
             lines.append(f"| {task} | {m} | {100 * r['mean']:.1f} +- {100 * r['std']:.1f} | "
                          f"{100 * r['record_mean']:.1f} +- {100 * r['record_std']:.1f} | "
                          f"{100 * r['source_acc_mean']:.1f} | {r['fit_time_mean']:.0f} / {r['fit_time_max']:.0f} | "
                          f"{'n/a' if np.isnan(within) else f'{100 * within:.1f}'} | "
-                         f"{'n/a' if np.isnan(rho) else f'{rho:.2f}'} |")
+                         f"{'n/a' if np.isnan(rho) else f'{rho:.2f}'} | {warned} |")
     lines += ["", "| task | comparison | mean gain [points] | seeds won | paired t-test p |", "|---|---|---|---|---|"]
     for task, s in summary.items():
         for k, d in s["paired"].items():

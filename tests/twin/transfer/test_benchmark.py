@@ -63,22 +63,26 @@ def test_first_seed_adds_later_seeds_and_is_checked_before_any_data_are_built(tm
     assert not (tmp_path / "out").exists()
 
 
-def _run(method, seed, acc):
-    return RunResult("wear", method, seed, acc, acc, 1.0, 10.0, [[1]], [])
+def _run(method, seed, acc, drop=None):
+    return RunResult("wear", method, seed, acc, acc, 1.0, 10.0, [[1]], [], class_prior_drop=drop)
 
 
 def test_summarise_pairs_methods_by_seed():
     runs = [_run("cnn", s, a) for s, a in enumerate([0.80, 0.82, 0.81])]
-    runs += [_run("mmd", s, a) for s, a in enumerate([0.90, 0.91, 0.93])]
-    runs += [_run("proposed", s, a) for s, a in enumerate([0.91, 0.90, 0.95])]
+    runs += [_run("mmd", s, a, 0.0) for s, a in enumerate([0.90, 0.91, 0.93])]
+    # fit warns above a 4-point drop of confidence: seeds 1 and 2
+    runs += [_run("proposed", s, a, d) for s, a, d in zip(range(3), [0.91, 0.90, 0.95], [0.039, 0.041, 0.2])]
     s = summarise(runs)["wear"]
     assert s["methods"]["mmd"]["mean"] == pytest.approx(0.9133333, abs=1e-6)
     assert s["methods"]["cnn"]["std"] == pytest.approx(0.01, abs=1e-9)
     d = s["paired"]["proposed-mmd"]
     assert d["mean_diff"] == pytest.approx(0.0066667, abs=1e-6) and d["wins"] == 2 and d["n"] == 3
     assert s["paired"]["mmd-cnn"]["paired_t_p"] < 0.05
+    assert [s["methods"][m]["class_prior_warnings"] for m in ("cnn", "mmd", "proposed")] == [None, 0, 2]
     table = markdown_table(summarise(runs))
     assert "| wear | mmd | 91.3 +- 1.5 |" in table and "| wear | proposed-mmd | +0.7 | 2/3 |" in table
+    rows = {line.split(" | ")[1]: line for line in table.splitlines() if line.startswith("| wear | ")}
+    assert rows["cnn"].endswith("| n/a |") and rows["mmd"].endswith("| 0/3 |") and rows["proposed"].endswith("| 2/3 |")
 
 
 def test_the_report_draws_its_figures_from_the_runs_first_seed(tmp_path, monkeypatch):
