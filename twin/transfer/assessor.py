@@ -66,6 +66,11 @@ CLASS_PRIOR_WARN_DROP = 0.04
 _EVAL_BATCH = 256
 
 
+def class_prior_warns(confidence_drop: float) -> bool:
+    """``fit``'s rule: does a class-prior match that cost this much mean confidence warn?"""
+    return confidence_drop > CLASS_PRIOR_WARN_DROP
+
+
 @dataclass(frozen=True)
 class RecordAssessment:
     """The verdict on one record.
@@ -502,7 +507,7 @@ class Assessor:
         from twin.transfer.prior import confidence_drop, stage_moves
         self.adaptation_stage_counts_, self.class_prior_moved_ = stage_moves(p_adapt, self.target_log_weights_)
         self.class_prior_confidence_drop_ = confidence_drop(p_adapt, self.target_log_weights_)
-        if prior is not None and self.class_prior_confidence_drop_ > CLASS_PRIOR_WARN_DROP:
+        if prior is not None and class_prior_warns(self.class_prior_confidence_drop_):
             import warnings
             k = p_adapt.shape[1]
             counts = ", ".join(map(str, self.adaptation_stage_counts_[0]))

@@ -358,9 +358,9 @@ def summarise(results: list[RunResult]) -> dict:
 
 def _warnings(runs: list[RunResult]) -> int | None:
     """How many runs' class-prior match passed fit's warning threshold; None when none had a match."""
-    from twin.transfer.assessor import CLASS_PRIOR_WARN_DROP
+    from twin.transfer.assessor import class_prior_warns
     drops = [r.class_prior_drop for r in runs if r.class_prior_drop is not None]
-    return sum(d > CLASS_PRIOR_WARN_DROP for d in drops) if drops else None
+    return sum(class_prior_warns(d) for d in drops) if drops else None
 
 
 def stage_order_scores(confusion) -> tuple[float, float]:
