@@ -171,17 +171,61 @@ def draw_pinion(draw: np.random.Generator, spec, teeth: int) -> PinionDraw:
                       np.asarray(c, float))
 
 
+def _profile(parameters: dict, name: str) -> np.ndarray:
+    """The FMU array ``name[1..n]`` of ``parameters`` in index order (empty when absent)."""
+    keys = sorted((k for k in parameters if k.startswith(name + "[")), key=lambda k: int(k[len(name) + 1:-1]))
+    return np.array([parameters[k] for k in keys], dtype=float)
+
+
+def tooth_compliance_factors(k_healthy: np.ndarray, k_damaged: np.ndarray, damage_factors: np.ndarray,
+                             samples_per_segment: int = 50) -> np.ndarray:
+    """Per-tooth stiffness multipliers of a pinion whose teeth are pitted unevenly.
+
+    The uniform damage lowers the pair stiffness along the path of contact from ``k_healthy`` to
+    ``k_damaged`` (the FMU's ``k_pair`` nodes, equally spaced in roll, interpolated piecewise
+    linearly as the FMU does), a local loss ``d(u) = 1 - k_damaged(u) / k_healthy(u)``.  Tooth i is
+    pitted ``c_i`` times as much in the same zone: its pair stiffness would be
+    ``k_healthy(u) (1 - min(c_i d(u), 0.95))``.  The FMU scales the common profile by one number per
+    tooth, so the number chosen keeps the tooth's *mean compliance* along the path, 1/k averaged
+    over u: that is the tooth's mean quasi-static deflection under a given mesh force, whose
+    differences from tooth to tooth are what puts energy at the shaft-order sidebands.  (Keeping
+    the mean stiffness instead, the rule until stop 21, underestimates how far a badly pitted
+    tooth gives way: where its local loss nears the cap, its compliance grows as 1 / (1 - loss).)
+    For uniform damage (``c_i = 1``), or a loss that is the same all along the path, both rules
+    agree: (1 - min(c_i L, 0.95)) / (1 - L).
+
+    Parameters
+    ----------
+    k_healthy, k_damaged : ndarray, shape (n,)
+        Pair stiffness nodes [N/m] of the healthy and of the uniformly damaged flank.
+    damage_factors : ndarray, shape (teeth,)
+        c_i [-], >= 0.
+    samples_per_segment : int
+        Points per node interval of the grid the compliance is averaged on.
+
+    Returns
+    -------
+    ndarray, shape (teeth,)
+        ``tooth_stiffness_factor`` [-]; all ones when the damaged flank is nowhere softer.
+    """
+    c = np.asarray(damage_factors, dtype=float)
+    kh, kd = np.asarray(k_healthy, dtype=float), np.asarray(k_damaged, dtype=float)
+    if kh.size == 0 or not np.any(kd < kh):
+        return np.ones(c.size)
+    nodes = np.linspace(0.0, 1.0, kh.size)
+    u = np.linspace(0.0, 1.0, max(1, (kh.size - 1) * samples_per_segment) + 1)
+    kh_u, kd_u = np.interp(u, nodes, kh), np.interp(u, nodes, kd)
+    loss = 1.0 - kd_u / kh_u                                              # (U,)
+    tooth_k = kh_u * (1.0 - np.minimum(c[:, None] * loss, PITTING_LOSS_CAP))   # (teeth, U)
+    return np.mean(1.0 / kd_u) / np.mean(1.0 / tooth_k, axis=1)
+
+
 def pinion_parameters(pinion: PinionDraw, healthy: dict, damaged: dict) -> dict[str, float]:
     """Per-tooth FMU parameters of a drawn pinion at a record's damage (see :func:`tooth_errors`)."""
     teeth = pinion.pitch_deviation.size
     c = pinion.damage_factors
     offset = pinion.pitch_deviation + runout_deviation(pinion.runout, pinion.runout_phase, teeth)
-    factor = np.ones(teeth)
-    k_keys = [k for k in healthy if k.startswith("k_pair[")]
-    k_healthy = sum(healthy[k] for k in k_keys)
-    loss = 1.0 - sum(damaged[k] for k in k_keys) / k_healthy if k_keys and k_healthy > 0 else 0.0
-    if loss > 0:
-        factor = (1.0 - np.minimum(c * loss, PITTING_LOSS_CAP)) / (1.0 - loss)
+    factor = tooth_compliance_factors(_profile(healthy, "k_pair"), _profile(damaged, "k_pair"), c)
     depth = [v for k, v in damaged.items() if k.startswith("profile_deviation[")]
     mean_depth = float(np.mean(depth)) if depth else 0.0
     if mean_depth > 0:
@@ -205,12 +249,13 @@ def tooth_errors(draw: np.random.Generator, spec, teeth: int, healthy: dict, dam
     * ``runout`` [m]: bound of the peak-to-peak run-out, a once-per-revolution sinusoid of random
       phase over the teeth;
     * ``tooth_damage_scatter`` [-]: bound of the relative sd of per-tooth damage factors c_i
-      (gamma distributed, mean 1, so the stage's mean damage is kept).  Pitting: tooth i loses
-      min(c_i L, 0.95) of its pair stiffness where the uniform damage loses L (the mean relative
-      ``k_pair`` loss), written as ``tooth_stiffness_factor[i]`` = (1 - min(c_i L, 0.95)) / (1 - L)
-      on top of the uniform ``k_pair``.  Wear: tooth i is worn c_i times the mean depth, written as
-      the extra offset (c_i - 1) x mean ``profile_deviation``.  A scalar per tooth approximates
-      the damage's shape along the flank by the uniform one's.
+      (gamma distributed, mean 1, so the stage's mean damage is kept).  Pitting: where the uniform
+      damage loses d(u) of the pair stiffness, tooth i loses min(c_i d(u), 0.95); the FMU takes
+      one ``tooth_stiffness_factor[i]`` per tooth on top of the uniform ``k_pair``, chosen to keep
+      the tooth's mean compliance along the path (:func:`tooth_compliance_factors`).  Wear: tooth
+      i is worn c_i times the mean depth, written as the extra offset (c_i - 1) x mean
+      ``profile_deviation``.  Either way one number per tooth stands in for the damage's shape
+      along that tooth's flank, which is taken to be the uniform damage's.
 
     The offsets are ``tooth_deviation_offset[1..teeth]`` [m], shifted so that the least-cut tooth
     has zero (a common offset only moves the static deflection).

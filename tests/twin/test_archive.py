@@ -113,7 +113,7 @@ def test_tooth_errors_by_hand():
     offsets = [out[f"tooth_deviation_offset[{i}]"] for i in range(1, 5)]
     np.testing.assert_allclose(offsets, [2e-6, 0.0, 1e-6, 3e-6], atol=1e-18)       # pitch, shifted to min 0
     factors = [out[f"tooth_stiffness_factor[{i}]"] for i in range(1, 5)]
-    # (1 - min(c L, 0.95)) / (1 - L): c = 1 keeps the uniform loss; c = 6 is capped at 95 % loss
+    # a loss the same all along the path: (1 - min(c L, 0.95)) / (1 - L); c = 6 is capped at 95 %
     np.testing.assert_allclose(factors, [1.0, 0.4 / 0.8, 0.05 / 0.8, 0.9 / 0.8])
 
     worn = {**healthy, "profile_deviation[1]": 10e-6, "profile_deviation[2]": 30e-6}  # mean 20 um
@@ -122,6 +122,20 @@ def test_tooth_errors_by_hand():
     np.testing.assert_allclose([out[f"tooth_deviation_offset[{i}]"] for i in range(1, 5)],
                                [10e-6, 20e-6, 0.0, 10e-6], atol=1e-18)                # (c - 1) 20 um, min 0
     assert all(out[f"tooth_stiffness_factor[{i}]"] == 1.0 for i in range(1, 5))
+
+
+def test_tooth_compliance_factors_keep_the_mean_deflection_by_hand():
+    from twin.archive import tooth_compliance_factors
+    # Healthy flank stiffness 1 everywhere; the uniform damage halves it at mid path, linearly
+    # in between (three nodes, as the FMU interpolates): the loss is t / 2, with t running from 0
+    # at either end to 1 at mid path, so mean(1 / k_damaged) = int_0^1 dt / (1 - t / 2) = 2 ln 2.
+    # A tooth pitted twice as much loses min(t, 0.95): mean(1 / k) = -ln(0.05) + 0.05 / 0.05.
+    f = tooth_compliance_factors(np.ones(3), np.array([1.0, 0.5, 1.0]), np.array([0.0, 1.0, 2.0]),
+                                 samples_per_segment=20000)
+    np.testing.assert_allclose(f, [2 * np.log(2), 1.0, 2 * np.log(2) / (1.0 - np.log(0.05))], rtol=1e-3)
+    # the mean-stiffness rule (until stop 21) gave the doubly pitted tooth (1 - 2 L) / (1 - L) = 0.8
+    assert f[2] < 0.4
+    assert np.all(tooth_compliance_factors(np.ones(3), np.ones(3), np.array([0.5, 3.0])) == 1.0)
 
 
 def test_tooth_errors_runout_and_identical_teeth():

@@ -130,6 +130,12 @@ TASK_SETTINGS = {"pitting": DataSettings(source_pitch_error=0.0),
 TASK_REMOVE_LEVEL = {"pitting": True, "wear": False}
 
 
+# Changes of how the archive is simulated that the settings above do not show.  Data cached under
+# another value are rebuilt.  2: per-tooth pitting factors keep each tooth's mean compliance
+# (twin.archive.tooth_compliance_factors, stop 21) instead of its mean stiffness.
+ARCHIVE_RULES = 2
+
+
 def rig_settings(task: str, rig: str = "rig") -> DataSettings:
     """The data settings of ``task`` with its target measured on ``rig`` (:data:`RIGS`)."""
     from dataclasses import replace
@@ -176,7 +182,7 @@ def prepare_task(task: str, data_dir: str | Path, settings: DataSettings | None 
     # own copy of the source archive, so one key always describes the pair it sits next to.
     tag = task if settings.rig == "rig" else f"{task}_{settings.rig}"
     src, tgt, key = data_dir / f"source_{tag}.h5", data_dir / f"target_{tag}.h5", data_dir / f"{tag}.json"
-    wanted = json.dumps(asdict(settings), sort_keys=True)
+    wanted = json.dumps({**asdict(settings), "archive_rules": ARCHIVE_RULES}, sort_keys=True)
     if src.exists() and tgt.exists() and key.exists() and key.read_text() == wanted:
         return src, tgt
     sc = load_scenario(REPO / TASKS[task])

@@ -174,6 +174,7 @@ def test_prepare_task_keeps_each_rigs_data_apart_and_reuses_it(tmp_path, monkeyp
     import twin.archive
     import twin.degradation_run
     import twin.scenario
+    import twin.transfer.benchmark
     import twin.transfer.domain
     from twin.transfer.benchmark import prepare_task
 
@@ -203,6 +204,11 @@ def test_prepare_task_keeps_each_rigs_data_apart_and_reuses_it(tmp_path, monkeyp
     prepare_task("wear", tmp_path, changed, progress=False)                                  # new settings: rebuilt
     assert calls[n:] == [("source", "source_wear.h5"), ("target", "target_wear.h5")]
     assert rig[0].read_text() == "3" and blind[0].read_text() == "32"                       # the blind pair untouched
+    # data built under other archive rules (the same settings, older code) are rebuilt too
+    monkeypatch.setattr(twin.transfer.benchmark, "ARCHIVE_RULES", twin.transfer.benchmark.ARCHIVE_RULES + 1)
+    n = len(calls)
+    prepare_task("wear", tmp_path, rig_settings("wear", "blind"), progress=False)
+    assert calls[n:] == [("source", "source_wear_blind.h5"), ("target", "target_wear_blind.h5")]
 
 
 def test_the_lumped_rig_is_simulated_by_the_independent_model_not_the_fmu(tmp_path, monkeypatch):
