@@ -18,7 +18,12 @@ stage and per domain, the following. Target labels are read here, for diagnosis 
 * per stage and domain, the energy of the shaft-order sidebands (mesh harmonics +- 1-3 shaft
   orders) against the mesh harmonics themselves, in dB: how much tooth-to-tooth variation
   (pitch errors, run-out, uneven damage) each domain has.  Each record's shaft speed is found
-  from its mesh comb, since the twin's motor slips under load.
+  from its mesh comb, since the twin's motor slips under load;
+* per stage and domain, the change of the first mesh harmonics' log amplitudes from the first
+  stage: the damage's own effect on the mesh excitation.  A linear transfer path multiplies each
+  harmonic by a gain of its own, the same at every stage, so the change is free of the path
+  (at the near-constant speed of a test); what remains differs between two domains only where
+  their damage physics does.
 """
 from __future__ import annotations
 
@@ -78,6 +83,21 @@ def _sideband_db(x: np.ndarray, fs: float, nominal: float, teeth: int = 19, fmax
     mesh = sum(at(h) for h in harmonics)
     side = sum(at(h + m * f) for h in harmonics for m in (-3, -2, -1, 1, 2, 3))
     return 10 * np.log10(side / mesh)
+
+
+HARMONICS = 6
+
+
+def _harmonic_log_amplitudes(x: np.ndarray, fs: float, nominal: float, teeth: int = 19) -> np.ndarray:
+    """(HARMONICS,) natural log of the amplitude at mesh harmonics 1..HARMONICS (3 Hann bins each)."""
+    f = _shaft_speed(x, fs, nominal, teeth)
+    power = np.abs(np.fft.rfft((x - x.mean()) * np.hanning(x.size))) ** 2
+    df = fs / x.size
+    out = []
+    for h in range(1, HARMONICS + 1):
+        k = int(round(h * teeth * f / df))
+        out.append(0.5 * np.log(power[max(k - 1, 0):k + 2].sum()))
+    return np.array(out)
 
 
 def _lda(x: np.ndarray, y: np.ndarray, shrinkage: float):
@@ -155,6 +175,19 @@ def main() -> None:
         sb = [np.mean([_sideband_db(r[ch], r.sample_rate, r.nominal_speed) for r in recs if r.label == c])
               for recs in (src, tgt)]
         print(f"| {c + 1} | {sb[0]:.1f} | {sb[1]:.1f} |")
+
+    print(f"\n| stage | mesh harmonics 1-{HARMONICS}, change of log amplitude from stage 1, twin | the same, rig "
+          "| correlation |\n|---|---|---|---|")
+    response = []
+    for recs in (src, tgt):
+        amp = np.array([_harmonic_log_amplitudes(r[ch], r.sample_rate, r.nominal_speed) for r in recs])
+        y = np.array([r.label for r in recs])
+        mean = np.array([amp[y == c].mean(axis=0) for c in range(k)])
+        response.append(mean - mean[0])
+    for c in range(1, k):
+        a, b = response[0][c], response[1][c]
+        print(f"| {c + 1} | {' '.join(f'{v:+.2f}' for v in a)} | {' '.join(f'{v:+.2f}' for v in b)} | "
+              f"{np.corrcoef(a, b)[0, 1]:.2f} |")
 
 
 if __name__ == "__main__":
