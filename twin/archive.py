@@ -214,10 +214,13 @@ def tooth_compliance_factors(k_healthy: np.ndarray, k_damaged: np.ndarray, damag
         return np.ones(c.size)
     nodes = np.linspace(0.0, 1.0, kh.size)
     u = np.linspace(0.0, 1.0, max(1, (kh.size - 1) * samples_per_segment) + 1)
-    kh_u, kd_u = np.interp(u, nodes, kh), np.interp(u, nodes, kd)
-    loss = 1.0 - kd_u / kh_u                                              # (U,)
-    tooth_k = kh_u * (1.0 - np.minimum(c[:, None] * loss, PITTING_LOSS_CAP))   # (teeth, U)
-    return np.mean(1.0 / kd_u) / np.mean(1.0 / tooth_k, axis=1)
+    kh_u = np.interp(u, nodes, kh)
+    # A flank the uniform damage has stripped bare (k_damaged 0 at a node) would make every
+    # tooth's compliance infinite; the cap keeps the comparison finite for it too.
+    loss = np.minimum(1.0 - np.interp(u, nodes, kd) / kh_u, PITTING_LOSS_CAP)      # (U,)
+    common_k = kh_u * (1.0 - loss)
+    tooth_k = kh_u * (1.0 - np.minimum(c[:, None] * loss, PITTING_LOSS_CAP))       # (teeth, U)
+    return np.mean(1.0 / common_k) / np.mean(1.0 / tooth_k, axis=1)
 
 
 def pinion_parameters(pinion: PinionDraw, healthy: dict, damaged: dict) -> dict[str, float]:

@@ -136,6 +136,9 @@ def test_tooth_compliance_factors_keep_the_mean_deflection_by_hand():
     # the mean-stiffness rule (until stop 21) gave the doubly pitted tooth (1 - 2 L) / (1 - L) = 0.8
     assert f[2] < 0.4
     assert np.all(tooth_compliance_factors(np.ones(3), np.ones(3), np.array([0.5, 3.0])) == 1.0)
+    # a node the uniform damage stripped bare: finite factors, the mean tooth unchanged
+    bare = tooth_compliance_factors(np.ones(3), np.array([1.0, 0.0, 1.0]), np.array([0.5, 1.0, 2.0]))
+    assert np.all(np.isfinite(bare)) and bare[1] == 1.0 and bare[0] > 1.0 > bare[2]
 
 
 def test_tooth_errors_runout_and_identical_teeth():
