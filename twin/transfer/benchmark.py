@@ -20,11 +20,11 @@ Data (built once per task and cached in ``data_dir``, keyed by the settings belo
   (wear, which the hunting tooth ratio 19:52 evens out), and, in the wear archive only, pitch
   errors with an sd up to 2 um (ISO 1328 class 5 for m = 3 mm, d = 57 mm allows a single pitch
   deviation of 5.8 um and a run-out of 14 um; :data:`TASK_SETTINGS` says why pitting has none).
-  A tooth's pitting factor keeps its mean compliance along the path
-  (:func:`twin.archive.tooth_compliance_factors`, stop 21).
   Every real pinion has such errors, and pits start on single teeth; the twin's teeth are
   otherwise identical, and with identical teeth its shaft-order sidebands sat 21-23 dB below the
   mesh harmonics, against -7 to -17 dB on the emulated rig (bench/transfer_diagnostics.py).
+  A tooth's pitting factor keeps its mean compliance along the path
+  (:func:`twin.archive.tooth_compliance_factors`, stop 21).
   Many short records rather than a few long ones: what the network must learn to ignore is the
   spread *between* records (operating point, sensor gain, the damage within its stage), and a
   record's later windows add little of it.  At the same number of windows, hence the same
