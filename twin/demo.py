@@ -310,7 +310,7 @@ def _independent_rig_demo(data: Path, settings, pre, epochs: int) -> float:
     within, _ = stage_order_scores(confusion_matrix(*asm.window_verdicts(), a.n_classes_))
     print(f"      an independent simulator of the gearbox (twin.transfer.lumped, no code shared with the twin; "
           f"{time.perf_counter() - t:.0f} s): proposed {100 * asm.window_accuracy:.0f} % exact, "
-          f"{100 * within:.0f} % within one stage (5 seeds and why: BENCHMARKS.md, stop 15)")
+          f"{100 * within:.0f} % within one stage (5 seeds and why: BENCHMARKS.md, stops 15 and 21)")
     for note in caught:
         print(f"      warning: {note}")
     return asm.window_accuracy
