@@ -115,7 +115,7 @@ def _check_rig(rig: str) -> None:
 # Record lengths in the same number of pinion revolutions for both tests: the dry test runs at
 # half the speed of the lubricated one, so its records last twice as long.
 # The pitting archive has no pitch errors (stop 16, benchmark rig, 5 seeds): at 20 N.m the static
-# mesh deflection is about 2 um, so pitch errors of that size rewrite the spectral shape that the
+# mesh deflection is about 0.7 um, so pitch errors of 2 um rewrite the spectral shape that the
 # stages' few per cent of stiffness loss show in; with them pitting fell to 79.6 +- 9.2 %, without
 # them (run-out and per-tooth damage kept) it is 98.5 +- 1.4 %.  Wear depths are 60 um per stage.
 TASK_SETTINGS = {"pitting": DataSettings(source_pitch_error=0.0),
