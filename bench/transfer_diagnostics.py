@@ -69,8 +69,14 @@ def _shaft_speed(x: np.ndarray, fs: float, nominal: float, teeth: int) -> float:
     return float(cands[np.argmax(comb)])
 
 
-def _sideband_db(x: np.ndarray, fs: float, nominal: float, teeth: int = 19, fmax: float = 5000.0) -> float:
-    """Energy at the mesh harmonics +- 1-3 shaft orders over that at the harmonics [dB] (3 bins each)."""
+HARMONICS = 6
+
+
+def _mesh_lines(x: np.ndarray, fs: float, nominal: float, teeth: int = 19,
+                fmax: float = 5000.0) -> tuple[float, np.ndarray]:
+    """One record's mesh lines from one Hann power spectrum, 3 bins per line: the energy at the
+    mesh harmonics (below ``fmax``) +- 1-3 shaft orders over that at the harmonics [dB], and the
+    natural log of the amplitude at mesh harmonics 1..HARMONICS, shape (HARMONICS,)."""
     f = _shaft_speed(x, fs, nominal, teeth)
     power = np.abs(np.fft.rfft((x - x.mean()) * np.hanning(x.size))) ** 2
     df = fs / x.size
@@ -82,22 +88,7 @@ def _sideband_db(x: np.ndarray, fs: float, nominal: float, teeth: int = 19, fmax
     harmonics = [k * teeth * f for k in range(1, 100) if k * teeth * f < min(fmax, fs / 2 - 4 * f)]
     mesh = sum(at(h) for h in harmonics)
     side = sum(at(h + m * f) for h in harmonics for m in (-3, -2, -1, 1, 2, 3))
-    return 10 * np.log10(side / mesh)
-
-
-HARMONICS = 6
-
-
-def _harmonic_log_amplitudes(x: np.ndarray, fs: float, nominal: float, teeth: int = 19) -> np.ndarray:
-    """(HARMONICS,) natural log of the amplitude at mesh harmonics 1..HARMONICS (3 Hann bins each)."""
-    f = _shaft_speed(x, fs, nominal, teeth)
-    power = np.abs(np.fft.rfft((x - x.mean()) * np.hanning(x.size))) ** 2
-    df = fs / x.size
-    out = []
-    for h in range(1, HARMONICS + 1):
-        k = int(round(h * teeth * f / df))
-        out.append(0.5 * np.log(power[max(k - 1, 0):k + 2].sum()))
-    return np.array(out)
+    return 10 * np.log10(side / mesh), np.array([0.5 * np.log(at(h * teeth * f)) for h in range(1, HARMONICS + 1)])
 
 
 def _lda(x: np.ndarray, y: np.ndarray, shrinkage: float):
@@ -170,18 +161,18 @@ def main() -> None:
         predict = _lda(xs, y_s, shrinkage=0.1)
         print(f"| {name} | {100 * np.mean(predict(xt) == y_t):.1f} |")
 
+    lines = [[_mesh_lines(r[ch], r.sample_rate, r.nominal_speed) for r in recs] for recs in (src, tgt)]
+    labels = [np.array([r.label for r in recs]) for recs in (src, tgt)]
     print("\n| stage | sidebands / mesh harmonics, twin [dB] | the same, rig [dB] |\n|---|---|---|")
     for c in range(k):
-        sb = [np.mean([_sideband_db(r[ch], r.sample_rate, r.nominal_speed) for r in recs if r.label == c])
-              for recs in (src, tgt)]
+        sb = [np.mean([db for (db, _), y in zip(rows, ys) if y == c]) for rows, ys in zip(lines, labels)]
         print(f"| {c + 1} | {sb[0]:.1f} | {sb[1]:.1f} |")
 
     print(f"\n| stage | mesh harmonics 1-{HARMONICS}, change of log amplitude from stage 1, twin | the same, rig "
           "| correlation |\n|---|---|---|---|")
     response = []
-    for recs in (src, tgt):
-        amp = np.array([_harmonic_log_amplitudes(r[ch], r.sample_rate, r.nominal_speed) for r in recs])
-        y = np.array([r.label for r in recs])
+    for rows, y in zip(lines, labels):
+        amp = np.array([a for _, a in rows])
         mean = np.array([amp[y == c].mean(axis=0) for c in range(k)])
         response.append(mean - mean[0])
     for c in range(1, k):
