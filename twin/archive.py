@@ -229,8 +229,8 @@ def pinion_parameters(pinion: PinionDraw, healthy: dict, damaged: dict) -> dict[
     c = pinion.damage_factors
     offset = pinion.pitch_deviation + runout_deviation(pinion.runout, pinion.runout_phase, teeth)
     factor = tooth_compliance_factors(_profile(healthy, "k_pair"), _profile(damaged, "k_pair"), c)
-    depth = [v for k, v in damaged.items() if k.startswith("profile_deviation[")]
-    mean_depth = float(np.mean(depth)) if depth else 0.0
+    depth = _profile(damaged, "profile_deviation")
+    mean_depth = float(depth.mean()) if depth.size else 0.0
     if mean_depth > 0:
         offset = offset + (c - 1.0) * mean_depth
     offset = offset - offset.min()
