@@ -158,6 +158,12 @@ class Assessor:
         Contrastive margin m on squared distances of unit feature vectors, in (0, 4].
     pairs : {"all", "diagonal"}
         Source/target pairs of the contrastive loss (see :mod:`twin.transfer.losses`).
+    contrastive_reduction : {"mean", "sum"}
+        How the contrastive terms of a batch add up: their mean, or Eq. 18's sum over the batch's
+        gated target windows, which gives ``beta`` the paper's weight, ``batch_size`` times the
+        mean's (:func:`~twin.transfer.losses.class_contrastive_loss`).  The sum locks in wrong
+        pseudo-labels on a rig whose records do not fall into the twin's stages (BENCHMARKS.md,
+        stop 22), so the mean is the default.
     preprocessing : Preprocessing, optional
         Channel, resampling rate, window, hop, normalisation (default :class:`Preprocessing()`).
     augmentation : Augmentation or None, optional
@@ -206,7 +212,8 @@ class Assessor:
 
     def __init__(self, method: str = "proposed", *, alpha: float = 0.1, beta: float = 0.1, lr: float = 0.01,
                  batch_size: int = 20, epochs: int = 80, threshold: float = 0.9, warmup_epochs: int = 10,
-                 margin: float = 1.0, pairs: str = "all", preprocessing: Preprocessing | None = None,
+                 margin: float = 1.0, pairs: str = "all", contrastive_reduction: str = "mean",
+                 preprocessing: Preprocessing | None = None,
                  augmentation: Augmentation | None | str = "default", n_stages: int | None = None,
                  seed: int = 0, device: str | None = None, n_threads: int = 1, progress: bool = True,
                  class_prior: str | None = "source"):
@@ -220,6 +227,7 @@ class Assessor:
         self.warmup_epochs = warmup_epochs
         self.margin = margin
         self.pairs = pairs
+        self.contrastive_reduction = contrastive_reduction
         self.preprocessing = preprocessing
         self.augmentation = augmentation
         self.n_stages = n_stages
@@ -231,8 +239,8 @@ class Assessor:
 
     # ---- scikit-learn plumbing ---------------------------------------------------------------
     _PARAMS = ("method", "alpha", "beta", "lr", "batch_size", "epochs", "threshold", "warmup_epochs", "margin",
-               "pairs", "preprocessing", "augmentation", "n_stages", "seed", "device", "n_threads", "progress",
-               "class_prior")
+               "pairs", "contrastive_reduction", "preprocessing", "augmentation", "n_stages", "seed", "device",
+               "n_threads", "progress", "class_prior")
 
     def get_params(self, deep: bool = True) -> dict:
         return {k: getattr(self, k) for k in self._PARAMS}
@@ -283,6 +291,8 @@ class Assessor:
             bad("margin", "must be in (0, 4]")
         if self.pairs not in ("all", "diagonal"):
             bad("pairs", "use 'all' or 'diagonal'")
+        if self.contrastive_reduction not in ("mean", "sum"):
+            bad("contrastive_reduction", "use 'mean' or 'sum'")
         if self.class_prior not in CLASS_PRIORS:
             bad("class_prior", "use 'source' or None")
         if self.n_stages is not None and (isinstance(self.n_stages, bool) or not isinstance(self.n_stages, int)
@@ -448,7 +458,8 @@ class Assessor:
                         if self.method == "proposed":
                             pt = torch.softmax(lt.detach(), dim=1)
                             yt, mask = pseudo_label_gate(pt, epoch, self.threshold, self.warmup_epochs)
-                            con = class_contrastive_loss(gs, yb, gt, yt, mask, self.margin, self.pairs)
+                            con = class_contrastive_loss(gs, yb, gt, yt, mask, self.margin, self.pairs,
+                                                         self.contrastive_reduction)
                             sums["gated"] += int(mask.sum())
                             sums["tseen"] += int(mask.numel())
                     else:
@@ -704,6 +715,8 @@ class Assessor:
         version = cfg["format_version"]
         if version < 4:     # trained before the class-prior match existed
             params["class_prior"] = None
+        # saved before the reduction was a parameter: those were trained with the mean
+        params.setdefault("contrastive_reduction", "mean")
         if device is not None:
             params["device"] = device
         aug = Augmentation(**cfg["augmentation"]) if cfg["augmentation"] else None

@@ -12,8 +12,12 @@
   ``d`` is the squared Euclidean distance between the *L2-normalised* features, in [0, 4], so
   the margin ``m`` (default 1, i.e. cosine similarity below 0.5 for different classes) does not
   depend on the feature scale.  By default every (source, confident target) pair of the batch is
-  used (``pairs="all"``), the paper's i-th/i-th pairing is ``pairs="diagonal"``; the loss is the
-  mean over the pairs used rather than the sum, so ``beta`` does not scale with the batch size.
+  used (``pairs="all"``), the paper's i-th/i-th pairing is ``pairs="diagonal"``.  Eq. 18 *sums*
+  the terms over the batch (``reduction="sum"``; with all pairs, each gated target window adds
+  the mean of its terms with the source windows), so with batch 20 the paper's ``beta = 0.1``
+  weighs the loss 20 times more than the mean over pairs (``reduction="mean"``) does.  The
+  assessor keeps the mean by default: with the sum, wrong pseudo-labels lock in on a rig whose
+  records do not fall into the twin's stages (``BENCHMARKS.md``, stop 22).
 * :func:`pseudo_label_gate` -- the target pseudo-labels ``y~_t`` that may enter Eq. 19: the
   classifier's arg-max, kept only where its probability is at least ``threshold`` and only from
   epoch ``warmup_epochs`` on, so that the early, mostly wrong labels cannot lock in.
@@ -96,9 +100,9 @@ def pseudo_label_gate(probs: torch.Tensor, epoch: int, threshold: float, warmup_
 
 
 def class_contrastive_loss(gs: torch.Tensor, ys: torch.Tensor, gt: torch.Tensor, yt: torch.Tensor,
-                           mask: torch.Tensor | None = None, margin: float = 1.0, pairs: str = "all"
-                           ) -> torch.Tensor:
-    """Instance class-contrastive loss, Eq. 17-19, mean over the pairs used (0 if there are none).
+                           mask: torch.Tensor | None = None, margin: float = 1.0, pairs: str = "all",
+                           reduction: str = "mean") -> torch.Tensor:
+    """Instance class-contrastive loss, Eq. 17-19 (0 if no pair is used).
 
     Parameters
     ----------
@@ -107,10 +111,16 @@ def class_contrastive_loss(gs: torch.Tensor, ys: torch.Tensor, gt: torch.Tensor,
     mask : (n_t,) bool, target windows allowed in (the pseudo-label gate); default all.
     margin : m of Eq. 17, on the squared distance of unit vectors (0 < m <= 4).
     pairs : ``"all"`` every source/target pair, ``"diagonal"`` the i-th with the i-th (paper).
+    reduction : ``"mean"`` over the pairs used; ``"sum"`` Eq. 18's sum over the target windows
+        let in, where with ``pairs="all"`` each target window contributes the mean of its terms
+        with the source windows (the expectation of its one diagonal term over the batch order),
+        so both pairings give Eq. 18's magnitude.
     """
     _check_features(gs, gt, "class_contrastive_loss")
     if pairs not in ("all", "diagonal"):
         raise AssessorError(f"class_contrastive_loss: pairs must be 'all' or 'diagonal', got {pairs!r}")
+    if reduction not in ("mean", "sum"):
+        raise AssessorError(f"class_contrastive_loss: reduction must be 'mean' or 'sum', got {reduction!r}")
     if mask is None:
         mask = torch.ones(gt.shape[0], dtype=torch.bool, device=gt.device)
     a = torch.nn.functional.normalize(gs, dim=1)
@@ -127,7 +137,11 @@ def class_contrastive_loss(gs: torch.Tensor, ys: torch.Tensor, gt: torch.Tensor,
     if not bool(use.any()):
         return gs.sum() * 0.0          # keeps the graph, contributes nothing
     loss = torch.where(same, d, (margin - d).clamp_min(0.0))
-    return loss[use].mean()
+    if reduction == "mean":
+        return loss[use].mean()
+    if pairs == "diagonal":
+        return loss[use].sum()
+    return loss.mean(0)[mask].sum()
 
 
 def coral_loss(source: torch.Tensor, target: torch.Tensor) -> torch.Tensor:

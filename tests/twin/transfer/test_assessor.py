@@ -203,6 +203,8 @@ def test_bad_parameters_are_named(tiny_pre, tiny_data):
         Assessor("dann", preprocessing=tiny_pre).fit(src, adapt)
     with pytest.raises(AssessorError, match="threshold=1.5"):
         Assessor(threshold=1.5, preprocessing=tiny_pre).fit(src, adapt)
+    with pytest.raises(AssessorError, match="contrastive_reduction='max'"):
+        Assessor(contrastive_reduction="max", preprocessing=tiny_pre).fit(src, adapt)
     with pytest.raises(AssessorError, match="not fitted"):
         Assessor().predict(np.zeros((1, 2048)))
     with pytest.raises(AssessorError, match="labels must have shape \\(3,\\)"):
@@ -256,6 +258,17 @@ def test_source_only_cnn_gets_no_class_prior_offsets(tiny_pre, tiny_data):
     src, adapt, _ = tiny_data
     a = tiny_assessor("cnn", tiny_pre, epochs=1).fit(src, adapt)
     assert np.array_equal(a.target_log_weights_, np.zeros(3))
+
+
+def test_contrastive_reduction_is_saved_and_older_assessors_load_with_the_mean(fitted, tmp_path):
+    import copy
+    paper = copy.copy(fitted).set_params(contrastive_reduction="sum")   # the fixture stays as it is
+    d = paper.save(tmp_path / "red")
+    assert Assessor.load(d).contrastive_reduction == "sum"
+    cfg = json.loads((d / "config.json").read_text())
+    del cfg["params"]["contrastive_reduction"]              # as saved before stop 22
+    (d / "config.json").write_text(json.dumps(cfg))
+    assert Assessor.load(d).contrastive_reduction == "mean"
 
 
 def test_class_prior_offsets_survive_save_and_load_and_version_3_loads_without(fitted, tiny_data, tmp_path):

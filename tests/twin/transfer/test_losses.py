@@ -79,6 +79,28 @@ def test_contrastive_mask_and_diagonal():
         class_contrastive_loss(gs, ys, gt, yt, pairs="some")
 
 
+def test_contrastive_sum_is_eq18_over_gated_target_windows():
+    # source (1,0) class 0 and (0,1) class 1; targets (1,0) and (0,1), pseudo-labels 0 and 0
+    gs = torch.tensor([[1.0, 0.0], [0.0, 1.0]])
+    gt = torch.tensor([[1.0, 0.0], [0.0, 1.0]])
+    ys, yt = torch.tensor([0, 1]), torch.tensor([0, 0])
+    # pair terms (margin 3): (s0,t0) same d=0 -> 0; (s1,t0) diff d=2 -> 1;
+    #                        (s0,t1) same d=2 -> 2; (s1,t1) diff d=0 -> 3
+    # diagonal: 0 + 3 = 3 (Eq. 18), mean 1.5
+    assert float(class_contrastive_loss(gs, ys, gt, yt, margin=3.0, pairs="diagonal", reduction="sum")) == \
+        pytest.approx(3.0)
+    # all pairs: each target window's mean over the sources, summed: (0+1)/2 + (2+3)/2 = 3; mean 1.5
+    assert float(class_contrastive_loss(gs, ys, gt, yt, margin=3.0, reduction="sum")) == pytest.approx(3.0)
+    assert float(class_contrastive_loss(gs, ys, gt, yt, margin=3.0)) == pytest.approx(1.5)
+    # a gated-out target window drops its terms from the sum
+    m = torch.tensor([False, True])
+    assert float(class_contrastive_loss(gs, ys, gt, yt, m, margin=3.0, reduction="sum")) == pytest.approx(2.5)
+    assert float(class_contrastive_loss(gs, ys, gt, yt, m, margin=3.0, pairs="diagonal", reduction="sum")) == \
+        pytest.approx(3.0)
+    with pytest.raises(AssessorError, match="reduction"):
+        class_contrastive_loss(gs, ys, gt, yt, reduction="max")
+
+
 def test_pseudo_label_gate_threshold_and_warmup():
     p = torch.tensor([[0.95, 0.05], [0.6, 0.4], [0.1, 0.9]])
     labels, mask = pseudo_label_gate(p, epoch=4, threshold=0.9, warmup_epochs=5)
