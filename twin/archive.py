@@ -172,7 +172,10 @@ def draw_pinion(draw: np.random.Generator, spec, teeth: int) -> PinionDraw:
 
 
 def _profile(parameters: dict, name: str) -> np.ndarray:
-    """The FMU array ``name[1..n]`` of ``parameters`` in index order (empty when absent)."""
+    """The FMU array ``name[1..n]`` of ``parameters`` in index order (empty when absent).
+
+    Unlike :func:`twin.degradation._nodes.node_array` it accepts a single node, as a flank
+    that is the same all along the path is written in the tests."""
     keys = sorted((k for k in parameters if k.startswith(name + "[")), key=lambda k: int(k[len(name) + 1:-1]))
     return np.array([parameters[k] for k in keys], dtype=float)
 
@@ -208,16 +211,17 @@ def tooth_compliance_factors(k_healthy: np.ndarray, k_damaged: np.ndarray, damag
     ndarray, shape (teeth,)
         ``tooth_stiffness_factor`` [-]; all ones when the damaged flank is nowhere softer.
     """
+    from twin.degradation._nodes import interp_nodes, node_xi
+
     c = np.asarray(damage_factors, dtype=float)
     kh, kd = np.asarray(k_healthy, dtype=float), np.asarray(k_damaged, dtype=float)
     if kh.size == 0 or not np.any(kd < kh):
         return np.ones(c.size)
-    nodes = np.linspace(0.0, 1.0, kh.size)
-    u = np.linspace(0.0, 1.0, max(1, (kh.size - 1) * samples_per_segment) + 1)
-    kh_u = np.interp(u, nodes, kh)
+    u = node_xi(max(1, (kh.size - 1) * samples_per_segment) + 1)
+    kh_u = interp_nodes(kh, u)
     # A flank the uniform damage has stripped bare (k_damaged 0 at a node) would make every
     # tooth's compliance infinite; the cap keeps the comparison finite for it too.
-    loss = np.minimum(1.0 - np.interp(u, nodes, kd) / kh_u, PITTING_LOSS_CAP)      # (U,)
+    loss = np.minimum(1.0 - interp_nodes(kd, u) / kh_u, PITTING_LOSS_CAP)      # (U,)
     common_k = kh_u * (1.0 - loss)
     tooth_k = kh_u * (1.0 - np.minimum(c[:, None] * loss, PITTING_LOSS_CAP))       # (teeth, U)
     return np.mean(1.0 / common_k) / np.mean(1.0 / tooth_k, axis=1)
