@@ -1,7 +1,7 @@
 """Benchmark: transfer from the twin's archive to an emulated rig, CNN vs MMD vs proposed.
 
     python bench/transfer.py [--seeds 5] [--first-seed 0] [--task both] [--epochs 80] [--jobs 2] [--out bench_out/transfer]
-                             [--rig rig|blind|lumped] [--source-ceiling | --target-ceiling]
+                             [--rig rig|blind|lumped|ltca] [--source-ceiling | --target-ceiling]
 
 Builds (or reuses, in OUT/data) the source archives of scenarios/lubricated.yaml (6 pitting
 stages) and scenarios/dry.yaml (4 wear stages) and their "measured" target domains

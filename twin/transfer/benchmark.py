@@ -56,6 +56,7 @@ import numpy as np
 
 from twin.errors import ParameterError
 from twin.transfer.domain import TargetShift
+from twin.transfer.ltca import LtcaRig
 from twin.transfer.lumped import LumpedRig
 
 REPO = Path(__file__).resolve().parents[2]
@@ -98,13 +99,17 @@ class DataSettings:
 # less run-out and noise, its own data seed (2).  A result on it is a blind test of the settings.
 # "lumped" is not the twin at all: an independent one-DOF simulator of the same gearbox with its
 # own stiffness, wear, pitting and casing models (twin.transfer.lumped, stop 15), also only scored.
-RIGS: dict[str, TargetShift | LumpedRig] = {
+# "ltca" is a third simulator of another model family: a loaded tooth contact analysis whose static
+# transmission error excites linear dynamics, with Archard wear integrated on both flanks and
+# discrete pits (twin.transfer.ltca, stop 23), fixed before it was first scored.
+RIGS: dict[str, TargetShift | LumpedRig | LtcaRig] = {
     "rig": TargetShift(),
     "blind": TargetShift(runout=3e-6, sensor_angle=0.1, pedestal_stiffness_factor=1.15,
                          resonance_hz=3300.0, resonance_q=6.0, gain_error=0.10, noise=0.06,
                          speed_scatter=0.02, load_scatter=0.10),
-    "lumped": LumpedRig()}
-RIG_SEEDS = {"rig": 1, "blind": 2, "lumped": 3}
+    "lumped": LumpedRig(),
+    "ltca": LtcaRig()}
+RIG_SEEDS = {"rig": 1, "blind": 2, "lumped": 3, "ltca": 4}
 
 
 def _check_rig(rig: str) -> None:
@@ -202,6 +207,11 @@ def prepare_task(task: str, data_dir: str | Path, settings: DataSettings | None 
         make_lumped_target(sc, tgt, records_per_stage=settings.target_records_per_stage,
                            record_duration=settings.target_record_duration, seed=settings.target_seed,
                            rig=rig, progress=progress)
+    elif isinstance(rig, LtcaRig):
+        from twin.transfer.ltca import make_ltca_target
+        make_ltca_target(sc, tgt, records_per_stage=settings.target_records_per_stage,
+                         record_duration=settings.target_record_duration, seed=settings.target_seed,
+                         rig=rig, progress=progress)
     else:
         run = run_degradation(sc, None, fmu_path=fmu, progress=progress, channels=(CHANNEL,))
         make_target_domain(sc, tgt, records_per_stage=settings.target_records_per_stage,

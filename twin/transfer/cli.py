@@ -122,9 +122,10 @@ def add_subcommands(sub) -> None:
     p.add_argument("--data-dir", help="where the simulated source/target data are cached (default: OUT/data)")
     # The names of benchmark.RIGS, spelt out: importing it would pull numpy into ``twin --help``
     # (tests/twin/transfer/test_cli_transfer.py checks that the two agree).
-    p.add_argument("--rig", choices=("rig", "blind", "lumped"), default="rig",
+    p.add_argument("--rig", choices=("rig", "blind", "lumped", "ltca"), default="rig",
                    help="emulated rig of the target data: the benchmark's (default), the blind one fixed "
-                        "after every setting was chosen, or 'lumped', an independent simulator of the gearbox "
-                        "(twin.transfer.lumped) that shares no code with the twin")
+                        "after every setting was chosen, or a simulator of the gearbox that is not the twin: "
+                        "'lumped' (twin.transfer.lumped, one-DOF contact dynamics) or 'ltca' "
+                        "(twin.transfer.ltca, loaded tooth contact analysis + linear dynamics)")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bars")
     p.set_defaults(handler=_cmd_benchmark_transfer)

@@ -55,7 +55,8 @@ import numpy as np
 
 from twin.errors import ParameterError, ScenarioError
 
-__all__ = ["LumpedRig", "make_lumped_target", "mesh_geometry", "simulate_lumped"]
+__all__ = ["LumpedRig", "check_records", "field_problems", "make_lumped_target", "mesh_geometry", "mode_problems",
+           "simulate_lumped", "write_simulated_target"]
 
 STEEL_DENSITY = 7850.0          # kg/m3
 ISO_SINGLE_PAIR_STIFFNESS = 14e9    # N/m per m of face width (ISO 6336-1 c' = 14 N/(mm um))
@@ -113,25 +114,58 @@ class LumpedRig:
         problems = []
         if (len(self.teeth) != 2 or not all(isinstance(z, int) and z >= 10 for z in self.teeth)):
             problems.append(f"teeth must be two integers >= 10, got {self.teeth!r}")
-        for name in ("module", "pressure_angle", "face_width", "damping_ratio", "sample_rate"):
-            v = getattr(self, name)
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-                problems.append(f"{name} must be a finite number > 0, got {v!r}")
-        for name in ("pitch_error", "runout", "wear_tooth_scatter", "pitting_tooth_scatter", "pit_band_width",
-                     "gain_error", "noise", "speed_scatter", "load_scatter"):
-            v = getattr(self, name)
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
-                problems.append(f"{name} must be a finite number >= 0, got {v!r}")
+        problems += field_problems(self, ("module", "pressure_angle", "face_width", "damping_ratio", "sample_rate"),
+                                   ("pitch_error", "runout", "wear_tooth_scatter", "pitting_tooth_scatter",
+                                    "pit_band_width", "gain_error", "noise", "speed_scatter", "load_scatter"))
         if not (isinstance(self.substeps, int) and self.substeps >= 1):
             problems.append(f"substeps must be a positive integer, got {self.substeps!r}")
-        modes = (self.modes_hz, self.modes_damping, self.modes_gain)
-        if len({len(m) for m in modes}) != 1 or not self.modes_hz:
-            problems.append("modes_hz, modes_damping and modes_gain must have the same, non-zero length")
-        elif any(not 0 < f < self.sample_rate / 2 for f in self.modes_hz) or any(d <= 0 for d in self.modes_damping):
-            problems.append(f"casing modes must lie in (0, {self.sample_rate / 2:g}) Hz with damping > 0, "
-                            f"got {self.modes_hz!r} / {self.modes_damping!r}")
+        problems += mode_problems(self)
         if problems:
             raise ParameterError("LumpedRig: " + "; ".join(problems))
+
+
+def field_problems(rig, positive: tuple, nonnegative: tuple) -> list[str]:
+    """What is wrong with a rig's fields that must be finite and > 0, or finite and >= 0."""
+    problems = []
+    for names, ok, rule in ((positive, lambda v: v > 0, "> 0"), (nonnegative, lambda v: v >= 0, ">= 0")):
+        for name in names:
+            v = getattr(rig, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and ok(v)):
+                problems.append(f"{name} must be a finite number {rule}, got {v!r}")
+    return problems
+
+
+def mode_problems(rig) -> list[str]:
+    """What is wrong with a rig's casing modes (``modes_hz``, ``modes_damping``, ``modes_gain``)."""
+    modes = (rig.modes_hz, rig.modes_damping, rig.modes_gain)
+    if len({len(m) for m in modes}) != 1 or not rig.modes_hz:
+        return ["modes_hz, modes_damping and modes_gain must have the same, non-zero length"]
+    if any(not 0 < f < rig.sample_rate / 2 for f in rig.modes_hz) or any(d <= 0 for d in rig.modes_damping):
+        return [f"casing modes must lie in (0, {rig.sample_rate / 2:g}) Hz with damping > 0, "
+                f"got {rig.modes_hz!r} / {rig.modes_damping!r}"]
+    return []
+
+
+def check_records(speeds, loads, damages, kind: str, start_angles) -> tuple[np.ndarray, ...]:
+    """Checked (speeds, loads, damages, start angles) of a batch of records, each (R,) float.
+
+    Raises :class:`ParameterError` naming the bad values: an unknown damage ``kind``, arrays of
+    different lengths, speeds or loads not finite and > 0, damages not finite and >= 0.
+    """
+    if kind not in ("pitting_density", "wear_depth"):
+        raise ParameterError(f"damage kind must be 'pitting_density' or 'wear_depth', got {kind!r}")
+    speeds, loads, damages = (np.asarray(a, dtype=float) for a in (speeds, loads, damages))
+    if not (speeds.shape == loads.shape == damages.shape and speeds.ndim == 1):
+        raise ParameterError("speeds, loads and damages must be 1-D arrays of one length")
+    bad = [f"{name} {a[~ok].tolist()[:5]}" for name, a, ok in (
+        ("speeds", speeds, np.isfinite(speeds) & (speeds > 0)), ("loads", loads, np.isfinite(loads) & (loads > 0)),
+        ("damages", damages, np.isfinite(damages) & (damages >= 0))) if not ok.all()]
+    if bad:
+        raise ParameterError("speeds and loads must be finite and > 0, damages finite and >= 0; got " + ", ".join(bad))
+    start = np.zeros_like(speeds) if start_angles is None else np.asarray(start_angles, dtype=float)
+    if start.shape != speeds.shape:
+        raise ParameterError("start_angles must have one angle per record")
+    return speeds, loads, damages, start
 
 
 @dataclass(frozen=True)
@@ -196,16 +230,7 @@ def simulate_lumped(rig: LumpedRig, speeds, loads, damages, kind: str, duration:
     """
     from scipy.signal import bilinear, decimate, lfilter
 
-    if kind not in ("pitting_density", "wear_depth"):
-        raise ParameterError(f"damage kind must be 'pitting_density' or 'wear_depth', got {kind!r}")
-    speeds, loads, damages = (np.asarray(a, dtype=float) for a in (speeds, loads, damages))
-    if not (speeds.shape == loads.shape == damages.shape and speeds.ndim == 1):
-        raise ParameterError("speeds, loads and damages must be 1-D arrays of one length")
-    bad = [f"{name} {a[~ok].tolist()[:5]}" for name, a, ok in (
-        ("speeds", speeds, np.isfinite(speeds) & (speeds > 0)), ("loads", loads, np.isfinite(loads) & (loads > 0)),
-        ("damages", damages, np.isfinite(damages) & (damages >= 0))) if not ok.all()]
-    if bad:
-        raise ParameterError("speeds and loads must be finite and > 0, damages finite and >= 0; got " + ", ".join(bad))
+    speeds, loads, damages, start_angle = check_records(speeds, loads, damages, kind, start_angles)
     g = mesh_geometry(rig)
     z1 = rig.teeth[0]
     rng = np.random.default_rng(gear_seed)
@@ -214,9 +239,6 @@ def simulate_lumped(rig: LumpedRig, speeds, loads, damages, kind: str, duration:
     shape_k = 1.0 / max(rig.pitting_tooth_scatter, 1e-3) ** 2
     pit_factor = rng.gamma(shape_k, 1.0 / shape_k, z1)
     runout_phase = rng.uniform(0, 2 * np.pi)
-    start_angle = np.zeros_like(speeds) if start_angles is None else np.asarray(start_angles, dtype=float)
-    if start_angle.shape != speeds.shape:
-        raise ParameterError("start_angles must have one angle per record")
 
     u_grid, wear_shape, band = _profile_shapes(g, rig.pit_band_width)
     eps, m_e, k_peak = g.contact_ratio, g.equivalent_mass, g.pair_stiffness
@@ -299,18 +321,38 @@ def make_lumped_target(source_scenario, output: str | Path, *, records_per_stage
     ``damage_kind``, ``lumped_rig`` (JSON).  Only the scenario's stages, damage kind (its
     degradation model) and nominal operating point are read; its FMU is not used.
     """
+    rig = rig or LumpedRig()
+    return write_simulated_target(
+        source_scenario, output, rig, lambda *a, nominal_load, **k: simulate_lumped(rig, *a, **k), name="lumped",
+        records_per_stage=records_per_stage, record_duration=record_duration, seed=seed, progress=progress,
+        note="independent lumped simulator (twin.transfer.lumped); labels and damage are for evaluation only")
+
+
+def write_simulated_target(source_scenario, output: str | Path, rig, simulate, *, name: str,
+                           records_per_stage: int, record_duration: float, seed: int, progress: bool,
+                           note: str) -> Path:
+    """Draw the records of an independent simulator's target domain, simulate them, write them.
+
+    The part every simulator that is not the twin shares: which damage, operating point, sensor
+    gain and start angle each record gets, the noise, and the file layout of
+    :func:`make_lumped_target`.  ``rig`` is a frozen dataclass with the fields ``speed_scatter``,
+    ``load_scatter``, ``gain_error``, ``noise`` and ``sample_rate``; it is saved as the metadata
+    entry ``f"{name}_rig"`` (JSON).  ``simulate(speeds, loads, damages, kind, duration, *,
+    gear_seed, start_angles, nominal_load)`` returns the records' acceleration before gain and
+    noise, shape (R, round(duration * rig.sample_rate)); ``nominal_load`` is the scenario's brake
+    torque [N.m], the load the damage grew under.
+    """
     from twin._progress import progress_bar
     from twin.archive import nominal_operating_point, stage_damage
     from twin.measurements import MeasurementSet, Record, write_measurements
     from twin.transfer.domain import check_target_request
 
-    rig = rig or LumpedRig()
     spec, target = check_target_request(source_scenario, output, records_per_stage, record_duration)
     model = (source_scenario.degradation or {}).get("model")
     kinds = {"pitting": "pitting_density", "wear": "wear_depth"}
     if model not in kinds:
         raise ScenarioError([(str(source_scenario.source), "degradation.model",
-                              f"the lumped rig simulates 'pitting' or 'wear', got {model!r}")])
+                              f"the {name} rig simulates 'pitting' or 'wear', got {model!r}")])
     bounds = [float(b) for b in spec["stages"]]
     nominal_speed, nominal_load = nominal_operating_point(source_scenario)
     seq_draw, seq_gear, seq_noise = np.random.SeedSequence(seed).spawn(3)
@@ -327,13 +369,13 @@ def make_lumped_target(source_scenario, output: str | Path, *, records_per_stage
             meta.append((s, d, f, t_load, gain, angle))
     s_, d_, f_, l_, g_, a_ = (np.array(c) for c in zip(*meta))
     acc = np.empty((len(meta), int(round(record_duration * rig.sample_rate))))
-    chunk = 30      # records integrated together: vectorised, and a bar that moves
-    bar = progress_bar(len(meta), progress, "lumped rig", "record")
+    chunk = 30      # records simulated together: vectorised, and a bar that moves
+    bar = progress_bar(len(meta), progress, f"{name} rig", "record")
     try:
         for i in range(0, len(meta), chunk):
             sl = slice(i, i + chunk)
-            acc[sl] = simulate_lumped(rig, f_[sl], l_[sl], d_[sl], kinds[model], float(record_duration),
-                                      gear_seed=gear_seed, start_angles=a_[sl])
+            acc[sl] = simulate(f_[sl], l_[sl], d_[sl], kinds[model], float(record_duration),
+                               gear_seed=gear_seed, start_angles=a_[sl], nominal_load=nominal_load)
             bar.update(acc[sl].shape[0])
     finally:
         bar.close()
@@ -345,7 +387,6 @@ def make_lumped_target(source_scenario, output: str | Path, *, records_per_stage
         records.append(Record(f"rec{k:05d}", {"accel_pinion_casing": x}, {"accel_pinion_casing": "m/s2"},
                               rig.sample_rate, nominal_speed=float(f_[k]), load=float(l_[k]), label=int(s_[k]),
                               damage=float(d_[k])))
-    metadata = {"stages": np.asarray(bounds), "damage_kind": kinds[model], "lumped_rig": json.dumps(asdict(rig)),
-                "seed": int(seed), "source_scenario": source_scenario.name,
-                "note": "independent lumped simulator (twin.transfer.lumped); labels and damage are for evaluation only"}
+    metadata = {"stages": np.asarray(bounds), "damage_kind": kinds[model], f"{name}_rig": json.dumps(asdict(rig)),
+                "seed": int(seed), "source_scenario": source_scenario.name, "note": note}
     return write_measurements(MeasurementSet(tuple(records), None, (), metadata), target)
