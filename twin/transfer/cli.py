@@ -26,7 +26,8 @@ def _cmd_train_assessor(args: argparse.Namespace) -> int:
     pre = (transfer.Preprocessing(**settings) if args.shaft_speed is None
            else transfer.Preprocessing.for_shaft_speed(args.shaft_speed, **settings))
     a = transfer.Assessor(args.method, epochs=args.epochs, seed=args.seed, preprocessing=pre,
-                          progress=not args.no_progress, class_prior=None if args.no_class_prior else "source")
+                          progress=not args.no_progress, class_prior=None if args.no_class_prior else "source",
+                          pairs=args.pairs, contrastive_reduction=args.contrastive_reduction)
     from twin.transfer.errors import class_prior_notes
     with class_prior_notes() as notes:
         a.fit(Path(args.source), Path(args.target))
@@ -85,6 +86,12 @@ def add_subcommands(sub) -> None:
     p.add_argument("--out", required=True, help="directory to save the assessor in")
     p.add_argument("--method", choices=("proposed", "mmd", "cnn", "coral"), default="proposed",
                    help="proposed (MMD + class contrastive, default), mmd, cnn (source only), coral")
+    p.add_argument("--pairs", choices=("all", "diagonal"), default="all",
+                   help="source/target pairs of the class-contrastive loss: every pair of the batch (default) or "
+                        "the paper's i-th with i-th")
+    p.add_argument("--contrastive-reduction", choices=("mean", "sum"), default="mean",
+                   help="mean over the pairs (default) or the paper's sum over the batch (Eq. 18), 20 times the "
+                        "weight at batch 20; measured in BENCHMARKS.md (stop 22) and not the default")
     p.add_argument("--seed", type=int, default=0, help="seed of initialisation, batches, augmentation")
     p.add_argument("--epochs", type=int, default=80, help="passes over the source windows (default: 80)")
     p.add_argument("--shaft-speed", type=float, metavar="HZ",

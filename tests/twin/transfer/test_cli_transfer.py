@@ -152,6 +152,22 @@ def test_train_assessor_reports_the_class_prior_match_and_warns_on_one_stage_rig
     assert "class-prior match" not in out and "warning" not in out
 
 
+def test_the_papers_contrastive_pairing_and_weighting_reach_the_saved_assessor(tmp_path):
+    src = _file(tmp_path / "src.h5", False, True)
+    tgt = _file(tmp_path / "tgt.h5", True, False)
+    p = _parser()
+    base = ["train-assessor", "--source", str(src), "--target", str(tgt), "--epochs", "1", "--no-progress"]
+    args = p.parse_args(base + ["--out", str(tmp_path / "default")])
+    assert (args.pairs, args.contrastive_reduction) == ("all", "mean")
+    args = p.parse_args(base + ["--out", str(tmp_path / "paper"), "--pairs", "diagonal",
+                                "--contrastive-reduction", "sum"])
+    assert args.handler(args) == 0
+    params = json.loads((tmp_path / "paper" / "config.json").read_text())["params"]
+    assert (params["pairs"], params["contrastive_reduction"]) == ("diagonal", "sum")
+    with pytest.raises(SystemExit):
+        p.parse_args(base + ["--out", "x", "--contrastive-reduction", "median"])
+
+
 def test_target_channel_reaches_the_saved_assessor_and_assess(tmp_path):
     src = _file(tmp_path / "src.h5", False, True)
     recs = [Record(r.name, {"acc_rig": r["accel_pinion_casing"]}, {"acc_rig": "m/s2"}, r.sample_rate, label=r.label)
