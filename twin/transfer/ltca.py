@@ -41,8 +41,9 @@ pitting                        discrete pits: per pinion tooth a fixed sequence 
                                added until the pitted share of the active flank is ``D a_i`` (``a_i``
                                gamma, sd 40 %, mean 1 over the teeth); a contact line loses the
                                stiffness of its pitted width (at most 95 %)
-acquisition                    25.6 kHz (RK-free: the time series is filtered at 4x that rate and
-                               decimated), gain 10 %, noise 6 %, speed and load scatter 1.5 % / 8 %
+acquisition                    25.6 kHz (no time integration: the transmission error is computed and
+                               filtered at 4x that rate, then decimated), gain 10 %, noise 6 %,
+                               speed and load scatter 1.5 % / 8 %
 =============================  =====================================================================
 
 Limits, by design: no loss of contact in the dynamics (the linear model allows negative force), one
@@ -209,7 +210,8 @@ def static_approach(k: np.ndarray, e: np.ndarray, force) -> np.ndarray:
     Parameters
     ----------
     k, e : ndarray (..., P)
-        Pair stiffness [N/m] (0 for a pair out of mesh) and deviation [m] of the P pairs.
+        Pair stiffness [N/m] (0 for a pair out of mesh) and deviation [m] of the P pairs; at
+        least one pair per position must be in mesh (the leading pair always is).
     force : float or ndarray (...)
         Mesh force [N], > 0.
 
