@@ -202,16 +202,13 @@ def prepare_task(task: str, data_dir: str | Path, settings: DataSettings | None 
     fmu = sc.fmu_path()
     build_archive(sc, src, progress=progress, fmu_path=fmu)
     rig = RIGS[settings.rig]
-    if isinstance(rig, LumpedRig):
-        from twin.transfer.lumped import make_lumped_target
-        make_lumped_target(sc, tgt, records_per_stage=settings.target_records_per_stage,
-                           record_duration=settings.target_record_duration, seed=settings.target_seed,
-                           rig=rig, progress=progress)
-    elif isinstance(rig, LtcaRig):
-        from twin.transfer.ltca import make_ltca_target
-        make_ltca_target(sc, tgt, records_per_stage=settings.target_records_per_stage,
-                         record_duration=settings.target_record_duration, seed=settings.target_seed,
-                         rig=rig, progress=progress)
+    if isinstance(rig, (LumpedRig, LtcaRig)):
+        # the simulators that are not the twin write their own target files, from the scenario alone
+        from twin.transfer import ltca, lumped
+        make = lumped.make_lumped_target if isinstance(rig, LumpedRig) else ltca.make_ltca_target
+        make(sc, tgt, records_per_stage=settings.target_records_per_stage,
+             record_duration=settings.target_record_duration, seed=settings.target_seed,
+             rig=rig, progress=progress)
     else:
         run = run_degradation(sc, None, fmu_path=fmu, progress=progress, channels=(CHANNEL,))
         make_target_domain(sc, tgt, records_per_stage=settings.target_records_per_stage,

@@ -53,12 +53,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
 from twin.errors import ParameterError, SimulationError
-from twin.transfer.lumped import check_records, field_problems, mode_problems
+from twin.transfer.lumped import (ISO_SINGLE_PAIR_STIFFNESS, check_records, field_problems, mesh_geometry,
+                                  mode_problems, write_simulated_target)
 
 __all__ = ["LtcaRig", "lost_width", "make_ltca_target", "pair_stiffness", "pit_fields", "simulate_ltca",
            "static_approach", "wear_profiles"]
@@ -133,6 +135,10 @@ class LtcaRig:
     load_scatter: float = 0.08
 
     def __post_init__(self) -> None:
+        # tuples, so a rig is hashable (one gearbox's draws are cached per rig and seed)
+        for name in ("teeth", "pitch_error", "runout", "modes_hz", "modes_damping", "modes_gain"):
+            if isinstance(getattr(self, name), list):
+                object.__setattr__(self, name, tuple(getattr(self, name)))
         problems = []
         if len(self.teeth) != 2 or not all(isinstance(z, int) and z >= 10 for z in self.teeth):
             problems.append(f"teeth must be two integers >= 10, got {self.teeth!r}")
@@ -157,10 +163,7 @@ class LtcaRig:
 # ---- geometry and stiffness ----------------------------------------------------------------------------
 def _geometry(rig: LtcaRig):
     """(MeshGeometry, path length L [m], pinion and gear radii of curvature along u, shape (_U_NODES,) each)."""
-    from twin.transfer.lumped import LumpedRig, mesh_geometry
-
-    g = mesh_geometry(LumpedRig(teeth=rig.teeth, module=rig.module, pressure_angle=rig.pressure_angle,
-                                face_width=rig.face_width))
+    g = mesh_geometry(rig)
     length = g.contact_ratio * math.pi * rig.module * math.cos(rig.pressure_angle)
     r1 = 0.5 * rig.module * rig.teeth[0]
     r2 = 0.5 * rig.module * rig.teeth[1]
@@ -196,8 +199,6 @@ def pair_stiffness(rig: LtcaRig) -> np.ndarray:
 
     Beam theory gives the shape; its peak is ISO 6336-1's ``c' b`` (14 N/(mm um) times the face width).
     """
-    from twin.transfer.lumped import ISO_SINGLE_PAIR_STIFFNESS
-
     _, _, rho1, rho2 = _geometry(rig)
     hertz = 4 * (1 - rig.poisson_ratio ** 2) / (math.pi * rig.youngs_modulus * rig.face_width)
     k = 1.0 / (_tooth_compliance(rig, rig.teeth[0], rho1) + _tooth_compliance(rig, rig.teeth[1], rho2) + hertz)
@@ -256,6 +257,10 @@ def wear_profiles(rig: LtcaRig, depths, load: float) -> tuple[np.ndarray, np.nda
     depths = np.asarray(depths, dtype=float)
     if depths.ndim != 1 or not np.all(np.isfinite(depths) & (depths >= 0)):
         raise ParameterError("wear depths must be a 1-D array of finite numbers >= 0")
+    step = 0.25e-6
+    n_steps = int(math.ceil(depths.max() / step)) if depths.size and depths.max() > 0 else 0
+    if n_steps == 0:
+        return np.zeros((depths.size, _U_NODES)), np.zeros((depths.size, _U_NODES))
     g, _, rho1, rho2 = _geometry(rig)
     u = np.linspace(0.0, 1.0, _U_NODES)
     k = pair_stiffness(rig)
@@ -267,8 +272,6 @@ def wear_profiles(rig: LtcaRig, depths, load: float) -> tuple[np.ndarray, np.nda
     have = np.isfinite(part)
     kp = np.where(have, np.interp(np.nan_to_num(part), u, k), 0.0)
     centre = int(math.ceil(g.contact_ratio))         # the column of the pair itself
-    step = 0.25e-6
-    n_steps = int(math.ceil(depths.max() / step)) if depths.size and depths.max() > 0 else 0
     h1, h2 = np.zeros(_U_NODES), np.zeros(_U_NODES)
     hist1, hist2 = [h1.copy()], [h2.copy()]
     for _ in range(n_steps):
@@ -282,9 +285,7 @@ def wear_profiles(rig: LtcaRig, depths, load: float) -> tuple[np.ndarray, np.nda
         hist2.append(h2.copy())
     grid = step * np.arange(n_steps + 1)
     hist1, hist2 = np.array(hist1), np.array(hist2)
-    idx = np.clip(np.searchsorted(grid, depths) - 1, 0, max(n_steps - 1, 0))
-    if n_steps == 0:
-        return np.zeros((depths.size, _U_NODES)), np.zeros((depths.size, _U_NODES))
+    idx = np.clip(np.searchsorted(grid, depths) - 1, 0, n_steps - 1)
     w = ((depths - grid[idx]) / step)[:, None]
     p1 = (1 - w) * hist1[idx] + w * hist1[idx + 1]
     p2 = (1 - w) * hist2[idx] + w * hist2[idx + 1]
@@ -343,6 +344,24 @@ def _closed_walk(rng: np.random.Generator, z: int, sd: float) -> np.ndarray:
     return cum - cum.mean()
 
 
+@lru_cache(maxsize=4)
+def _gearbox(rig: LtcaRig, gear_seed: int, kind: str) -> tuple:
+    """The draws that make one gearbox: pitch deviations and run-out phases of both gears, then the
+    per-tooth wear factors (wear) or pit factors and pit fields (pitting).  The same for every batch
+    of records of a target domain, so it is drawn once (the pit fields take seconds)."""
+    z1, z2 = rig.teeth
+    rng = np.random.default_rng(gear_seed)
+    pitch1, pitch2 = _closed_walk(rng, z1, rig.pitch_error[0]), _closed_walk(rng, z2, rig.pitch_error[1])
+    phases = tuple(rng.uniform(0, 2 * np.pi, 2))
+    if kind == "wear_depth":
+        factors = (1 + rig.wear_tooth_scatter * rng.standard_normal(z1),
+                   1 + rig.wear_tooth_scatter * rng.standard_normal(z2))
+        return pitch1, pitch2, phases, factors, None
+    shape = 1.0 / max(rig.pitting_tooth_scatter, 1e-3) ** 2
+    pit_factor = rng.gamma(shape, 1.0 / shape, z1)
+    return pitch1, pitch2, phases, (pit_factor / pit_factor.mean(),), pit_fields(rig, rng)
+
+
 def simulate_ltca(rig: LtcaRig, speeds, loads, damages, kind: str, duration: float, *, gear_seed: int,
                   nominal_load: float, start_angles=None, settle: float = 0.05) -> np.ndarray:
     """Casing acceleration of records of the LTCA model, before gain and noise.
@@ -377,19 +396,13 @@ def simulate_ltca(rig: LtcaRig, speeds, loads, damages, kind: str, duration: flo
     eps = g.contact_ratio
     u_nodes = np.linspace(0.0, 1.0, _U_NODES)
     k_u = pair_stiffness(rig)
-    rng = np.random.default_rng(gear_seed)
-    pitch1, pitch2 = _closed_walk(rng, z1, rig.pitch_error[0]), _closed_walk(rng, z2, rig.pitch_error[1])
-    phase1, phase2 = rng.uniform(0, 2 * np.pi, 2)
+    pitch1, pitch2, (phase1, phase2), factors, fields = _gearbox(rig, int(gear_seed), kind)
     ecc1, ecc2 = (0.5 * r * math.sin(rig.pressure_angle) for r in rig.runout)
     if kind == "wear_depth":
-        wear1 = 1 + rig.wear_tooth_scatter * rng.standard_normal(z1)
-        wear2 = 1 + rig.wear_tooth_scatter * rng.standard_normal(z2)
+        wear1, wear2 = factors
         prof1, prof2 = wear_profiles(rig, damages, nominal_load)
     else:
-        shape = 1.0 / max(rig.pitting_tooth_scatter, 1e-3) ** 2
-        pit_factor = rng.gamma(shape, 1.0 / shape, z1)
-        pit_factor /= pit_factor.mean()
-        fields = pit_fields(rig, rng)
+        (pit_factor,) = factors
 
     fs = rig.sample_rate * rig.oversampling
     n_settle, n_keep = int(round(settle * fs)), int(round(duration * rig.sample_rate)) * rig.oversampling
@@ -454,8 +467,6 @@ def make_ltca_target(source_scenario, output: str | Path, *, records_per_stage: 
     ``ltca_rig`` (JSON).  Only the scenario's stages, damage kind and nominal operating point are
     read; its FMU is not used.
     """
-    from twin.transfer.lumped import write_simulated_target
-
     rig = rig or LtcaRig()
     return write_simulated_target(
         source_scenario, output, rig, lambda *a, **k: simulate_ltca(rig, *a, **k), name="ltca",

@@ -179,8 +179,9 @@ class MeshGeometry:
     pair_stiffness: float       # c' b, peak single-pair stiffness [N/m]
 
 
-def mesh_geometry(rig: LumpedRig) -> MeshGeometry:
-    """The standard involute relations (addendum = one module, no profile shift)."""
+def mesh_geometry(rig) -> MeshGeometry:
+    """The standard involute relations (addendum = one module, no profile shift) of any rig with the
+    datasheet fields ``teeth``, ``module``, ``pressure_angle`` and ``face_width``."""
     z1, z2 = rig.teeth
     r1, r2 = 0.5 * rig.module * z1, 0.5 * rig.module * z2
     rb1, rb2 = r1 * math.cos(rig.pressure_angle), r2 * math.cos(rig.pressure_angle)
