@@ -133,6 +133,7 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
     with FMU(fmu_file) as fmu:
         check_compatibility(fmu, scenario)
         geometry_values = {v.name: fmu.get(v.name) for v in fmu.parameters if "[" not in v.name}
+        geometry_values.update(fmu.structural_values())       # the tooth counts are built in
         geometry_values.update({k: v for k, v in scenario.parameters.items() if "[" not in k})
         geometry = GearPair.from_parameters(geometry_values)
         k_healthy = tuple(scenario.parameters.get(f"k_pair[{i}]", fmu.variable(f"k_pair[{i}]").start)

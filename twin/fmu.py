@@ -166,6 +166,12 @@ class FMU:
     def parameters(self) -> list[Variable]:
         return self._by("parameter")
 
+    def structural_values(self) -> dict[str, int]:
+        """The model's Integer constants (``z1``, ``z2``, ``n_profile``, ...): fixed when the FMU
+        was built, so read from its model description."""
+        return {v.name: int(v.start) for v in self.variables.values()
+                if v.type == "Integer" and v.variability == "constant" and v.start is not None}
+
     @property
     def inputs(self) -> list[Variable]:
         return self._by("input")
@@ -317,10 +323,19 @@ class FMU:
             self._call("fmi2SetReal", self._slave.setReal, vrs, vals)
 
     def get(self, names: str | Sequence[str]) -> float | np.ndarray:
-        """Current values of Real variables by name (a float for one name, else an array)."""
+        """Current values of Real variables by name (a float for one name, else an array).
+
+        A structural Integer or Boolean (``z1``, ``z2``, ``n_profile``) has no Real value: read it
+        with :meth:`structural_values`.  Value references are unique per type only, so reading
+        one as a Real would return another variable's value; it is a ParameterError instead."""
         self.instantiate()
         single = isinstance(names, str)
         names = [names] if single else list(names)
+        not_real = [n for n in names if self.variable(n).type != "Real"]
+        if not_real:
+            raise ParameterError(f"{', '.join(repr(n) for n in not_real)} of {self.model_name} "
+                                 f"{'is not a Real' if len(not_real) == 1 else 'are not Reals'}; "
+                                 "read structural Integers with structural_values()")
         vrs = [self.variable(n).value_reference for n in names]
         vals = np.array(self._call("fmi2GetReal", self._slave.getReal, vrs))
         return float(vals[0]) if single else vals
