@@ -22,6 +22,13 @@ def gearbox_fmu(fmu_dir) -> Path:
 
 
 @pytest.fixture(scope="session")
+def wheel_fmu(fmu_dir) -> Path:
+    """The variant with the gear's own tooth errors (GearTwin.Variants.Gearbox21WheelErrors)."""
+    from fmu_build import build_fmu
+    return build_fmu("GearTwin.Variants.Gearbox21WheelErrors", MODELICA, fmu_dir)
+
+
+@pytest.fixture(scope="session")
 def two_mass_fmu(fmu_dir) -> Path:
     """A second, small model built by the same pipeline (GearTwin.Examples.TwoMassOscillator)."""
     from fmu_build import build_fmu

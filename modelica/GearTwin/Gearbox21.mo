@@ -195,6 +195,7 @@ model Gearbox21 "21-DOF lumped model of the UNSW spur-gear test rig (Feng et al.
   parameter Real effect_tooth_stiffness_factor[z1] = {1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1} "Per-pinion-tooth stiffness multiplier from an effect (local tooth damage); multiplies tooth_stiffness_factor";
   parameter Real effect_tooth_offset[z1](each unit = "m") = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0} "Per-pinion-tooth material loss from an effect (spall); added to tooth_deviation_offset";
   parameter Real effect_profile_deviation[n_profile](each unit = "m") = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0} "Material missing along the profile from an effect (distributed wear); added to profile_deviation";
+  Real effect_pair_deviation[3](each unit = "m") = {0, 0, 0} "Extra material loss at the contact of each pair (leading, current, next): the gear's tooth errors (GearTwin.Variants.Gearbox21WheelErrors); added to pair_deviation";
   Real effect_mesh_displacement(unit = "m") = 0 "Extra approach of the flanks along the line of action (run-out)";
   Real effect_mesh_displacement_rate(unit = "m/s") = 0 "Time derivative of effect_mesh_displacement";
   Real effect_mesh_force(unit = "N") = 0 "Extra force along the line of action (back-flank contact)";
@@ -219,7 +220,7 @@ equation
   pair_tooth_offset = {sum((tooth_deviation_offset[tooth_prev[j]] + effect_tooth_offset[tooth_prev[j]]) * tooth_weight[j] for j in 1:z1), sum((tooth_deviation_offset[j] + effect_tooth_offset[j]) * tooth_weight[j] for j in 1:z1), sum((tooth_deviation_offset[tooth_next[j]] + effect_tooth_offset[tooth_next[j]]) * tooth_weight[j] for j in 1:z1)};
   // Piecewise-linear interpolation along the profile: hat functions on n_profile nodes.
   pair_stiffness = {mesh_stiffness_scale * window[i] * pair_tooth_factor[i] * sum(k_pair[n] * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[i]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile) for i in 1:3};
-  pair_deviation = {pair_tooth_offset[i] + sum((profile_deviation[n] + effect_profile_deviation[n]) * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[i]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile) for i in 1:3};
+  pair_deviation = {pair_tooth_offset[i] + effect_pair_deviation[i] + sum((profile_deviation[n] + effect_profile_deviation[n]) * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[i]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile) for i in 1:3};
   mesh_deflection = rb1 * theta5 - rb2 * theta10 + (x5 - x10) * sin(alpha) + (y5 - y10) * cos(alpha) + effect_mesh_displacement;
   mesh_deflection_rate = rb1 * omega5 - rb2 * omega10 + (vx5 - vx10) * sin(alpha) + (vy5 - vy10) * cos(alpha) + effect_mesh_displacement_rate;
   // A pair whose flanks are apart (deviation larger than the approach) carries no load.

@@ -14,7 +14,9 @@ Model summary
   pedestals 9 and 11 and gear 10 (output shaft), each in x (horizontal) and y (vertical).
 * Mesh: three tooth pairs (leading, current, next) with smooth entry/exit windows; pair
   stiffness interpolated with hat functions on ``k_pair`` along the path of contact, scaled
-  per pinion tooth; a pair whose flank deviation exceeds the approach carries no load.
+  per pinion tooth; each pair's flank deviation adds the offset of its pinion tooth and, in the
+  variant ``GearTwin.Variants.Gearbox21WheelErrors``, of its gear tooth (both counted by the
+  completed mesh cycles); a pair whose flank deviation exceeds the approach carries no load.
 
 State vector (42,), in the declaration order of the Modelica model
 -----------------------------------------------------------------
@@ -66,7 +68,13 @@ DEFAULT_INPUTS: dict[str, float] = {
 }
 
 _ARRAY_FIELDS = ("k_pair", "profile_deviation", "tooth_stiffness_factor", "tooth_deviation_offset",
-                 "effect_tooth_stiffness_factor", "effect_tooth_offset", "effect_profile_deviation")
+                 "wheel_tooth_deviation_offset", "effect_tooth_stiffness_factor", "effect_tooth_offset",
+                 "effect_profile_deviation")
+#: Structural Integer parameters of the model: FMU constants, never set as start values.
+STRUCTURAL = ("z1", "n_profile")
+#: Fields that only ``GearTwin.Variants.Gearbox21WheelErrors`` has as parameters (the base model
+#: has them at zero, through its hook ``effect_pair_deviation``).
+VARIANT_FIELDS = ("wheel_tooth_deviation_offset",)
 
 
 @dataclass(frozen=True)
@@ -75,8 +83,8 @@ class GearboxParams:
 
     Array parameters are tuples of floats (``k_pair`` and ``profile_deviation`` have
     ``n_profile`` entries, ``tooth_stiffness_factor`` and ``tooth_deviation_offset`` have
-    ``z1``); lists or numpy arrays passed in are converted.  The Modelica parameters with a
-    binding to other parameters (``rb1``, ``rb2``, ``contact_ratio``, ``torque_out``,
+    ``z1``, ``wheel_tooth_deviation_offset`` has ``z2``, and is the variant
+    ``GearTwin.Variants.Gearbox21WheelErrors``'s); lists or numpy arrays passed in are converted.  The Modelica parameters with a binding to other parameters (``rb1``, ``rb2``, ``contact_ratio``, ``torque_out``,
     ``torque_in``, ``mesh_force_static``, ``speed_start``, ``k_mesh_mean``) are properties.
     The instance is hashable, which lets the per-parameter-set constants be cached.
     """
@@ -95,6 +103,7 @@ class GearboxParams:
     profile_deviation: tuple[float, ...] = (0.0,) * 11                          # m
     tooth_stiffness_factor: tuple[float, ...] = (1.0,) * 19                     # -
     tooth_deviation_offset: tuple[float, ...] = (0.0,) * 19                     # m
+    wheel_tooth_deviation_offset: tuple[float, ...] = (0.0,) * 52               # m, per gear tooth
     # parameter hooks of the effect catalogue (neutral here; they compose with the three above)
     effect_tooth_stiffness_factor: tuple[float, ...] = (1.0,) * 19              # -
     effect_tooth_offset: tuple[float, ...] = (0.0,) * 19                        # m
@@ -187,6 +196,9 @@ class GearboxParams:
                      "effect_tooth_offset"):
             if len(getattr(self, name)) != self.z1:
                 raise ValueError(f"{name} needs z1={self.z1} entries, got {len(getattr(self, name))}")
+        if len(self.wheel_tooth_deviation_offset) != round(self.z2):
+            raise ValueError(f"wheel_tooth_deviation_offset needs z2={self.z2} entries, "
+                             f"got {len(self.wheel_tooth_deviation_offset)}")
         if self.n_profile < 2:
             raise ValueError("n_profile must be >= 2 (hat interpolation needs two nodes)")
 
@@ -260,19 +272,22 @@ class GearboxParams:
         """Approximate mean mesh stiffness [N/m] used for the static pre-load."""
         return self.mesh_stiffness_scale * self.contact_ratio * sum(self.k_pair) / self.n_profile
 
-    def fmu_start_values(self, only_changed: bool = True) -> dict[str, float]:
+    def fmu_start_values(self, only_changed: bool = True, variant: bool = False) -> dict[str, float]:
         """Start values for the compiled FMU, keyed by its variable names (``k_pair[3]``, ...).
 
         ``z1`` and ``n_profile`` are structural constants of the FMU and never included.  With
-        ``only_changed`` only the fields that differ from the defaults are returned.
+        ``only_changed`` only the fields that differ from the defaults are returned.  The gear's
+        tooth offsets (:data:`VARIANT_FIELDS`) are parameters of the variant only: they are
+        included when they are not all zero, or when ``variant`` is true.
         """
         default = GearboxParams()
         out: dict[str, float] = {}
         for f in dataclasses.fields(self):
-            if f.name in ("z1", "n_profile"):
+            if f.name in STRUCTURAL:
                 continue
             value = getattr(self, f.name)
-            if only_changed and value == getattr(default, f.name):
+            unchanged = value == getattr(default, f.name)
+            if unchanged and (only_changed or (f.name in VARIANT_FIELDS and not variant)):
                 continue
             if f.name in _ARRAY_FIELDS:
                 out.update({f"{f.name}[{i + 1}]": v for i, v in enumerate(value)})
@@ -304,6 +319,13 @@ class _Constants:
         # Offsets of the leading / current / next pair: pinion-tooth angle [rad] and cycle, (3,).
         self.pair_tooth_shift = np.array([-2 * PI / p.z1, 0.0, 2 * PI / p.z1])
         self.pair_cycle_shift = np.array([1.0, 0.0, -1.0])
+        # The same for the gear's teeth, counted by the same mesh cycles.
+        self.wheel_offset = np.asarray(p.wheel_tooth_deviation_offset)           # (z2,)
+        self.wheel_teeth = self.wheel_offset.size
+        wheel_node = 2 * PI * np.arange(self.wheel_teeth) / self.wheel_teeth
+        self.wheel_node_cos, self.wheel_node_sin = np.cos(wheel_node), np.sin(wheel_node)
+        self.wheel_inv_chord2 = 1.0 / math.sin(PI / self.wheel_teeth) ** 2
+        self.pair_wheel_shift = np.array([-2 * PI, 0.0, 2 * PI]) / self.wheel_teeth
         self.cs_sensor_p = (math.cos(p.sensor_angle_pinion), math.sin(p.sensor_angle_pinion))
         self.cs_sensor_g = (math.cos(p.sensor_angle_gear), math.sin(p.sensor_angle_gear))
 
@@ -388,6 +410,12 @@ def _mesh(c: _Constants, x: np.ndarray) -> dict[str, np.ndarray]:
     select = np.maximum(0.0, 1.0 - chord2 * c.inv_chord2)
     pair_stiffness = window * k_profile * (select @ c.tooth_factor)
     pair_deviation = dev_profile + select @ c.tooth_offset
+    if c.wheel_offset.any():
+        # The variant's gear tooth of each pair: the same completed mesh cycles, on z2 teeth.
+        wheel_ang = (mesh_angle - 2 * PI * cycle) / c.wheel_teeth + c.pair_wheel_shift[extra]
+        wheel_chord2 = ((np.cos(wheel_ang)[..., None] - c.wheel_node_cos) ** 2
+                        + (np.sin(wheel_ang)[..., None] - c.wheel_node_sin) ** 2)  # (3, ..., z2)
+        pair_deviation = pair_deviation + np.maximum(0.0, 1.0 - wheel_chord2 * c.wheel_inv_chord2) @ c.wheel_offset
     # Approach of the flanks along the line of action: torsional plus the lateral projection.
     deflection = (c.rb1 * theta5 - c.rb2 * theta10
                   + (x[_I["x5"]] - x[_I["x10"]]) * c.sin_a + (x[_I["y5"]] - x[_I["y10"]]) * c.cos_a)

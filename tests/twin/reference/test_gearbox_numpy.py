@@ -52,8 +52,8 @@ def degraded_params() -> tuple[GearboxParams, dict[str, float]]:
 
 
 # ---- numpy model vs compiled FMU ------------------------------------------------------------
-@pytest.mark.parametrize("case", ["default", "degraded"])
-def test_matches_compiled_fmu(gearbox_fmu, case):
+@pytest.mark.parametrize("case", ["default", "degraded", "gear errors"])
+def test_matches_compiled_fmu(gearbox_fmu, wheel_fmu, case):
     """20 ms at 1e-5 s output: accelerations and mesh force agree with the FMU to 1e-3 relative.
 
     Both integrate the same equations with RK4 at 5e-6 s (two sub-steps per output
@@ -65,8 +65,14 @@ def test_matches_compiled_fmu(gearbox_fmu, case):
         p, u = GearboxParams(), {}
     else:
         p, u = degraded_params()
+    fmu = gearbox_fmu
+    if case == "gear errors":
+        # the variant: a gear with run-out and gear tooth 6 (the runs pass gear teeth 1-10) 1.5 um short
+        wheel = 0.5e-6 * (1 - np.cos(2 * np.pi * np.arange(52) / 52 + 0.4))
+        wheel[5] += 1.5e-6
+        p, fmu = p.replace(wheel_tooth_deviation_offset=wheel), wheel_fmu
     t, out = gn.simulate_rk4(p, u, stop_time=0.02, step=5e-6, output_interval=1e-5)
-    ref = simulate_compiled(gearbox_fmu, 0.02, 1e-5, {**p.fmu_start_values(), **u})
+    ref = simulate_compiled(fmu, 0.02, 1e-5, {**p.fmu_start_values(), **u})
     assert ref["time"].shape == t.shape
     np.testing.assert_allclose(ref["time"], t, rtol=0, atol=1e-12)
     for name in gn.OUTPUT_NAMES:
@@ -344,3 +350,47 @@ def test_more_load_more_mesh_force_and_transmission_error():
     assert np.all(np.diff(force) > 0.5 * 10.0 / p.rb2)
     assert np.all(np.diff(te) > 0.5 * 10.0 / p.rb2 / p.k_mesh_mean)
     assert np.all(force > 0) and np.all(te > 0)   # the pinion drives: flanks compressed
+
+
+def test_gear_tooth_follows_the_mesh_count():
+    """Gear tooth j is in the current pair at completed mesh cycles k = j - 1 (mod z2), whatever
+    pinion tooth it meets: a deviation on gear tooth 3 shows in the current pair at k = 2 and one
+    gear revolution (52 cycles, pinion tooth 17 instead of 3) later, in the leading pair one cycle
+    after that, and nowhere else."""
+    wheel = np.zeros(52)
+    wheel[2] = 1e-6
+    c = gn._constants(GearboxParams(wheel_tooth_deviation_offset=wheel))
+    x = np.zeros(gn.N_STATES)
+
+    def deviation(cycles):                      # pair deviations at mid-cycle after `cycles` cycles
+        x[gn.STATE_NAMES.index("theta5")] = 2 * math.pi * (cycles + 0.5) / 19
+        return gn._mesh(c, x)["pair_deviation"]
+
+    np.testing.assert_allclose(deviation(2), [0, 1e-6, 0], atol=1e-15)
+    np.testing.assert_allclose(deviation(2 + 52), [0, 1e-6, 0], atol=1e-15)
+    np.testing.assert_allclose(deviation(3), [1e-6, 0, 0], atol=1e-15)
+    np.testing.assert_allclose(deviation(1), [0, 0, 1e-6], atol=1e-15)
+    for k in (0, 5, 21, 40, 57):
+        np.testing.assert_allclose(deviation(k), 0, atol=1e-15)
+
+
+def test_gear_tooth_array_needs_z2_entries():
+    with pytest.raises(ValueError, match="wheel_tooth_deviation_offset needs z2=52.0 entries, got 19"):
+        GearboxParams(wheel_tooth_deviation_offset=np.zeros(19))
+
+
+def test_gear_error_variant_has_the_base_parameters_plus_the_gear_teeth(gearbox_fmu, wheel_fmu):
+    """GearTwin.Variants.Gearbox21WheelErrors: the base model's parameters, the same defaults, and
+    the 52 gear-tooth offsets; with them all zero it gives the base model's numbers exactly."""
+    def params(fmu):
+        md = read_model_description(str(fmu))
+        return {v.name: float(v.start) for v in md.modelVariables
+                if v.causality == "parameter" and not v.name.startswith("solver.")}
+    base, variant = params(gearbox_fmu), params(wheel_fmu)
+    assert set(variant) == set(GearboxParams().fmu_start_values(only_changed=False, variant=True))
+    assert set(variant) - set(base) == {f"wheel_tooth_deviation_offset[{i}]" for i in range(1, 53)}
+    assert all(variant[n] == v for n, v in base.items())
+    a = simulate_compiled(gearbox_fmu, 0.005, 1e-5)
+    b = simulate_compiled(wheel_fmu, 0.005, 1e-5)
+    for name in ACCEL_FORCE:
+        np.testing.assert_array_equal(a[name], b[name])
