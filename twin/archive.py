@@ -14,6 +14,8 @@
    spread of the damage over the teeth, drawn from a stream of its own, so an archive without
    these keys is unchanged by them.  Each record keeps its drawn pinion as ``gear_*`` record
    attributes (:func:`gear_attributes`), so a record names the gear it was simulated with;
+   likewise each record can get a gear (wheel) of its own (``wheel_pitch_error``,
+   ``wheel_runout``; :func:`draw_wheel`), from a third stream, kept as ``gear_wheel_*``;
 4. simulates the records in parallel (local processes by default, Dask when the scenario's
    ``executor`` says so), each ``settle_time`` + ``record_duration`` seconds long, keeps the
    last ``record_duration`` seconds, and adds white measurement noise relative to the record's RMS.
@@ -83,8 +85,9 @@ class Archive:
     stages: tuple               # stage boundaries
     damage_kind: str            # "pitting_density" or "wear_depth"
     path: Path | None = None
-    # per record, the drawn pinion when the archive has tooth errors: its ``gear_*`` record
-    # attributes (PinionDraw.attributes, plus the per-tooth arrays set in the FMU); None without
+    # per record, the drawn pinion and wheel when the archive has tooth errors: their ``gear_*``
+    # record attributes (PinionDraw.attributes plus the per-tooth arrays set in the FMU,
+    # WheelDraw.attributes); None without
     gears: tuple | None = None
 
 
@@ -169,6 +172,62 @@ def draw_pinion(draw: np.random.Generator, spec, teeth: int) -> PinionDraw:
     c = draw.gamma(1.0 / scatter ** 2, scatter ** 2, teeth) if scatter > 0 else np.ones(teeth)
     return PinionDraw(float(pitch_sd), float(runout), float(phase), float(scatter), np.asarray(pitch, float),
                       np.asarray(c, float))
+
+
+WHEEL_ERROR_KEYS = ("wheel_pitch_error", "wheel_runout")
+
+
+@dataclass(frozen=True)
+class WheelDraw:
+    """One record's drawn gear (the wheel, 52 teeth in the rig): its tooth positions.
+
+    Attributes
+    ----------
+    pitch_error_sd : float
+        Drawn sd of the single pitch deviations [m].
+    runout : float
+        Drawn peak-to-peak run-out [m].
+    runout_phase : float
+        Angle of tooth 1 on the run-out sinusoid [rad].
+    deviation : ndarray (teeth,)
+        ``wheel_tooth_deviation_offset`` [m]: cumulative pitch deviation plus run-out, shifted so
+        that the least-cut tooth has zero.
+    """
+
+    pitch_error_sd: float
+    runout: float
+    runout_phase: float
+    deviation: np.ndarray
+
+    def attributes(self) -> dict:
+        """The drawn gear as record attributes (``gear_wheel_`` prefix, SI units)."""
+        return {"gear_wheel_pitch_error_sd": self.pitch_error_sd, "gear_wheel_runout": self.runout,
+                "gear_wheel_runout_phase": self.runout_phase,
+                "gear_wheel_tooth_deviation_offset": np.asarray(self.deviation, float)}
+
+    def parameters(self) -> dict[str, float]:
+        """The FMU parameters ``wheel_tooth_deviation_offset[1..teeth]`` [m]."""
+        return {f"wheel_tooth_deviation_offset[{i + 1}]": float(v) for i, v in enumerate(self.deviation)}
+
+
+def draw_wheel(draw: np.random.Generator, spec, teeth: int) -> WheelDraw:
+    """Draw one record's gear within the archive block's bounds (``wheel_pitch_error``,
+    ``wheel_runout`` [m], absent = 0), each magnitude uniform between zero and its bound.
+
+    The pinion's tooth positions are drawn independent from tooth to tooth
+    (:func:`draw_pinion`).  The gear's follow ISO 1328's definition instead: the single pitch
+    deviations (tooth to tooth spacing) are independent normal, and a tooth's position deviation
+    is their sum from tooth 1, the cumulative pitch deviation, which closes over the revolution
+    (the spacings sum to the circumference).  Its energy sits at the gear's first few shaft
+    orders, which is where a hobbed gear's errors are, with run-out on top at the first.
+    """
+    pitch_sd = draw.uniform(0.0, float(spec.get("wheel_pitch_error", 0.0)))
+    single = pitch_sd * draw.standard_normal(teeth)
+    runout = draw.uniform(0.0, float(spec.get("wheel_runout", 0.0)))
+    phase = draw.uniform(0.0, 2 * np.pi)
+    cumulative = np.cumsum(single - single.mean())      # closed: tooth z + 1 is tooth 1 again
+    dev = cumulative + runout_deviation(runout, phase, teeth)
+    return WheelDraw(float(pitch_sd), float(runout), float(phase), dev - dev.min())
 
 
 def _profile(parameters: dict, name: str) -> np.ndarray:
@@ -294,8 +353,9 @@ def gear_attributes(pinion: PinionDraw, parameters: dict, teeth: int) -> dict:
     return out
 
 
-def tooth_error_bounds(scenario: Scenario) -> tuple[float, float, float]:
-    """The archive block's (``pitch_error``, ``runout``, ``tooth_damage_scatter``) bounds, absent = 0.
+def tooth_error_bounds(scenario: Scenario, keys: tuple = TOOTH_ERROR_KEYS) -> tuple[float, ...]:
+    """The archive block's bounds of ``keys`` (default ``pitch_error``, ``runout``,
+    ``tooth_damage_scatter``; or :data:`WHEEL_ERROR_KEYS`), absent = 0.
 
     The scenario schema checks them in a file; a block built in code (``with_overrides``) is
     checked here, so a negative or non-numeric bound is a :class:`ScenarioError` naming every bad
@@ -303,7 +363,7 @@ def tooth_error_bounds(scenario: Scenario) -> tuple[float, float, float]:
     """
     spec = scenario.archive or {}
     bounds, problems = [], []
-    for key in TOOTH_ERROR_KEYS:
+    for key in keys:
         value = spec.get(key, 0.0)
         ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value) and value >= 0
         if not ok:
@@ -324,6 +384,19 @@ def pinion_teeth(fmu_path) -> int:
         raise SimulationError(f"the FMU {fmu_path} has no per-tooth parameters (tooth_deviation_offset[i], "
                               f"tooth_stiffness_factor[i]); remove {', '.join(TOOTH_ERROR_KEYS)} from the archive "
                               "block or use a model that has them")
+    return teeth
+
+
+def wheel_teeth(fmu_path) -> int:
+    """Number of ``wheel_tooth_deviation_offset[i]`` parameters of the FMU; SimulationError if none."""
+    from twin.fmu import FMU
+    with FMU(fmu_path) as fmu:
+        teeth = sum(1 for v in fmu.parameters if v.name.startswith("wheel_tooth_deviation_offset["))
+    if teeth == 0:
+        raise SimulationError(f"the FMU {fmu_path} has no per-gear-tooth parameters "
+                              f"(wheel_tooth_deviation_offset[i]); remove {', '.join(WHEEL_ERROR_KEYS)} from the "
+                              "archive block or use a model that has them, such as "
+                              "fmu: GearTwin.Variants.Gearbox21WheelErrors")
     return teeth
 
 
@@ -372,6 +445,7 @@ def build_archive(scenario: Scenario, output: str | Path | None = None, *, progr
         check_output_path(path)
     fmu_file = fmu_path or scenario.fmu_path()
     gear_bounds = tooth_error_bounds(scenario)      # before the degradation run, which takes a while
+    wheel_bounds = tooth_error_bounds(scenario, WHEEL_ERROR_KEYS)
     run = run_degradation(scenario, None, fmu_path=fmu_file, progress=progress, channels=("accel_pinion_casing",))
     damages = run.damage
     if np.any(np.diff(damages) < 0):
@@ -391,9 +465,16 @@ def build_archive(scenario: Scenario, output: str | Path | None = None, *, progr
     seq = np.random.SeedSequence(scenario.seed)
     draw = np.random.default_rng(seq.spawn(1)[0])
     record_seeds = seq.spawn(len(bounds) * per_stage + 1)[1:]
-    # The gears have their own stream: turning the tooth errors on or off leaves every other draw.
+    # The pinions and the wheels have streams of their own: turning their errors on or off leaves
+    # every other draw.
     gear_draw = np.random.default_rng(seq.spawn(1)[0])
     teeth = pinion_teeth(fmu_file) if any(b > 0 for b in gear_bounds) else 0
+    wheel_draw = np.random.default_rng(seq.spawn(1)[0])
+    z_wheel = wheel_teeth(fmu_file) if any(b > 0 for b in wheel_bounds) else 0
+    if z_wheel and round(float(scenario.parameters.get("z2", z_wheel))) != z_wheel:
+        raise ScenarioError([(str(scenario.source), "parameters.z2",
+                              f"the FMU's gear has {z_wheel} teeth (wheel_tooth_deviation_offset), "
+                              f"got z2 = {scenario.parameters['z2']!r}")])
     tasks, labels, dmg, speeds, loads, gears = [], [], [], [], [], []
     k = 0
     for s, (lo, hi) in enumerate(zip(bounds, bounds[1:])):
@@ -411,7 +492,12 @@ def build_archive(scenario: Scenario, output: str | Path | None = None, *, progr
                 gear = {n: v * scenario.parameters.get(n, 1.0) if n.startswith("tooth_stiffness")
                         else v + scenario.parameters.get(n, 0.0) for n, v in gear.items()}
                 p.update(gear)
-                gears.append(gear_attributes(pinion, gear, teeth))
+            if z_wheel:
+                wheel = draw_wheel(wheel_draw, spec, z_wheel)
+                p.update({n: v + scenario.parameters.get(n, 0.0) for n, v in wheel.parameters().items()})
+            if teeth or z_wheel:
+                gears.append({**(gear_attributes(pinion, gear, teeth) if teeth else {}),
+                              **(wheel.attributes() if z_wheel else {})})
             tasks.append(RecordTask(k, str(fmu_file), p, inputs, settle, duration, scenario.output_interval,
                                     channels, noise, int(record_seeds[k].generate_state(1)[0])))
             labels.append(s)
@@ -423,7 +509,7 @@ def build_archive(scenario: Scenario, output: str | Path | None = None, *, progr
     signals = {c: np.stack([r[c] for r in results]) for c in channels}
     kind = "pitting_density" if run.model == "pitting" else "wear_depth"
     archive = Archive(np.array(labels), np.array(dmg), np.array(speeds), np.array(loads), signals,
-                      scenario.sample_rate, tuple(bounds), kind, path, tuple(gears) if teeth else None)
+                      scenario.sample_rate, tuple(bounds), kind, path, tuple(gears) if gears else None)
     if path is not None:
         write_archive(archive, path, scenario, run)
     return archive

@@ -150,6 +150,11 @@ SCHEMA: dict[str, Any] = {
                                                     "uniformly up to this (default 0)"},
                 "tooth_damage_scatter": {**_NONNEG, "description": "relative sd of the damage from tooth to tooth, "
                                                                   "drawn per record uniformly up to this (default 0)"},
+                "wheel_pitch_error": {**_NONNEG, "description": "m: each record's gear (wheel) has single pitch "
+                                                               "deviations with an sd drawn uniformly up to this; "
+                                                               "its teeth sit at their cumulative sum (default 0)"},
+                "wheel_runout": {**_NONNEG, "description": "m: each record's gear (wheel) has a run-out, peak to "
+                                                          "peak, drawn uniformly up to this (default 0)"},
             },
         },
         "calibration": CALIBRATION_SCHEMA,

@@ -221,9 +221,81 @@ def test_tooth_errors_need_a_model_with_per_tooth_parameters(two_mass_fmu):
     from twin.archive import pinion_teeth
     with pytest.raises(SimulationError, match="no per-tooth parameters"):
         pinion_teeth(two_mass_fmu)
+    from twin.archive import wheel_teeth
+    with pytest.raises(SimulationError, match="no per-gear-tooth parameters"):
+        wheel_teeth(two_mass_fmu)
 
 
-@pytest.mark.parametrize("key", ["pitch_error", "runout", "tooth_damage_scatter"])
+def test_gear_errors_need_the_variant(gearbox_fmu, wheel_fmu, tmp_path):
+    from twin.archive import wheel_teeth
+    from twin.errors import ScenarioError
+    with pytest.raises(SimulationError, match="GearTwin.Variants.Gearbox21WheelErrors"):
+        wheel_teeth(gearbox_fmu)
+    assert wheel_teeth(wheel_fmu) == 52
+    sc = _small()
+    sc = sc.with_overrides(archive={**sc.archive, "wheel_runout": 5e-6}, parameters={**sc.parameters, "z2": 53.0})
+    out = tmp_path / "a.h5"
+    out.write_bytes(b"kept")
+    with pytest.raises(ScenarioError, match="z2 = 53.0"):
+        build_archive(sc, out, fmu_path=wheel_fmu, progress=False)
+    assert out.read_bytes() == b"kept"
+
+
+def test_wheel_draw_by_hand():
+    """The gear's teeth sit at the cumulative sum of its single pitch deviations, which closes over
+    the revolution, plus the run-out; zero bounds give a perfect gear."""
+    from twin.archive import draw_wheel, runout_deviation
+    assert not np.any(draw_wheel(np.random.default_rng(0), {}, 52).deviation)
+    w = draw_wheel(np.random.default_rng(4), {"wheel_pitch_error": 2e-6}, 52)
+    # replay the draws: sd, the 52 single deviations, then run-out and phase
+    rng = np.random.default_rng(4)
+    sd = rng.uniform(0.0, 2e-6)
+    single = sd * rng.standard_normal(52)
+    assert w.pitch_error_sd == sd and w.runout == 0.0
+    spacing = np.diff(np.r_[w.deviation, w.deviation[0]])      # tooth 53 is tooth 1 again
+    np.testing.assert_allclose(spacing, np.roll(single - single.mean(), -1), atol=1e-18)
+    assert w.deviation.min() == 0.0
+    r = draw_wheel(np.random.default_rng(1), {"wheel_runout": 10e-6}, 52)
+    np.testing.assert_allclose(r.deviation, runout_deviation(r.runout, r.runout_phase, 52) -
+                               runout_deviation(r.runout, r.runout_phase, 52).min(), atol=1e-18)
+    assert 0 < r.runout <= 10e-6
+    assert set(r.parameters()) == {f"wheel_tooth_deviation_offset[{i}]" for i in range(1, 53)}
+
+
+def test_archive_with_wheel_errors_keeps_every_other_draw(archive_pair, wheel_fmu, tmp_path):
+    """A wheel of its own per record changes the signals and nothing else the archive draws; the
+    records keep it, as set in the FMU, and with pinion errors too each keeps both."""
+    from twin.archive import draw_wheel
+    a, _ = archive_pair
+    sc = _small(workers=2)
+    bounds = {"wheel_pitch_error": 1.5e-6, "wheel_runout": 10e-6}
+    path = tmp_path / "w.h5"
+    b = build_archive(sc.with_overrides(archive={**sc.archive, **bounds}), path, fmu_path=wheel_fmu,
+                      progress=False)
+    for name in ("labels", "damage", "speed", "load"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
+    x, y = a.signals["accel_pinion_casing"], b.signals["accel_pinion_casing"]
+    assert np.all(np.isfinite(y)) and not np.allclose(x, y, rtol=0.05)
+    seq = np.random.SeedSequence(sc.seed)
+    seq.spawn(1 + 3 * 2 + 1 + 1)     # record draws and seeds, then the pinions' stream
+    replay = np.random.default_rng(seq.spawn(1)[0])
+    back = read_archive(path)
+    for g, h in zip(b.gears, back.gears):
+        w = draw_wheel(replay, bounds, 52)
+        assert set(g) == {"gear_wheel_pitch_error_sd", "gear_wheel_runout", "gear_wheel_runout_phase",
+                          "gear_wheel_tooth_deviation_offset"}
+        np.testing.assert_array_equal(g["gear_wheel_tooth_deviation_offset"], w.deviation)
+        for name in g:
+            np.testing.assert_array_equal(h[name], g[name])
+    both = build_archive(sc.with_overrides(archive={**sc.archive, **bounds, "runout": 5e-6}), None,
+                         fmu_path=wheel_fmu, progress=False)
+    for g, w in zip(both.gears, b.gears):
+        assert "gear_runout" in g
+        np.testing.assert_array_equal(g["gear_wheel_tooth_deviation_offset"], w["gear_wheel_tooth_deviation_offset"])
+
+
+@pytest.mark.parametrize("key", ["pitch_error", "runout", "tooth_damage_scatter", "wheel_pitch_error",
+                                 "wheel_runout"])
 def test_negative_tooth_error_bound_is_a_scenario_error(key):
     import yaml
 
@@ -250,4 +322,9 @@ def test_bad_tooth_error_bounds_set_in_code_are_named_before_any_simulation(tmp_
     with pytest.raises(ScenarioError, match="archive.runout") as err:
         build_archive(sc.with_overrides(archive=arc), out, fmu_path=gearbox_fmu, progress=False)
     assert "archive.pitch_error" in str(err.value) and "tooth_damage_scatter" not in str(err.value)
+    assert out.read_bytes() == b"kept"
+    arc = {**sc.archive, "wheel_runout": float("nan"), "wheel_pitch_error": -1e-6}
+    with pytest.raises(ScenarioError, match="archive.wheel_runout") as err:
+        build_archive(sc.with_overrides(archive=arc), out, fmu_path=gearbox_fmu, progress=False)
+    assert "archive.wheel_pitch_error" in str(err.value)
     assert out.read_bytes() == b"kept"

@@ -61,6 +61,7 @@ from twin.transfer.lumped import LumpedRig
 
 REPO = Path(__file__).resolve().parents[2]
 TASKS = {"pitting": "scenarios/lubricated.yaml", "wear": "scenarios/dry.yaml"}
+WHEEL_MODEL = "GearTwin.Variants.Gearbox21WheelErrors"   # the source model when records get gears of their own
 CHANNEL = "accel_pinion_casing"     # the one channel the benchmark's data are simulated and read with
 METHODS = ("cnn", "mmd", "proposed")
 
@@ -85,6 +86,10 @@ class DataSettings:
     source_pitch_error: float = 2e-6
     source_runout: float = 10e-6
     source_tooth_damage_scatter: float = 0.5
+    # each source record's gear (wheel): bounds of its single-pitch-deviation sd and run-out [m]
+    # (twin.archive.draw_wheel); 0 = a perfect gear
+    source_wheel_pitch_error: float = 0.0
+    source_wheel_runout: float = 0.0
     # which emulated rig measures the target (RIGS)
     rig: str = "rig"
 
@@ -197,10 +202,15 @@ def prepare_task(task: str, data_dir: str | Path, settings: DataSettings | None 
            "record_duration": settings.source_record_duration, "damage_sampling": settings.damage_sampling,
            "damage_scatter": settings.damage_scatter, "speed_scatter": settings.source_speed_scatter,
            "load_scatter": settings.source_load_scatter, "pitch_error": settings.source_pitch_error,
-           "runout": settings.source_runout, "tooth_damage_scatter": settings.source_tooth_damage_scatter}
+           "runout": settings.source_runout, "tooth_damage_scatter": settings.source_tooth_damage_scatter,
+           "wheel_pitch_error": settings.source_wheel_pitch_error, "wheel_runout": settings.source_wheel_runout}
     sc = sc.with_overrides(archive=arc)
     fmu = sc.fmu_path()
-    build_archive(sc, src, progress=progress, fmu_path=fmu)
+    # gears of their own need the model variant that has per-gear-tooth parameters; the targets
+    # below keep the scenario's model
+    src_sc = sc.with_overrides(fmu=WHEEL_MODEL) if settings.source_wheel_pitch_error or settings.source_wheel_runout \
+        else sc
+    build_archive(src_sc, src, progress=progress, fmu_path=src_sc.fmu_path())
     rig = RIGS[settings.rig]
     if isinstance(rig, (LumpedRig, LtcaRig)):
         # the simulators that are not the twin write their own target files, from the scenario alone

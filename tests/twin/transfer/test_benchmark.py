@@ -156,17 +156,28 @@ def test_the_archive_gets_each_tasks_tooth_errors(tmp_path, monkeypatch):
     seen = {}
 
     def build_archive(sc, path, **kw):
-        seen[path.name] = {k: sc.archive.get(k) for k in twin.archive.TOOTH_ERROR_KEYS}
+        keys = twin.archive.TOOTH_ERROR_KEYS + twin.archive.WHEEL_ERROR_KEYS
+        seen[path.name] = ({k: sc.archive.get(k) for k in keys}, kw["fmu_path"].name)
         path.write_text("source")
 
-    monkeypatch.setattr(twin.scenario.Scenario, "fmu_path", lambda self: tmp_path / "model.fmu")
+    def make_target_domain(sc, path, **kw):
+        seen[path.name] = kw["fmu_path"].name
+        path.write_text("t")
+
+    monkeypatch.setattr(twin.scenario.Scenario, "fmu_path", lambda self: tmp_path / f"{self.fmu}.fmu")
     monkeypatch.setattr(twin.archive, "build_archive", build_archive)
     monkeypatch.setattr(twin.degradation_run, "run_degradation", lambda *a, **kw: None)
-    monkeypatch.setattr(twin.transfer.domain, "make_target_domain", lambda sc, path, **kw: path.write_text("t"))
+    monkeypatch.setattr(twin.transfer.domain, "make_target_domain", make_target_domain)
     prepare_task("pitting", tmp_path, progress=False)
-    prepare_task("wear", tmp_path, replace(TASK_SETTINGS["wear"], source_runout=0.0), progress=False)
-    assert seen["source_pitting.h5"] == {"pitch_error": 0.0, "runout": 10e-6, "tooth_damage_scatter": 0.5}
-    assert seen["source_wear.h5"] == {"pitch_error": 2e-6, "runout": 0.0, "tooth_damage_scatter": 0.1}
+    prepare_task("wear", tmp_path, replace(TASK_SETTINGS["wear"], source_runout=0.0, source_wheel_runout=5e-6),
+                 progress=False)
+    assert seen["source_pitting.h5"] == ({"pitch_error": 0.0, "runout": 10e-6, "tooth_damage_scatter": 0.5,
+                                          "wheel_pitch_error": 0.0, "wheel_runout": 0.0}, "GearTwin.Gearbox21.fmu")
+    # gears of their own: the source comes from the variant that has them, the target does not
+    assert seen["source_wear.h5"] == ({"pitch_error": 2e-6, "runout": 0.0, "tooth_damage_scatter": 0.1,
+                                       "wheel_pitch_error": 0.0, "wheel_runout": 5e-6},
+                                      "GearTwin.Variants.Gearbox21WheelErrors.fmu")
+    assert seen["target_wear.h5"] == seen["target_pitting.h5"] == "GearTwin.Gearbox21.fmu"
 
 
 def test_prepare_task_keeps_each_rigs_data_apart_and_reuses_it(tmp_path, monkeypatch):
