@@ -444,8 +444,15 @@ def build_archive(scenario: Scenario, output: str | Path | None = None, *, progr
         from twin.results import check_output_path
         check_output_path(path)
     fmu_file = fmu_path or scenario.fmu_path()
-    gear_bounds = tooth_error_bounds(scenario)      # before the degradation run, which takes a while
+    # the gear checks come before the degradation run, which takes a while
+    gear_bounds = tooth_error_bounds(scenario)
     wheel_bounds = tooth_error_bounds(scenario, WHEEL_ERROR_KEYS)
+    teeth = pinion_teeth(fmu_file) if any(b > 0 for b in gear_bounds) else 0
+    z_wheel = wheel_teeth(fmu_file) if any(b > 0 for b in wheel_bounds) else 0
+    if z_wheel and round(float(scenario.parameters.get("z2", z_wheel))) != z_wheel:
+        raise ScenarioError([(str(scenario.source), "parameters.z2",
+                              f"the FMU's gear has {z_wheel} teeth (wheel_tooth_deviation_offset), "
+                              f"got z2 = {scenario.parameters['z2']!r}")])
     run = run_degradation(scenario, None, fmu_path=fmu_file, progress=progress, channels=("accel_pinion_casing",))
     damages = run.damage
     if np.any(np.diff(damages) < 0):
@@ -468,13 +475,7 @@ def build_archive(scenario: Scenario, output: str | Path | None = None, *, progr
     # The pinions and the wheels have streams of their own: turning their errors on or off leaves
     # every other draw.
     gear_draw = np.random.default_rng(seq.spawn(1)[0])
-    teeth = pinion_teeth(fmu_file) if any(b > 0 for b in gear_bounds) else 0
     wheel_draw = np.random.default_rng(seq.spawn(1)[0])
-    z_wheel = wheel_teeth(fmu_file) if any(b > 0 for b in wheel_bounds) else 0
-    if z_wheel and round(float(scenario.parameters.get("z2", z_wheel))) != z_wheel:
-        raise ScenarioError([(str(scenario.source), "parameters.z2",
-                              f"the FMU's gear has {z_wheel} teeth (wheel_tooth_deviation_offset), "
-                              f"got z2 = {scenario.parameters['z2']!r}")])
     tasks, labels, dmg, speeds, loads, gears = [], [], [], [], [], []
     k = 0
     for s, (lo, hi) in enumerate(zip(bounds, bounds[1:])):

@@ -226,9 +226,16 @@ def test_tooth_errors_need_a_model_with_per_tooth_parameters(two_mass_fmu):
         wheel_teeth(two_mass_fmu)
 
 
-def test_gear_errors_need_the_variant(gearbox_fmu, wheel_fmu, tmp_path):
+def test_gear_errors_need_the_variant(gearbox_fmu, wheel_fmu, tmp_path, monkeypatch):
+    """Both refusals come before the degradation run, and leave an existing output alone."""
+    import twin.degradation_run
     from twin.archive import wheel_teeth
     from twin.errors import ScenarioError
+
+    def no_run(*a, **kw):
+        raise AssertionError("the degradation run must not start")
+
+    monkeypatch.setattr(twin.degradation_run, "run_degradation", no_run)
     with pytest.raises(SimulationError, match="GearTwin.Variants.Gearbox21WheelErrors"):
         wheel_teeth(gearbox_fmu)
     assert wheel_teeth(wheel_fmu) == 52
@@ -238,6 +245,8 @@ def test_gear_errors_need_the_variant(gearbox_fmu, wheel_fmu, tmp_path):
     out.write_bytes(b"kept")
     with pytest.raises(ScenarioError, match="z2 = 53.0"):
         build_archive(sc, out, fmu_path=wheel_fmu, progress=False)
+    with pytest.raises(SimulationError, match="Gearbox21WheelErrors"):
+        build_archive(sc, out, fmu_path=gearbox_fmu, progress=False)
     assert out.read_bytes() == b"kept"
 
 
