@@ -97,14 +97,15 @@ def _gear_errors_demo(base, modelica_dir: Path, stop_time: float, pinion_hz: flo
 
     variant = build_fmu("GearTwin.Variants.Gearbox21WheelErrors", modelica_dir, REPO / "build")
     wheel = draw_wheel(np.random.default_rng(0), {"wheel_pitch_error": 2e-6, "wheel_runout": 10e-6}, 52)
-    result = simulate_fmu(variant, stop_time=stop_time, output_interval=1e-5, parameters=wheel.parameters(),
+    dt = float(base.time[1] - base.time[0])        # the base run's output interval [s]
+    result = simulate_fmu(variant, stop_time=stop_time, output_interval=dt, parameters=wheel.parameters(),
                           inputs={"motor_speed_ref": 2 * np.pi * SHAFT_HZ, "load_torque": LOAD_NM})
-    gear_hz = pinion_hz * 19 / 52
+    gear_hz = pinion_hz * 19 / wheel.deviation.size
 
     def ser(r):
         x = r["accel_pinion_casing"][r.time >= min(0.5, stop_time / 2)]
-        f, a = amplitude_spectrum(x, 1e5)
-        return sideband_energy_ratio(f, a, shaft_hz=gear_hz, z=52, n_sidebands=3)
+        f, a = amplitude_spectrum(x, 1.0 / dt)
+        return sideband_energy_ratio(f, a, shaft_hz=gear_hz, z=wheel.deviation.size, n_sidebands=3)
 
     print(f"      With a gear of its own ({variant.stem}: single pitch sd {1e6 * wheel.pitch_error_sd:.1f} um, "
           f"run-out {1e6 * wheel.runout:.1f} um, drawn as the archive draws it): sideband energy ratio at the "
