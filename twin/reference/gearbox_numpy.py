@@ -380,6 +380,13 @@ def _smoothstep(u):
     return u * u * (3.0 - 2.0 * u)
 
 
+def _tooth_select(angle, node_cos, node_sin, inv_chord2) -> np.ndarray:
+    """(..., teeth) weights of the teeth in contact: a hat of radius half a chord around each
+    tooth's position on the unit circle, 1 at the tooth whose angle ``angle`` [rad] is, 0 elsewhere."""
+    chord2 = (np.cos(angle)[..., None] - node_cos) ** 2 + (np.sin(angle)[..., None] - node_sin) ** 2
+    return np.maximum(0.0, 1.0 - chord2 * inv_chord2)
+
+
 def _mesh(c: _Constants, x: np.ndarray) -> dict[str, np.ndarray]:
     """Mesh quantities for states ``x`` (42, ...): forces [N], stiffnesses [N/m], deflections [m].
 
@@ -403,19 +410,15 @@ def _mesh(c: _Constants, x: np.ndarray) -> dict[str, np.ndarray]:
     hat = np.maximum(0.0, 1.0 - np.abs(pos[..., None] - c.node_index))        # (3, ..., n)
     k_profile = hat @ c.k_pair
     dev_profile = hat @ c.profile_deviation
-    # Tooth selection: hat of radius half a chord around each pinion tooth on the unit circle.
-    ang = tooth_angle + c.pair_tooth_shift[extra]                              # (3, ...)
-    chord2 = ((np.cos(ang)[..., None] - c.tooth_node_cos) ** 2
-              + (np.sin(ang)[..., None] - c.tooth_node_sin) ** 2)             # (3, ..., z1)
-    select = np.maximum(0.0, 1.0 - chord2 * c.inv_chord2)
+    select = _tooth_select(tooth_angle + c.pair_tooth_shift[extra], c.tooth_node_cos, c.tooth_node_sin,
+                           c.inv_chord2)                                      # (3, ..., z1)
     pair_stiffness = window * k_profile * (select @ c.tooth_factor)
     pair_deviation = dev_profile + select @ c.tooth_offset
     if c.wheel_offset.any():
         # The variant's gear tooth of each pair: the same completed mesh cycles, on z2 teeth.
         wheel_ang = (mesh_angle - 2 * PI * cycle) / c.wheel_teeth + c.pair_wheel_shift[extra]
-        wheel_chord2 = ((np.cos(wheel_ang)[..., None] - c.wheel_node_cos) ** 2
-                        + (np.sin(wheel_ang)[..., None] - c.wheel_node_sin) ** 2)  # (3, ..., z2)
-        pair_deviation = pair_deviation + np.maximum(0.0, 1.0 - wheel_chord2 * c.wheel_inv_chord2) @ c.wheel_offset
+        pair_deviation = pair_deviation + _tooth_select(wheel_ang, c.wheel_node_cos, c.wheel_node_sin,
+                                                        c.wheel_inv_chord2) @ c.wheel_offset
     # Approach of the flanks along the line of action: torsional plus the lateral projection.
     deflection = (c.rb1 * theta5 - c.rb2 * theta10
                   + (x[_I["x5"]] - x[_I["x10"]]) * c.sin_a + (x[_I["y5"]] - x[_I["y10"]]) * c.cos_a)
