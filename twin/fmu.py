@@ -331,12 +331,13 @@ class FMU:
         self.instantiate()
         single = isinstance(names, str)
         names = [names] if single else list(names)
-        not_real = [n for n in names if self.variable(n).type != "Real"]
+        variables = [self.variable(n) for n in names]
+        not_real = [v.name for v in variables if v.type != "Real"]
         if not_real:
             raise ParameterError(f"{', '.join(repr(n) for n in not_real)} of {self.model_name} "
                                  f"{'is not a Real' if len(not_real) == 1 else 'are not Reals'}; "
                                  "read structural Integers with structural_values()")
-        vrs = [self.variable(n).value_reference for n in names]
+        vrs = [v.value_reference for v in variables]
         vals = np.array(self._call("fmi2GetReal", self._slave.getReal, vrs))
         return float(vals[0]) if single else vals
 

@@ -205,7 +205,6 @@ def prepare_task(task: str, data_dir: str | Path, settings: DataSettings | None 
            "runout": settings.source_runout, "tooth_damage_scatter": settings.source_tooth_damage_scatter,
            "wheel_pitch_error": settings.source_wheel_pitch_error, "wheel_runout": settings.source_wheel_runout}
     sc = sc.with_overrides(archive=arc)
-    fmu = sc.fmu_path()
     # gears of their own need the model variant that has per-gear-tooth parameters; the targets
     # below keep the scenario's model
     src_sc = sc.with_overrides(fmu=WHEEL_MODEL) if settings.source_wheel_pitch_error or settings.source_wheel_runout \
@@ -220,6 +219,7 @@ def prepare_task(task: str, data_dir: str | Path, settings: DataSettings | None 
              record_duration=settings.target_record_duration, seed=settings.target_seed,
              rig=rig, progress=progress)
     else:
+        fmu = sc.fmu_path()
         run = run_degradation(sc, None, fmu_path=fmu, progress=progress, channels=(CHANNEL,))
         make_target_domain(sc, tgt, records_per_stage=settings.target_records_per_stage,
                            record_duration=settings.target_record_duration, seed=settings.target_seed,
