@@ -19,7 +19,10 @@ Methods (``method=``):
 Every method that adapts (all but ``"cnn"``) ends with a **class-prior match**
 (``class_prior="source"``, :mod:`twin.transfer.prior`): per-stage logit offsets, fitted on the
 unlabelled adaptation windows so that the rig's mean stage probabilities equal the twin's stage
-proportions, move the decision boundaries the rig has shifted.  ``class_prior=None`` switches it off.
+proportions, move the decision boundaries the rig has shifted.  ``class_prior="ordinal"`` places the
+boundaries along the windows' expected stage instead, at the quantiles of the twin's stage
+proportions, and keeps only the order of the windows (the benchmark's pitting default).
+``class_prior=None`` switches it off.
 
 Training (paper Table 3 defaults): SGD with momentum 0.9 and weight decay 5e-4, initial learning
 rate ``lr`` = 0.01 annealed as ``lr / (1 + 10 p)^0.75`` over the training progress ``p`` in [0, 1]
@@ -55,7 +58,7 @@ SAVE_VERSION = 4
 # version 1: waveform only, one scale per domain; version 2: log spectra under one Hann taper, level removed;
 # version 3: no class-prior match (its assessors load with zero offsets, as they were trained)
 _READABLE_VERSIONS = (1, 2, 3, 4)
-CLASS_PRIORS = ("source", None)
+CLASS_PRIORS = ("source", "ordinal", None)
 # How far the class-prior match may lower the adaptation windows' mean confidence before fit warns
 # (twin.transfer.prior.confidence_drop).  The middle of the gap in the runs that chose it
 # (BENCHMARKS.md, stop 20): on the balanced benchmark and blind rigs the match cost at most 0.019, on
@@ -177,12 +180,17 @@ class Assessor:
         Torch CPU threads during ``fit`` (determinism does not depend on it, speed does).
     progress : bool
         Progress bars.
-    class_prior : {"source", None}
+    class_prior : {"source", "ordinal", None}
         ``"source"``: after training, offset the stage logits on rig data so that the mean stage
         probabilities of the adaptation windows equal the twin's stage proportions
         (:mod:`twin.transfer.prior`; methods that adapt only).  It assumes the rig's adaptation
         data cover the stages in about the twin's proportions, as the domain normalisation does.
-        ``None``: no offsets.
+        ``"ordinal"``: the same assumption, used along the stage order: a rig window's stage is
+        where its expected stage falls among the quantiles of the adaptation windows' expected
+        stages at the twin's cumulative proportions (:func:`~twin.transfer.prior.ordinal_probabilities`;
+        its confidence, in [0.5, 1], is the distance from the nearest boundary).  Robust to a rig
+        whose damage moves the features by another amount than the twin's; wrong where the rig
+        reverses the order of stages.  ``None``: no match.
 
     Attributes (after ``fit``)
     --------------------------
@@ -202,8 +210,11 @@ class Assessor:
         Logit offsets applied to rig (target-domain) data; zeros without a class-prior match.
     adaptation_stage_counts_ : ndarray (2, K) of int
         Adaptation windows assessed as each stage, without (row 0) and with (row 1) the offsets.
+    ordinal_anchors_ : ndarray (2K - 1,) or None
+        With ``class_prior="ordinal"``: the middles and boundaries of the rig's stages along the
+        expected stage (:func:`~twin.transfer.prior.ordinal_anchors`); ``None`` otherwise.
     class_prior_moved_ : float
-        Share of the adaptation windows whose stage the offsets changed, in [0, 1].
+        Share of the adaptation windows whose stage the match (offsets or ordinal) changed, in [0, 1].
     class_prior_confidence_drop_ : float
         How much the offsets lowered the adaptation windows' mean confidence (largest stage
         probability), in (-1, 1) (:func:`~twin.transfer.prior.confidence_drop`).  Above
@@ -294,7 +305,7 @@ class Assessor:
         if self.contrastive_reduction not in ("mean", "sum"):
             bad("contrastive_reduction", "use 'mean' or 'sum'")
         if self.class_prior not in CLASS_PRIORS:
-            bad("class_prior", "use 'source' or None")
+            bad("class_prior", "use 'source', 'ordinal' or None")
         if self.n_stages is not None and (isinstance(self.n_stages, bool) or not isinstance(self.n_stages, int)
                                           or self.n_stages < 2):
             bad("n_stages", "must be an integer >= 2")
@@ -421,6 +432,7 @@ class Assessor:
             adapt = self.method != "cnn"
             history = []
             self.target_log_weights_ = np.zeros(k)      # the monitor sees the network as trained
+            self.ordinal_anchors_ = None
             bar = progress_bar(self.epochs, self.progress, f"train {self.method}", "epoch")
             t_start = time.perf_counter()
             step = 0
@@ -502,10 +514,13 @@ class Assessor:
         self.classes_ = np.arange(k)
         self.history_ = history
         p_adapt, prior = self._forward(xt)[1], None
-        if adapt and self.class_prior == "source":
-            from twin.transfer.prior import match_class_prior
+        if adapt and self.class_prior is not None:
+            from twin.transfer.prior import match_class_prior, ordinal_anchors
             prior = np.bincount(ys_fixed.astype(np.int64), minlength=k) / ys_fixed.size
-            self.target_log_weights_ = match_class_prior(p_adapt, prior)
+            if self.class_prior == "source":
+                self.target_log_weights_ = match_class_prior(p_adapt, prior)
+            else:
+                self.ordinal_anchors_ = ordinal_anchors(p_adapt, prior)
         self._class_prior_check(p_adapt, prior)
         self.n_source_windows_ = int(n_s)
         self.n_target_windows_ = int(xt.shape[0])
@@ -515,9 +530,20 @@ class Assessor:
         """Record how the offsets re-assess the adaptation windows ``p_adapt`` (n, K); warn when they
         cost the windows much confidence (the symptom of rig data that break the match's assumption;
         a rig that only shifts the boundaries moves the windows the network was unsure of)."""
-        from twin.transfer.prior import confidence_drop, stage_moves
-        self.adaptation_stage_counts_, self.class_prior_moved_ = stage_moves(p_adapt, self.target_log_weights_)
-        self.class_prior_confidence_drop_ = confidence_drop(p_adapt, self.target_log_weights_)
+        from twin.transfer.prior import confidence_drop, match_class_prior, ordinal_probabilities, stage_moves
+        if getattr(self, "ordinal_anchors_", None) is None:
+            self.adaptation_stage_counts_, self.class_prior_moved_ = stage_moves(p_adapt, self.target_log_weights_)
+            self.class_prior_confidence_drop_ = confidence_drop(p_adapt, self.target_log_weights_)
+        else:
+            k = p_adapt.shape[1]
+            before, after = p_adapt.argmax(1), ordinal_probabilities(p_adapt, self.ordinal_anchors_).argmax(1)
+            self.adaptation_stage_counts_ = np.stack([np.bincount(before, minlength=k),
+                                                      np.bincount(after, minlength=k)])
+            self.class_prior_moved_ = float(np.mean(before != after))
+            # The ordinal confidence measures the distance from a boundary, not comparable with the
+            # network's.  Whether the rig data break the proportion assumption is a property of the
+            # data, so the warning reads what the offsets would have cost (they are not applied).
+            self.class_prior_confidence_drop_ = confidence_drop(p_adapt, match_class_prior(p_adapt, prior))
         if prior is not None and class_prior_warns(self.class_prior_confidence_drop_):
             import warnings
             k = p_adapt.shape[1]
@@ -556,6 +582,10 @@ class Assessor:
 
     def _proba_windows(self, x: np.ndarray, domain: str = "target") -> np.ndarray:
         p = self._forward(x)[1]
+        anchors = getattr(self, "ordinal_anchors_", None)
+        if domain == "target" and anchors is not None:
+            from twin.transfer.prior import ordinal_probabilities
+            return ordinal_probabilities(p, anchors)
         w = getattr(self, "target_log_weights_", None)
         if domain == "target" and w is not None and np.any(w != 0):
             from twin.transfer.prior import apply_log_weights
@@ -676,6 +706,8 @@ class Assessor:
                   "source_normaliser": self.source_normaliser_.to_dict(),
                   "target_normaliser": self.target_normaliser_.to_dict(),
                   "target_log_weights": [float(v) for v in self.target_log_weights_],
+                  "ordinal_anchors": (None if getattr(self, "ordinal_anchors_", None) is None
+                                      else [float(v) for v in self.ordinal_anchors_]),
                   "adaptation_stage_counts": (self.adaptation_stage_counts_.tolist()
                                               if hasattr(self, "adaptation_stage_counts_") else None),
                   "class_prior_moved": getattr(self, "class_prior_moved_", None),
@@ -759,6 +791,20 @@ class Assessor:
             raise AssessorError(f"'{cfg_file}': target_log_weights must be {a.n_classes_} finite numbers, "
                                 f"got {weights!r}")
         a.target_log_weights_ = w
+        # written since stop 25; an adapting ordinal assessor cannot assess without them
+        anchors, a.ordinal_anchors_ = cfg.get("ordinal_anchors"), None
+        if a.class_prior == "ordinal" and a.method != "cnn":
+            ok = (isinstance(anchors, list) and len(anchors) == 2 * a.n_classes_ - 1
+                  and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in anchors))
+            arr = np.asarray(anchors, dtype=np.float64) if ok else np.empty(0)
+            if not ok or not np.all(np.isfinite(arr)) or np.any(np.diff(arr) < 0):
+                raise AssessorError(f"'{cfg_file}': class_prior 'ordinal' needs ordinal_anchors, "
+                                    f"{2 * a.n_classes_ - 1} finite non-decreasing numbers; got {anchors!r}")
+            a.ordinal_anchors_ = arr
+        elif anchors is not None:
+            raise AssessorError(f"'{cfg_file}': ordinal_anchors are only read with class_prior 'ordinal' and a "
+                                f"method that adapts; this file has class_prior {a.class_prior!r} and method "
+                                f"{a.method!r}")
         # diagnostics of the match, written since stop 14; an older version-4 file has none
         if cfg.get("class_prior_moved") is not None:
             try:

@@ -26,7 +26,7 @@ def _cmd_train_assessor(args: argparse.Namespace) -> int:
     pre = (transfer.Preprocessing(**settings) if args.shaft_speed is None
            else transfer.Preprocessing.for_shaft_speed(args.shaft_speed, **settings))
     a = transfer.Assessor(args.method, epochs=args.epochs, seed=args.seed, preprocessing=pre,
-                          progress=not args.no_progress, class_prior=None if args.no_class_prior else "source",
+                          progress=not args.no_progress, class_prior=None if args.no_class_prior else args.class_prior,
                           pairs=args.pairs, contrastive_reduction=args.contrastive_reduction)
     from twin.transfer.errors import class_prior_notes
     with class_prior_notes() as notes:
@@ -36,11 +36,16 @@ def _cmd_train_assessor(args: argparse.Namespace) -> int:
     print(f"{args.method}: {a.n_classes_} stages, {a.n_source_windows_} source / {a.n_target_windows_} target "
           f"windows, {len(a.history_)} epochs in {a.fit_time_:.0f} s; last epoch: loss {last['loss']:.3f}, "
           f"source accuracy {100 * last['source_acc']:.1f} % -> {out}")
-    if a.class_prior == "source" and args.method != "cnn":
+    if a.class_prior is not None and args.method != "cnn":
         before, after = (" / ".join(map(str, row)) for row in a.adaptation_stage_counts_)
-        print(f"class-prior match: rig adaptation windows per stage {before} -> {after} "
-              f"({100 * a.class_prior_moved_:.1f} % changed stage; mean confidence "
-              f"{-100 * a.class_prior_confidence_drop_:+.1f} points)")
+        changed = f"{100 * a.class_prior_moved_:.1f} % changed stage"
+        if a.class_prior == "source":
+            print(f"class-prior match: rig adaptation windows per stage {before} -> {after} "
+                  f"({changed}; mean confidence {-100 * a.class_prior_confidence_drop_:+.1f} points)")
+        else:
+            print(f"ordinal class-prior match: rig adaptation windows per stage {before} -> {after} ({changed}); "
+                  f"stage boundaries along the expected stage "
+                  + " ".join(f"{v:.2f}" for v in a.ordinal_anchors_[1::2]))
     for note in notes:
         print(f"warning: {note}")
     return 0
@@ -106,6 +111,10 @@ def add_subcommands(sub) -> None:
     p.add_argument("--target-channel", metavar="NAME",
                    help="the rig's name for that channel, if it differs; saved with the assessor, so `twin assess` "
                         "reads new rig files from it too")
+    p.add_argument("--class-prior", choices=("source", "ordinal"), default="source",
+                   help="how the rig's stage proportions are matched to the archive's: per-stage logit offsets "
+                        "(source, default) or boundaries along the expected stage, which keep only the order of "
+                        "the windows (ordinal; the benchmark's pitting rule, BENCHMARKS.md stop 25)")
     p.add_argument("--no-class-prior", action="store_true",
                    help="do not match the rig's stage proportions to the archive's after training (use it when the "
                         "rig data are mostly one stage, e.g. a run-to-failure history; default: match them)")

@@ -294,6 +294,52 @@ def test_class_prior_offsets_survive_save_and_load_and_version_3_loads_without(f
         Assessor.load(d)
 
 
+def test_ordinal_class_prior_splits_the_rig_by_the_expected_stage_and_survives_save_and_load(
+        tiny_pre, tiny_data, tmp_path):
+    """class_prior="ordinal" leaves the network as class_prior=None trains it; the rig's windows are
+    staged by where their expected stage falls among the adaptation windows' quantiles."""
+    from twin.transfer.prior import expected_stage
+    src, adapt, test = tiny_data
+    a = tiny_assessor("proposed", tiny_pre, seed=3, class_prior="ordinal").fit(src, adapt)
+    plain = tiny_assessor("proposed", tiny_pre, seed=3, class_prior=None).fit(src, adapt)
+    assert np.array_equal(a.target_log_weights_, np.zeros(3)) and a.ordinal_anchors_.shape == (5,)
+    assert plain.ordinal_anchors_ is None
+    x, *_ = a._windows(adapt, "adapt")
+    s_adapt = expected_stage(plain._proba_windows(x))
+    np.testing.assert_allclose(a.ordinal_anchors_, np.quantile(s_adapt, [1 / 6, 1 / 3, 1 / 2, 2 / 3, 5 / 6]))
+    xt, *_ = a._windows(test, "test")
+    s_test = expected_stage(plain._proba_windows(xt))
+    stages = a._proba_windows(xt).argmax(1)
+    assert stages.tolist() == (s_test[:, None] > a.ordinal_anchors_[None, 1::2]).sum(1).tolist()
+    assert a.adaptation_stage_counts_.sum(1).tolist() == [len(x), len(x)]
+    # the twin's own data are never matched
+    np.testing.assert_allclose(a.predict_proba(src, domain="source"), plain.predict_proba(src, domain="source"))
+    d = a.save(tmp_path / "ordinal")
+    back = Assessor.load(d)
+    assert back.class_prior == "ordinal"
+    np.testing.assert_array_equal(back.ordinal_anchors_, a.ordinal_anchors_)
+    np.testing.assert_array_equal(back.predict_proba(test), a.predict_proba(test))
+    cfg = json.loads((d / "config.json").read_text())
+    for bad in (None, [0.1, 0.2], [0.5, 0.4, 0.6, 0.7, 0.8], [0.1, 0.2, "x", 0.4, 0.5]):
+        cfg["ordinal_anchors"] = bad
+        (d / "config.json").write_text(json.dumps(cfg))
+        with pytest.raises(AssessorError, match="class_prior 'ordinal' needs ordinal_anchors"):
+            Assessor.load(d)
+    cfg["ordinal_anchors"], cfg["params"]["class_prior"] = a.ordinal_anchors_.tolist(), "source"
+    (d / "config.json").write_text(json.dumps(cfg))
+    with pytest.raises(AssessorError, match="ordinal_anchors are only read with class_prior 'ordinal'"):
+        Assessor.load(d)
+
+
+def test_source_only_cnn_with_ordinal_class_prior_is_not_matched(tiny_pre, tiny_data, tmp_path):
+    src, adapt, test = tiny_data
+    a = tiny_assessor("cnn", tiny_pre, epochs=1, class_prior="ordinal").fit(src, adapt)
+    assert a.ordinal_anchors_ is None
+    back = Assessor.load(a.save(tmp_path / "cnn"))
+    assert back.ordinal_anchors_ is None
+    np.testing.assert_array_equal(back.predict_proba(test), a.predict_proba(test))
+
+
 def test_class_prior_diagnostics_and_the_warning(tiny_pre, tiny_data, fitted):
     """fit records how the match re-assesses the adaptation windows and warns when it costs them
     much confidence: the tiny rig's gain and hum push stage 0 into stage 1, read with confidence,

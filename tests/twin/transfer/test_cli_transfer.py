@@ -108,21 +108,27 @@ def test_assess_checks_its_json_path_before_it_loads_or_prints_anything(tmp_path
     assert not (tmp_path / "no").exists()
 
 
-def test_no_class_prior_reaches_the_saved_assessor(tmp_path):
+def test_class_prior_choice_reaches_the_saved_assessor(tmp_path, capsys):
     src = _file(tmp_path / "src.h5", False, True)
     tgt = _file(tmp_path / "tgt.h5", True, True)
     p = _parser()
     saved = {}
-    for flag in ([], ["--no-class-prior"]):
-        out = tmp_path / ("plain" if flag else "matched")
+    for name, flag in (("source", []), ("none", ["--no-class-prior"]), ("ordinal", ["--class-prior", "ordinal"])):
+        out = tmp_path / name
         args = p.parse_args(["train-assessor", "--source", str(src), "--target", str(tgt), "--out", str(out),
                              "--epochs", "1", "--method", "mmd", "--no-progress", *flag])
         assert args.handler(args) == 0
-        saved[bool(flag)] = json.loads((out / "config.json").read_text())
-    assert saved[False]["params"]["class_prior"] == "source"
-    assert any(w != 0 for w in saved[False]["target_log_weights"])
-    assert saved[True]["params"]["class_prior"] is None
-    assert saved[True]["target_log_weights"] == [0.0, 0.0]
+        saved[name] = json.loads((out / "config.json").read_text())
+    assert saved["source"]["params"]["class_prior"] == "source"
+    assert any(w != 0 for w in saved["source"]["target_log_weights"]) and saved["source"]["ordinal_anchors"] is None
+    assert saved["none"]["params"]["class_prior"] is None
+    assert saved["none"]["target_log_weights"] == [0.0, 0.0]
+    assert saved["ordinal"]["params"]["class_prior"] == "ordinal"
+    assert saved["ordinal"]["target_log_weights"] == [0.0, 0.0] and len(saved["ordinal"]["ordinal_anchors"]) == 3
+    assert "ordinal class-prior match: rig adaptation windows per stage" in capsys.readouterr().out
+    with pytest.raises(SystemExit):
+        p.parse_args(["train-assessor", "--source", str(src), "--target", str(tgt), "--out", "x",
+                      "--class-prior", "median"])
 
 
 def test_train_assessor_reports_the_class_prior_match_and_warns_on_one_stage_rig_data(tmp_path, capsys):

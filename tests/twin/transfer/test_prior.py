@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from twin.transfer import AssessorError
-from twin.transfer.prior import LOG_WEIGHT_LIMIT, apply_log_weights, confidence_drop, match_class_prior, stage_moves
+from twin.transfer.prior import (LOG_WEIGHT_LIMIT, apply_log_weights, confidence_drop, expected_stage,
+                                 match_class_prior, ordinal_anchors, ordinal_probabilities, stage_moves)
 
 
 def test_identical_windows_give_the_hand_computed_offsets():
@@ -76,3 +77,78 @@ def test_confidence_drop_by_hand():
     assert confidence_drop(p, np.zeros(2)) == 0.0
     with pytest.raises(AssessorError, match=r"confidence drop: .*offsets \(K,\) needed"):
         confidence_drop(p, np.zeros(3))
+
+
+# ---- the ordinal match ------------------------------------------------------------------------
+def _onehot_mix(s: np.ndarray, k: int) -> np.ndarray:
+    """Probabilities (n, K) whose expected stage is ``s``: mass split between floor(s) and floor(s)+1."""
+    lo = np.minimum(np.floor(s).astype(int), k - 2)
+    f = s - lo
+    p = np.zeros((s.size, k))
+    p[np.arange(s.size), lo] = 1 - f
+    p[np.arange(s.size), lo + 1] = f
+    return p
+
+
+def test_ordinal_anchors_are_the_hand_computed_quantiles():
+    # expected stages 0, 0.25, ..., 2 (9 windows), uniform prior over 3 stages:
+    # quantile levels 1/6, 1/3, 1/2, 2/3, 5/6 of 0..2 in steps of 0.25 (linear interpolation)
+    s = np.linspace(0.0, 2.0, 9)
+    a = ordinal_anchors(_onehot_mix(s, 3), np.full(3, 1 / 3))
+    np.testing.assert_allclose(a, np.quantile(s, [1 / 6, 1 / 3, 1 / 2, 2 / 3, 5 / 6]))
+    np.testing.assert_allclose(a, [1 / 3, 2 / 3, 1.0, 4 / 3, 5 / 3])
+    np.testing.assert_allclose(expected_stage(_onehot_mix(s, 3)), s)
+
+
+def test_ordinal_stages_split_the_windows_in_the_prior_and_ignore_the_gain():
+    """A rig whose damage moves the expected stage by a different amount (any increasing map) is
+    read the same: only the order of the windows along the expected stage counts."""
+    rng = np.random.default_rng(1)
+    true = np.repeat(np.arange(4), 50)
+    s_twin = np.clip(true + rng.normal(0, 0.3, true.size), 0, 3)
+    s_rig = 3 * (s_twin / 3) ** 2.5                     # the rig's stages 0-2 read low, all in order
+    prior = np.full(4, 0.25)
+    p_twin, p_rig = _onehot_mix(s_twin, 4), _onehot_mix(s_rig, 4)
+    st_twin = ordinal_probabilities(p_twin, ordinal_anchors(p_twin, prior)).argmax(1)
+    st_rig = ordinal_probabilities(p_rig, ordinal_anchors(p_rig, prior)).argmax(1)
+    assert np.array_equal(st_twin, st_rig)
+    assert np.bincount(st_rig, minlength=4).tolist() == [50, 50, 50, 50]
+    assert np.mean(st_rig == true) > 0.8
+    assert np.mean(p_rig.argmax(1) == true) < 0.6      # the twin's own boundaries fail on the rig
+
+
+def test_ordinal_probabilities_by_hand():
+    # anchors of 2 stages: middle of 0 at 0.2, boundary at 0.5, middle of 1 at 0.9
+    a = np.array([0.2, 0.5, 0.9])
+    p = _onehot_mix(np.array([0.1, 0.2, 0.35, 0.5, 0.7, 0.9, 1.0]), 2)
+    q = ordinal_probabilities(p, a)
+    # c = 0 below the first middle; 0.25 half way to the boundary; the boundary itself stays in
+    # stage 0 (a window must exceed it) at 0.5 / 0.5; 0.75 half way to the next middle; 1 beyond
+    np.testing.assert_allclose(q[:, 1], [0.0, 0.0, 0.25, 0.5, 0.75, 1.0, 1.0])
+    np.testing.assert_allclose(q.sum(1), 1.0)
+    assert q.argmax(1).tolist() == [0, 0, 0, 0, 1, 1, 1]
+    assert np.all(q.max(1) >= 0.5)
+
+
+def test_ordinal_match_with_tied_anchors_keeps_the_count_rule():
+    # most windows saturate at the same expected stage, so quantiles tie
+    s = np.array([0.0, 0.1, 2.0, 2.0, 2.0, 2.0])
+    p = _onehot_mix(s, 3)
+    a = ordinal_anchors(p, np.full(3, 1 / 3))
+    assert np.all(np.diff(a) >= 0)
+    q = ordinal_probabilities(p, a)
+    assert np.all(np.isfinite(q)) and np.allclose(q.sum(1), 1.0)
+    assert q.argmax(1).tolist() == (s[:, None] > a[None, 1::2]).sum(1).tolist()
+
+
+@pytest.mark.parametrize("call, match", [
+    (lambda: ordinal_anchors(np.ones((3, 2)) / 2, np.array([0.5, 0.3, 0.2])), r"shape \(2,\)"),
+    (lambda: ordinal_anchors(np.array([[0.5, np.nan]]), np.array([0.5, 0.5])), "finite"),
+    (lambda: ordinal_anchors(np.ones((3, 2)) / 2, np.array([1.0, 0.0])), r"\[1.0, 0.0\]"),
+    (lambda: ordinal_probabilities(np.ones((3, 2)) / 2, np.array([0.2, 0.5])), "3 finite non-decreasing"),
+    (lambda: ordinal_probabilities(np.ones((3, 2)) / 2, np.array([0.9, 0.5, 0.2])), r"\[0.9, 0.5, 0.2\]"),
+    (lambda: expected_stage(np.ones(4)), r"got shape \(4,\)"),
+])
+def test_ordinal_bad_inputs_are_named(call, match):
+    with pytest.raises(AssessorError, match=match):
+        call()
