@@ -269,7 +269,8 @@ def _transfer_demo(out_dir: Path, epochs: int = 15):
     from dataclasses import replace
 
     from twin.transfer.assessor import Assessor
-    from twin.transfer.benchmark import TASK_SETTINGS, load_task_data, prepare_task, task_preprocessing
+    from twin.transfer.benchmark import (TASK_CLASS_PRIOR, TASK_SETTINGS, load_task_data, prepare_task,
+                                         task_preprocessing)
     from twin.transfer.errors import class_prior_notes
 
     t = time.perf_counter()
@@ -281,7 +282,8 @@ def _transfer_demo(out_dir: Path, epochs: int = 15):
     source, adapt, test = load_task_data("pitting", str(src), str(tgt), pre.sample_rate)
     accuracy, assessed, notes = {}, None, []
     for method in ("cnn", "mmd", "proposed"):
-        a = Assessor(method, epochs=epochs, seed=0, preprocessing=pre, progress=False)
+        a = Assessor(method, epochs=epochs, seed=0, preprocessing=pre, progress=False,
+                     class_prior=TASK_CLASS_PRIOR["pitting"])
         with class_prior_notes() as caught:      # printed below, in the step's layout
             a.fit(source, adapt)
         notes += [f"{method}: {n}" for n in caught]
@@ -289,16 +291,15 @@ def _transfer_demo(out_dir: Path, epochs: int = 15):
         accuracy[method] = asm.window_accuracy
         if method == "proposed":
             assessed = (asm, test)
-            offsets, moved, drop = a.target_log_weights_, a.class_prior_moved_, a.class_prior_confidence_drop_
+            boundaries, moved = a.ordinal_anchors_[1::2], a.class_prior_moved_
             a.save(out_dir / "assessor")
     print(f"[9/9] Wear-stage assessment of rig records (6 pitting stages; the rig has a mount resonance, "
           f"run-out and another sensor the twin lacks; {epochs} epochs, one seed: "
           f"{time.perf_counter() - t:.0f} s)")
     print("      target test accuracy: " + ", ".join(f"{m} {100 * v:.0f} %" for m, v in accuracy.items()))
-    print("      class-prior match (proposed): stage logit offsets "
-          + " ".join(f"{v:+.2f}" for v in offsets) + " balance the rig's stages as in the archive; "
-          f"{100 * moved:.1f} % of the rig's adaptation windows changed stage, their mean confidence "
-          f"{-100 * drop:+.1f} points")
+    print("      ordinal class-prior match (proposed): the rig's stage boundaries along the expected stage, "
+          + " ".join(f"{v:.2f}" for v in boundaries) + ", split its windows in the archive's proportions; "
+          f"{100 * moved:.1f} % of its adaptation windows changed stage (twin.transfer.prior, stop 25)")
     print(f"      each archive record has a pinion of its own: run-out up to {1e6 * settings.source_runout:.0f} um, "
           f"pitting spread over the teeth with a relative sd up to {settings.source_tooth_damage_scatter:.1f}, "
           + (f"pitch errors up to {1e6 * settings.source_pitch_error:.0f} um" if settings.source_pitch_error > 0
@@ -328,7 +329,8 @@ def _independent_rig_demo(data: Path, settings, pre, epochs: int, rig: str) -> f
     from dataclasses import replace
 
     from twin.transfer.assessor import Assessor
-    from twin.transfer.benchmark import RIG_SEEDS, load_task_data, prepare_task, stage_order_scores
+    from twin.transfer.benchmark import (RIG_SEEDS, TASK_CLASS_PRIOR, load_task_data, prepare_task,
+                                         stage_order_scores)
     from twin.transfer.errors import class_prior_notes
     from twin.transfer.report import confusion_matrix
 
@@ -337,7 +339,8 @@ def _independent_rig_demo(data: Path, settings, pre, epochs: int, rig: str) -> f
                     target_record_duration=0.3)
     src, tgt = prepare_task("pitting", data, other, progress=False)
     source, adapt, test = load_task_data("pitting", str(src), str(tgt), pre.sample_rate)
-    a = Assessor("proposed", epochs=epochs, seed=0, preprocessing=pre, progress=False)
+    a = Assessor("proposed", epochs=epochs, seed=0, preprocessing=pre, progress=False,
+                 class_prior=TASK_CLASS_PRIOR["pitting"])
     with class_prior_notes() as caught:
         a.fit(source, adapt)
     asm = a.assess(test)

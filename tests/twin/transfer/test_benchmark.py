@@ -290,3 +290,27 @@ def test_target_ceiling_trains_on_the_rigs_first_halves_and_scores_the_second(tm
     assert acc >= 0.9
     # the rig's labels are what it learns from: labels unrelated to the signals leave it near chance
     assert benchmark.target_ceiling("wear", str(_rig_file(tmp_path, "shuffled.h5", True)), seed=0, epochs=6) < 0.6
+
+
+def test_train_one_uses_each_tasks_class_prior_rule(monkeypatch, tiny_pre, tiny_data):
+    """Pitting is staged by the ordinal match (stop 25), wear by the per-stage offsets."""
+    from twin.transfer import benchmark
+    from twin.transfer.assessor import Assessor
+
+    monkeypatch.setattr(benchmark, "task_preprocessing", lambda task: tiny_pre)
+    monkeypatch.setattr(benchmark, "load_task_data", lambda *args: tiny_data)
+    seen = {}
+    fit = Assessor.fit
+
+    def spy_fit(self, source, target, **kw):
+        out = fit(self, source, target, **kw)
+        seen[self.class_prior] = (self.ordinal_anchors_, self.target_log_weights_)
+        return out
+
+    monkeypatch.setattr(Assessor, "fit", spy_fit)
+    assert set(benchmark.TASK_CLASS_PRIOR) == set(benchmark.TASKS)
+    for task in ("pitting", "wear"):
+        benchmark.train_one(task, "mmd", 0, "s.h5", "t.h5", epochs=2, monitor=False)
+    assert set(seen) == {"ordinal", "source"}
+    assert seen["ordinal"][0].shape == (5,) and not np.any(seen["ordinal"][1])
+    assert seen["source"][0] is None and np.any(seen["source"][1])
