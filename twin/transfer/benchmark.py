@@ -230,7 +230,9 @@ def prepare_task(task: str, data_dir: str | Path, settings: DataSettings | None 
         make_target_domain(sc, tgt, records_per_stage=settings.target_records_per_stage,
                            record_duration=settings.target_record_duration, seed=settings.target_seed,
                            shift=rig, run=run, fmu_path=fmu, progress=progress)
-    key.write_text(wanted)
+    from twin._atomic import atomic_path
+    with atomic_path(key) as tmp:       # a torn key would only force a rebuild, but never leave one
+        Path(tmp).write_text(wanted)
     return src, tgt
 
 
