@@ -527,9 +527,10 @@ class Assessor:
         return self
 
     def _class_prior_check(self, p_adapt: np.ndarray, prior: np.ndarray | None) -> None:
-        """Record how the offsets re-assess the adaptation windows ``p_adapt`` (n, K); warn when they
-        cost the windows much confidence (the symptom of rig data that break the match's assumption;
-        a rig that only shifts the boundaries moves the windows the network was unsure of)."""
+        """Record how the match (offsets or ordinal) re-assesses the adaptation windows ``p_adapt``
+        (n, K); warn when the offsets cost the windows much confidence (the symptom of rig data that
+        break the match's assumption; a rig that only shifts the boundaries moves the windows the
+        network was unsure of)."""
         from twin.transfer.prior import confidence_drop, match_class_prior, ordinal_probabilities, stage_moves
         if getattr(self, "ordinal_anchors_", None) is None:
             self.adaptation_stage_counts_, self.class_prior_moved_ = stage_moves(p_adapt, self.target_log_weights_)

@@ -111,11 +111,12 @@ def add_subcommands(sub) -> None:
     p.add_argument("--target-channel", metavar="NAME",
                    help="the rig's name for that channel, if it differs; saved with the assessor, so `twin assess` "
                         "reads new rig files from it too")
-    p.add_argument("--class-prior", choices=("source", "ordinal"), default="source",
+    match = p.add_mutually_exclusive_group()
+    match.add_argument("--class-prior", choices=("source", "ordinal"), default="source",
                    help="how the rig's stage proportions are matched to the archive's: per-stage logit offsets "
                         "(source, default) or boundaries along the expected stage, which keep only the order of "
                         "the windows (ordinal; the benchmark's pitting rule, BENCHMARKS.md stop 25)")
-    p.add_argument("--no-class-prior", action="store_true",
+    match.add_argument("--no-class-prior", action="store_true",
                    help="do not match the rig's stage proportions to the archive's after training (use it when the "
                         "rig data are mostly one stage, e.g. a run-to-failure history; default: match them)")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bars")

@@ -33,7 +33,7 @@ proportions.  Only the order of the windows along ``s`` matters, not where the t
 lie, so a rig whose damage moves the vibration features the same way as the twin's but by a
 different amount is read right.  The per-stage offsets above can move each boundary on its own
 but keep the twin's scale.  Measured (BENCHMARKS.md, stop 25; pitting, proposed method, seeds 0-4):
-the lumped rig, whose stages keep their order (rank correlation 0.9), goes from 23 % to 59 %; the
+the lumped rig, whose stages keep their order (rank correlation 0.8-0.9), goes from 23 % to 59 %; the
 LTCA rig, which reads its last stage below its fifth, falls from 26 % to 20 %; the benchmark rigs
 stay within their scatter.
 """

@@ -129,6 +129,9 @@ def test_class_prior_choice_reaches_the_saved_assessor(tmp_path, capsys):
     with pytest.raises(SystemExit):
         p.parse_args(["train-assessor", "--source", str(src), "--target", str(tgt), "--out", "x",
                       "--class-prior", "median"])
+    with pytest.raises(SystemExit):      # one or the other, not a silent winner
+        p.parse_args(["train-assessor", "--source", str(src), "--target", str(tgt), "--out", "x",
+                      "--class-prior", "ordinal", "--no-class-prior"])
 
 
 def test_train_assessor_reports_the_class_prior_match_and_warns_on_one_stage_rig_data(tmp_path, capsys):
