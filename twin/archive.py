@@ -374,11 +374,13 @@ def tooth_error_bounds(scenario: Scenario, keys: tuple = TOOTH_ERROR_KEYS) -> tu
     return tuple(bounds)
 
 
-def pinion_teeth(fmu_path) -> int:
-    """Number of ``tooth_deviation_offset[i]`` parameters of the FMU; SimulationError if it has none."""
+def _parameter_names(fmu_path) -> set[str]:
     from twin.fmu import FMU
     with FMU(fmu_path) as fmu:
-        names = {v.name for v in fmu.parameters}
+        return {v.name for v in fmu.parameters}
+
+
+def _pinion_teeth(names: set[str], fmu_path) -> int:
     teeth = sum(1 for n in names if n.startswith("tooth_deviation_offset["))
     if teeth == 0 or any(f"tooth_stiffness_factor[{i}]" not in names for i in range(1, teeth + 1)):
         raise SimulationError(f"the FMU {fmu_path} has no per-tooth parameters (tooth_deviation_offset[i], "
@@ -387,17 +389,24 @@ def pinion_teeth(fmu_path) -> int:
     return teeth
 
 
-def wheel_teeth(fmu_path) -> int:
-    """Number of ``wheel_tooth_deviation_offset[i]`` parameters of the FMU; SimulationError if none."""
-    from twin.fmu import FMU
-    with FMU(fmu_path) as fmu:
-        teeth = sum(1 for v in fmu.parameters if v.name.startswith("wheel_tooth_deviation_offset["))
+def _wheel_teeth(names: set[str], fmu_path) -> int:
+    teeth = sum(1 for n in names if n.startswith("wheel_tooth_deviation_offset["))
     if teeth == 0:
         raise SimulationError(f"the FMU {fmu_path} has no per-gear-tooth parameters "
                               f"(wheel_tooth_deviation_offset[i]); remove {', '.join(WHEEL_ERROR_KEYS)} from the "
                               "archive block or use a model that has them, such as "
                               "fmu: GearTwin.Variants.Gearbox21WheelErrors")
     return teeth
+
+
+def pinion_teeth(fmu_path) -> int:
+    """Number of ``tooth_deviation_offset[i]`` parameters of the FMU; SimulationError if it has none."""
+    return _pinion_teeth(_parameter_names(fmu_path), fmu_path)
+
+
+def wheel_teeth(fmu_path) -> int:
+    """Number of ``wheel_tooth_deviation_offset[i]`` parameters of the FMU; SimulationError if none."""
+    return _wheel_teeth(_parameter_names(fmu_path), fmu_path)
 
 
 def nominal_operating_point(scenario: Scenario) -> tuple[float, float]:
@@ -447,8 +456,10 @@ def build_archive(scenario: Scenario, output: str | Path | None = None, *, progr
     # the gear checks come before the degradation run, which takes a while
     gear_bounds = tooth_error_bounds(scenario)
     wheel_bounds = tooth_error_bounds(scenario, WHEEL_ERROR_KEYS)
-    teeth = pinion_teeth(fmu_file) if any(b > 0 for b in gear_bounds) else 0
-    z_wheel = wheel_teeth(fmu_file) if any(b > 0 for b in wheel_bounds) else 0
+    pinion_errors, wheel_errors = any(b > 0 for b in gear_bounds), any(b > 0 for b in wheel_bounds)
+    names = _parameter_names(fmu_file) if pinion_errors or wheel_errors else set()    # the FMU opened once
+    teeth = _pinion_teeth(names, fmu_file) if pinion_errors else 0
+    z_wheel = _wheel_teeth(names, fmu_file) if wheel_errors else 0
     if z_wheel and round(float(scenario.parameters.get("z2", z_wheel))) != z_wheel:
         raise ScenarioError([(str(scenario.source), "parameters.z2",
                               f"the FMU's gear has {z_wheel} teeth (wheel_tooth_deviation_offset), "

@@ -69,6 +69,15 @@ CLASS_PRIOR_WARN_DROP = 0.04
 _EVAL_BATCH = 256
 
 
+def _finite_numbers(value, n: int) -> np.ndarray | None:
+    """A saved list of ``n`` finite numbers as an array (n,); None for anything else."""
+    if not (isinstance(value, list) and len(value) == n
+            and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)):
+        return None
+    arr = np.asarray(value, dtype=np.float64)
+    return arr if np.all(np.isfinite(arr)) else None
+
+
 def class_prior_warns(confidence_drop: float) -> bool:
     """``fit``'s rule: does a class-prior match that cost this much mean confidence warn?"""
     return confidence_drop > CLASS_PRIOR_WARN_DROP
@@ -785,20 +794,16 @@ class Assessor:
         a.source_normaliser_, a.target_normaliser_ = norms
         # version 4 always writes the offsets: a file without them is damaged, not "no offsets"
         weights = cfg.get("target_log_weights") if version >= 4 else [0.0] * a.n_classes_
-        ok = isinstance(weights, list) and all(isinstance(v, (int, float)) and not isinstance(v, bool)
-                                               for v in weights)
-        w = np.asarray(weights, dtype=np.float64) if ok else np.empty(0)
-        if w.shape != (a.n_classes_,) or not np.all(np.isfinite(w)):
+        w = _finite_numbers(weights, a.n_classes_)
+        if w is None:
             raise AssessorError(f"'{cfg_file}': target_log_weights must be {a.n_classes_} finite numbers, "
                                 f"got {weights!r}")
         a.target_log_weights_ = w
         # written since stop 25; an adapting ordinal assessor cannot assess without them
         anchors, a.ordinal_anchors_ = cfg.get("ordinal_anchors"), None
         if a.class_prior == "ordinal" and a.method != "cnn":
-            ok = (isinstance(anchors, list) and len(anchors) == 2 * a.n_classes_ - 1
-                  and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in anchors))
-            arr = np.asarray(anchors, dtype=np.float64) if ok else np.empty(0)
-            if not ok or not np.all(np.isfinite(arr)) or np.any(np.diff(arr) < 0):
+            arr = _finite_numbers(anchors, 2 * a.n_classes_ - 1)
+            if arr is None or np.any(np.diff(arr) < 0):
                 raise AssessorError(f"'{cfg_file}': class_prior 'ordinal' needs ordinal_anchors, "
                                     f"{2 * a.n_classes_ - 1} finite non-decreasing numbers; got {anchors!r}")
             a.ordinal_anchors_ = arr

@@ -84,14 +84,8 @@ def match_class_prior(proba: np.ndarray, prior: np.ndarray, *, tol: float = 1e-6
         Shapes that do not match, non-finite or negative probabilities, a prior that is not a
         distribution with every stage > 0.
     """
-    p = np.asarray(proba, dtype=np.float64)
-    pi = np.asarray(prior, dtype=np.float64)
-    if p.ndim != 2 or p.shape[0] < 1 or pi.shape != (p.shape[1],):
-        raise AssessorError(f"class prior: probabilities (n, K) and a prior (K,) needed, got {p.shape} and {pi.shape}")
-    if not np.all(np.isfinite(p)) or np.any(p < 0):
-        raise AssessorError("class prior: probabilities must be finite and >= 0")
-    if not np.all(np.isfinite(pi)) or np.any(pi <= 0) or not np.isclose(pi.sum(), 1.0, atol=1e-9):
-        raise AssessorError(f"class prior: the prior must be > 0 for every stage and sum to 1, got {pi.tolist()}")
+    p = _check_proba("class prior", proba)
+    pi = _check_prior("class prior", p, prior)
     p = np.maximum(p, 1e-300)
     log_w = np.zeros(p.shape[1])
     for _ in range(max_iter):
@@ -105,11 +99,22 @@ def match_class_prior(proba: np.ndarray, prior: np.ndarray, *, tol: float = 1e-6
 
 def _check_proba(what: str, proba) -> np.ndarray:
     p = np.asarray(proba, dtype=np.float64)
-    if p.ndim != 2 or p.shape[0] < 1 or p.shape[1] < 2:
-        raise AssessorError(f"{what}: probabilities (n, K) with n >= 1 and K >= 2 needed, got shape {p.shape}")
+    if p.ndim != 2 or p.shape[0] < 1:
+        raise AssessorError(f"{what}: probabilities (n, K) with n >= 1 needed, got shape {p.shape}")
     if not np.all(np.isfinite(p)) or np.any(p < 0):
         raise AssessorError(f"{what}: probabilities must be finite and >= 0")
     return p
+
+
+def _check_prior(what: str, p: np.ndarray, prior) -> np.ndarray:
+    """``prior`` as an array (K,) for probabilities ``p`` (n, K): finite, every stage > 0, sum 1."""
+    pi = np.asarray(prior, dtype=np.float64)
+    if pi.shape != (p.shape[1],):
+        raise AssessorError(f"{what}: probabilities (n, K) and a prior of shape ({p.shape[1]},) needed, "
+                            f"got {p.shape} and {pi.shape}")
+    if not np.all(np.isfinite(pi)) or np.any(pi <= 0) or not np.isclose(pi.sum(), 1.0, atol=1e-9):
+        raise AssessorError(f"{what}: the prior must be > 0 for every stage and sum to 1, got {pi.tolist()}")
+    return pi
 
 
 def expected_stage(proba: np.ndarray) -> np.ndarray:
@@ -117,7 +122,10 @@ def expected_stage(proba: np.ndarray) -> np.ndarray:
 
     ``proba`` (n, K): stage probabilities (rows sum to 1).
     """
-    p = _check_proba("expected stage", proba)
+    return _expected(_check_proba("expected stage", proba))
+
+
+def _expected(p: np.ndarray) -> np.ndarray:
     return p @ np.arange(p.shape[1], dtype=np.float64)
 
 
@@ -145,16 +153,12 @@ def ordinal_anchors(proba: np.ndarray, prior: np.ndarray) -> np.ndarray:
         distribution with every stage > 0.
     """
     p = _check_proba("ordinal match", proba)
-    pi = np.asarray(prior, dtype=np.float64)
-    if pi.shape != (p.shape[1],):
-        raise AssessorError(f"ordinal match: a prior of shape ({p.shape[1]},) needed, got {pi.shape}")
-    if not np.all(np.isfinite(pi)) or np.any(pi <= 0) or not np.isclose(pi.sum(), 1.0, atol=1e-9):
-        raise AssessorError(f"ordinal match: the prior must be > 0 for every stage and sum to 1, got {pi.tolist()}")
+    pi = _check_prior("ordinal match", p, prior)
     upper = np.cumsum(pi)
     levels = np.empty(2 * pi.size - 1)
     levels[0::2] = upper - pi / 2
     levels[1::2] = upper[:-1]
-    return np.maximum.accumulate(np.quantile(expected_stage(p), np.clip(levels, 0.0, 1.0)))
+    return np.maximum.accumulate(np.quantile(_expected(p), np.clip(levels, 0.0, 1.0)))
 
 
 def ordinal_probabilities(proba: np.ndarray, anchors: np.ndarray) -> np.ndarray:
@@ -179,7 +183,7 @@ def ordinal_probabilities(proba: np.ndarray, anchors: np.ndarray) -> np.ndarray:
     a = np.asarray(anchors, dtype=np.float64)
     if a.shape != (2 * k - 1,) or not np.all(np.isfinite(a)) or np.any(np.diff(a) < 0):
         raise AssessorError(f"ordinal match: {2 * k - 1} finite non-decreasing anchors needed, got {a.tolist()}")
-    s = expected_stage(p)
+    s = _expected(p)
     stage = (s[:, None] > a[None, 1::2]).sum(axis=1)
     # piecewise-linear map; a zero-width segment (tied quantiles) takes its upper end
     i = np.clip(np.searchsorted(a, s, side="right") - 1, 0, a.size - 2)
