@@ -1,6 +1,6 @@
 """Command-line handlers of the transfer-learning assessor (wired into ``twin`` by twin/cli.py).
 
-``add_subcommands(sub)`` registers ``train-assessor``, ``assess`` and ``benchmark-transfer`` on the
+``add_subcommands(sub)`` registers ``train-assessor``, ``assess``, ``agreement`` and ``benchmark-transfer`` on the
 ``twin`` sub-parser object.  Handlers only parse and print; the work lives in
 :mod:`twin.transfer`, imported inside each handler so ``twin --help`` stays free of torch.
 """
@@ -71,6 +71,49 @@ def _cmd_assess(args: argparse.Namespace) -> int:
     return 0
 
 
+def _same_network(a, b) -> bool:
+    """Whether two fitted assessors carry identical network weights (fit is deterministic)."""
+    import torch
+    sa, sb = a.network_.state_dict(), b.network_.state_dict()
+    return sa.keys() == sb.keys() and all(torch.equal(sa[k], sb[k]) for k in sa)
+
+
+def _cmd_agreement(args: argparse.Namespace) -> int:
+    transfer = _lib("twin.transfer")
+    from twin.transfer.errors import AssessorError
+    from twin.transfer.reliability import agreement
+    if args.json:
+        from twin._atomic import check_parent
+        check_parent(args.json)
+    if args.worst < 0:
+        raise AssessorError(f"agreement: --worst must be >= 0, got {args.worst}")
+    if len(args.assessors) < 2:
+        raise AssessorError(f"agreement: at least 2 assessors needed, got {len(args.assessors)}")
+    loaded = [transfer.Assessor.load(Path(d)) for d in args.assessors]
+    for i in range(len(loaded)):
+        for j in range(i):
+            if _same_network(loaded[i], loaded[j]):
+                raise AssessorError(f"agreement: '{args.assessors[j]}' and '{args.assessors[i]}' hold the same network "
+                                    "(the same settings, seed and data), so their agreement says nothing; train "
+                                    "another with a different --seed")
+    res = agreement([a.assess(Path(args.measurements)) for a in loaded])
+    print(f"{res.n_assessors} assessors, {res.n_records} records, {res.n_windows} windows: the same stage on "
+          f"{100 * res.window_agreement:.1f} % of windows (pairs {100 * min(min(r) for r in res.pairwise):.1f}-"
+          f"{100 * max(v for i, r in enumerate(res.pairwise) for j, v in enumerate(r) if i != j):.1f} %) and "
+          f"{100 * res.record_agreement:.1f} % of records")
+    print(f"so their mean window accuracy on these data is at most {100 * res.accuracy_bound:.1f} %, whatever the true "
+          "stages (agreement is necessary for accuracy, not sufficient: members can agree and all be wrong)")
+    worst = sorted(zip(res.per_record, res.record_names))[:args.worst]
+    for g, name in worst:
+        print(f"  {name}: windows agree {100 * g:.1f} %")
+    if args.json:
+        from twin._atomic import atomic_path
+        with atomic_path(Path(args.json)) as tmp:
+            Path(tmp).write_text(json.dumps({"assessors": list(args.assessors), **res.to_dict()}, indent=1))
+        print(f"agreement -> {args.json}")
+    return 0
+
+
 def _cmd_benchmark_transfer(args: argparse.Namespace) -> int:
     bench = _lib("twin.transfer.benchmark")
     tasks = ("pitting", "wear") if args.task == "both" else (args.task,)
@@ -83,7 +126,7 @@ def _cmd_benchmark_transfer(args: argparse.Namespace) -> int:
 
 
 def add_subcommands(sub) -> None:
-    """Register ``train-assessor``, ``assess`` and ``benchmark-transfer`` on ``sub``
+    """Register ``train-assessor``, ``assess``, ``agreement`` and ``benchmark-transfer`` on ``sub``
     (the object returned by ``parser.add_subparsers``)."""
     p = sub.add_parser("train-assessor", help="train the transfer-learning wear assessor (twin -> rig)")
     p.add_argument("--source", required=True, help="labelled source archive HDF5 (twin archive)")
@@ -127,6 +170,15 @@ def add_subcommands(sub) -> None:
     p.add_argument("measurements", metavar="MEASUREMENTS", help="measurement HDF5 (or CSV + sidecar)")
     p.add_argument("--json", help="write stage and confidence per record and per window to this JSON file")
     p.set_defaults(handler=_cmd_assess)
+
+    p = sub.add_parser("agreement", help="how often assessors trained with other seeds agree on measurements "
+                                         "(no labels needed): an upper bound on their accuracy")
+    p.add_argument("assessors", metavar="ASSESSOR", nargs="+",
+                   help="two or more directories written by train-assessor (same data, other --seed)")
+    p.add_argument("measurements", metavar="MEASUREMENTS", help="measurement HDF5 (or CSV + sidecar)")
+    p.add_argument("--worst", type=int, default=5, help="records with the least agreement to list (default: 5)")
+    p.add_argument("--json", help="write the agreement (pairwise and per record) to this JSON file")
+    p.set_defaults(handler=_cmd_agreement)
 
     p = sub.add_parser("benchmark-transfer", help="CNN vs MMD vs proposed on twin -> emulated rig, over seeds")
     p.add_argument("--out", required=True, help="output directory (results.json, summary.md, report.html)")

@@ -193,3 +193,44 @@ def test_target_channel_reaches_the_saved_assessor_and_assess(tmp_path):
     args = p.parse_args(["assess", str(tmp_path / "model"), str(tgt), "--json", str(tmp_path / "stages.json")])
     assert args.handler(args) == 0
     assert len(json.loads((tmp_path / "stages.json").read_text())["records"]) == 6
+
+
+def test_agreement_of_two_seeds_and_its_refusals(tmp_path, capsys):
+    from twin.transfer.errors import AssessorError
+
+    src = _file(tmp_path / "src.h5", False, True)
+    tgt = _file(tmp_path / "tgt.h5", True, False)
+    p = _parser()
+    for seed in (0, 1):
+        args = p.parse_args(["train-assessor", "--source", str(src), "--target", str(tgt), "--out",
+                             str(tmp_path / f"seed{seed}"), "--epochs", "1", "--method", "cnn", "--seed", str(seed),
+                             "--no-progress"])
+        assert args.handler(args) == 0
+    capsys.readouterr()
+    out = tmp_path / "agree.json"
+    args = p.parse_args(["agreement", str(tmp_path / "seed0"), str(tmp_path / "seed1"), str(tgt), "--json", str(out),
+                         "--worst", "2"])
+    assert args.handler(args) == 0
+    saved = json.loads(out.read_text())
+    assert saved["assessors"] == [str(tmp_path / "seed0"), str(tmp_path / "seed1")]
+    assert saved["n_assessors"] == 2 and saved["n_records"] == 6 and len(saved["records"]) == 6
+    # the same figure the library gives from the two assessments
+    from twin.transfer import Assessor
+    from twin.transfer.reliability import agreement
+    res = agreement([Assessor.load(tmp_path / f"seed{s}").assess(tgt) for s in (0, 1)])
+    assert saved["window_agreement"] == pytest.approx(res.window_agreement)
+    assert saved["accuracy_bound"] == pytest.approx((1 + res.window_agreement) / 2)
+    printed = capsys.readouterr().out
+    assert f"at most {100 * res.accuracy_bound:.1f} %" in printed
+    assert sum(line.startswith("  s") for line in printed.splitlines()) == 2       # --worst 2
+    # the same network twice says nothing; one assessor is not an agreement; nothing is written
+    out.unlink()
+    for bad, message in (([str(tmp_path / "seed0"), str(tmp_path / "seed0")], "same network"),
+                         ([str(tmp_path / "seed0")], "at least 2 assessors")):
+        args = p.parse_args(["agreement", *bad, str(tgt), "--json", str(out)])
+        with pytest.raises(AssessorError, match=message):
+            args.handler(args)
+        assert not out.exists()
+    args = p.parse_args(["agreement", str(tmp_path / "seed0"), str(tmp_path / "seed1"), str(tgt), "--worst", "-1"])
+    with pytest.raises(AssessorError, match="--worst must be >= 0, got -1"):
+        args.handler(args)
