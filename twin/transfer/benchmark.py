@@ -280,6 +280,7 @@ class RunResult:
     history: list
     embedding: dict = field(default_factory=dict)     # features for t-SNE (first seed only)
     class_prior_drop: float | None = None   # fit's class_prior_confidence_drop_; None without a match (CNN)
+    window_stages: tuple = ()       # (n_windows,) assessed stage of each target test window, record by record
 
 
 def train_one(task: str, method: str, seed: int, source: str, target: str, epochs: int = 80,
@@ -307,7 +308,8 @@ def train_one(task: str, method: str, seed: int, source: str, target: str, epoch
     return RunResult(task, method, seed, float(np.mean(y == p)), float(asm.record_accuracy),
                      float(src_acc), float(a.fit_time_), confusion_matrix(y, p, a.n_classes_).tolist(),
                      a.history_, emb,
-                     a.class_prior_confidence_drop_ if method != "cnn" and a.class_prior is not None else None)
+                     a.class_prior_confidence_drop_ if method != "cnn" and a.class_prior is not None else None,
+                     tuple(int(v) for v in p))
 
 
 def source_ceiling(task: str, source: str, seed: int, epochs: int = 80) -> float:
@@ -378,7 +380,7 @@ def summarise(results: list[RunResult]) -> dict:
                        "spearman_mean": float(np.nanmean([o[1] for o in order])) if any(
                            np.isfinite(o[1]) for o in order) else float("nan"),
                        "fit_time_mean": float(t.mean()), "fit_time_max": float(t.max()),
-                       "class_prior_warnings": _warnings(rs)}
+                       "class_prior_warnings": _warnings(rs), "seed_agreement": _seed_agreement(rs)}
         pairs = {}
         for a, b in (("cnn", "mmd"), ("mmd", "proposed"), ("cnn", "proposed")):
             if a in rows and b in rows and rows[a]["seeds"] == rows[b]["seeds"]:
@@ -388,6 +390,16 @@ def summarise(results: list[RunResult]) -> dict:
                                      "paired_t_p": p}
         out[task] = {"methods": rows, "paired": pairs}
     return out
+
+
+def _seed_agreement(runs: list[RunResult]) -> float | None:
+    """Mean pairwise share of target test windows that two seeds assess alike
+    (:mod:`twin.transfer.reliability`); None with fewer than two seeds or without the stages."""
+    from twin.transfer.reliability import mean_agreement
+    stages = [r.window_stages for r in runs]
+    if len(stages) < 2 or not stages[0] or any(len(s) != len(stages[0]) for s in stages):
+        return None
+    return mean_agreement(np.array(stages, dtype=np.int64))
 
 
 def _warnings(runs: list[RunResult]) -> int | None:
@@ -421,19 +433,22 @@ def stage_order_scores(confusion) -> tuple[float, float]:
 def markdown_table(summary: dict) -> str:
     """The figures as a Markdown table (accuracy in %, mean +- std over seeds)."""
     lines = ["| task | method | target test windows [%] | target test records [%] | source (train) [%] | "
-             "fit time mean / max [s] | within one stage [%] | rank correlation | class-prior warnings |",
-             "|---|---|---|---|---|---|---|---|---|"]
+             "fit time mean / max [s] | within one stage [%] | rank correlation | class-prior warnings | "
+             "seed agreement [%] (accuracy bound) |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
     for task, s in summary.items():
         for m, r in s["methods"].items():
             # summaries written before the stage-order columns lack them
             within, rho = r.get("within_one_mean", float("nan")), r.get("spearman_mean", float("nan"))
             warned = r.get("class_prior_warnings")      # absent before stop 20, None without a match
             warned = "n/a" if warned is None else f"{warned}/{len(r['seeds'])}"
+            agree = r.get("seed_agreement")     # absent before stop 26, None with one seed
+            agree = "n/a" if agree is None else f"{100 * agree:.1f} ({100 * (1 + agree) / 2:.1f})"
             lines.append(f"| {task} | {m} | {100 * r['mean']:.1f} +- {100 * r['std']:.1f} | "
                          f"{100 * r['record_mean']:.1f} +- {100 * r['record_std']:.1f} | "
                          f"{100 * r['source_acc_mean']:.1f} | {r['fit_time_mean']:.0f} / {r['fit_time_max']:.0f} | "
                          f"{'n/a' if np.isnan(within) else f'{100 * within:.1f}'} | "
-                         f"{'n/a' if np.isnan(rho) else f'{rho:.2f}'} | {warned} |")
+                         f"{'n/a' if np.isnan(rho) else f'{rho:.2f}'} | {warned} | {agree} |")
     lines += ["", "| task | comparison | mean gain [points] | seeds won | paired t-test p |", "|---|---|---|---|---|"]
     for task, s in summary.items():
         for k, d in s["paired"].items():

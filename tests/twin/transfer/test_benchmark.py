@@ -82,7 +82,8 @@ def test_summarise_pairs_methods_by_seed():
     table = markdown_table(summarise(runs))
     assert "| wear | mmd | 91.3 +- 1.5 |" in table and "| wear | proposed-mmd | +0.7 | 2/3 |" in table
     rows = {line.split(" | ")[1]: line for line in table.splitlines() if line.startswith("| wear | ")}
-    assert rows["cnn"].endswith("| n/a |") and rows["mmd"].endswith("| 0/3 |") and rows["proposed"].endswith("| 2/3 |")
+    assert rows["cnn"].endswith("| n/a | n/a |") and rows["mmd"].endswith("| 0/3 | n/a |")
+    assert rows["proposed"].endswith("| 2/3 | n/a |")
 
 
 def test_the_report_draws_its_figures_from_the_runs_first_seed(tmp_path, monkeypatch):
@@ -143,6 +144,18 @@ def test_stage_order_scores_tell_one_stage_late_from_random():
         stage_order_scores([[1, 2, 3]])
     runs = [RunResult("wear", "mmd", s, 0.25, 0.25, 1.0, 1.0, late, []) for s in range(2)]
     assert "| 100.0 | 0.95 |" in markdown_table(summarise(runs))
+
+
+def test_summary_reads_the_seeds_agreement_on_the_rig_windows():
+    stages = [(0, 1, 2, 2), (0, 1, 1, 2), (1, 1, 1, 2)]      # pairs agree on 3/4, 2/4, 3/4 of the windows
+    runs = [RunResult("wear", "mmd", s, 0.5, 0.5, 1.0, 1.0, [[1]], [], window_stages=w) for s, w in enumerate(stages)]
+    s = summarise(runs)["wear"]["methods"]["mmd"]
+    assert s["seed_agreement"] == pytest.approx(2 / 3)
+    assert markdown_table(summarise(runs)).splitlines()[2].endswith("| 66.7 (83.3) |")
+    # one seed, or runs without stages (results written before stop 26): no figure
+    assert summarise(runs[:1])["wear"]["methods"]["mmd"]["seed_agreement"] is None
+    assert summarise([_run("mmd", s, 0.5) for s in range(2)])["wear"]["methods"]["mmd"]["seed_agreement"] is None
+    assert markdown_table(summarise(runs[:1])).splitlines()[2].endswith("| n/a |")
 
 
 def test_the_archive_gets_each_tasks_tooth_errors(tmp_path, monkeypatch):
