@@ -294,6 +294,7 @@ def _transfer_demo(out_dir: Path, epochs: int = 15):
             boundaries, moved = a.ordinal_anchors_[1::2], a.class_prior_moved_
             a.save(out_dir / "assessor")
             accuracy["proposed, offsets"] = _offsets_accuracy(a, source, adapt, test)
+            agreed = _seed_agreement(a, source, adapt, asm, test)
     print(f"[9/9] Wear-stage assessment of rig records (6 pitting stages; the rig has a mount resonance, "
           f"run-out and another sensor the twin lacks; {epochs} epochs, one seed: "
           f"{time.perf_counter() - t:.0f} s)")
@@ -305,6 +306,10 @@ def _transfer_demo(out_dir: Path, epochs: int = 15):
           f"{100 * moved:.1f} % of its adaptation windows changed stage (twin.transfer.prior, stop 25). "
           "It needs a well-trained network and many rig windows: here (15 epochs, 108 windows) it can "
           "lose to the offsets; at 80 epochs and 270 windows it does not (BENCHMARKS.md, stop 25)")
+    print(f"      without labels: a second seed of the proposed method gives {100 * agreed.window_agreement:.0f} % of "
+          f"the rig's test windows the same stage, so the two read at most {100 * agreed.accuracy_bound:.0f} % "
+          "of them right (twin agreement; low agreement proves a transfer unreliable, high agreement does not "
+          "prove it right: twin.transfer.reliability)")
     print(f"      each archive record has a pinion of its own: run-out up to {1e6 * settings.source_runout:.0f} um, "
           f"pitting spread over the teeth with a relative sd up to {settings.source_tooth_damage_scatter:.1f}, "
           + (f"pitch errors up to {1e6 * settings.source_pitch_error:.0f} um" if settings.source_pitch_error > 0
@@ -320,6 +325,19 @@ def _transfer_demo(out_dir: Path, epochs: int = 15):
     for rig in ("lumped", "ltca"):
         accuracy[rig] = _independent_rig_demo(data, settings, pre, epochs, rig)
     return accuracy
+
+
+def _seed_agreement(fitted, source, adapt, assessed, test):
+    """:class:`twin.transfer.reliability.Agreement` of ``fitted`` (whose assessment of ``test`` is
+    ``assessed``) and the same assessor trained with the next seed: what a user without labels sees."""
+    from twin.transfer.assessor import Assessor
+    from twin.transfer.errors import class_prior_notes
+    from twin.transfer.reliability import agreement
+
+    other = Assessor(**{**fitted.get_params(), "seed": fitted.seed + 1})
+    with class_prior_notes():       # its warnings are not the demo's subject
+        other.fit(source, adapt)
+    return agreement([assessed, other.assess(test)])
 
 
 def _offsets_accuracy(fitted, source, adapt, test) -> float:
@@ -360,10 +378,13 @@ def _independent_rig_demo(data: Path, settings, pre, epochs: int, rig: str) -> f
     within, _ = stage_order_scores(confusion_matrix(*asm.window_verdicts(), a.n_classes_))
     with class_prior_notes():       # the same warning again, already caught above
         offsets = _offsets_accuracy(a, source, adapt, test)
+    agreed = _seed_agreement(a, source, adapt, asm, test)
     what, where = _INDEPENDENT_RIGS[rig]
     print(f"      another simulator of the gearbox ({what}; {time.perf_counter() - t:.0f} s): "
           f"proposed {100 * asm.window_accuracy:.0f} % exact, {100 * within:.0f} % within one stage; "
-          f"{100 * offsets:.0f} % with the per-stage offsets (5 seeds and why: BENCHMARKS.md, {where})")
+          f"{100 * offsets:.0f} % with the per-stage offsets (5 seeds and why: BENCHMARKS.md, {where}); "
+          f"two seeds agree on {100 * agreed.window_agreement:.0f} % of windows (accuracy at most "
+          f"{100 * agreed.accuracy_bound:.0f} %)")
     for note in caught:
         print(f"      warning: {note}")
     return asm.window_accuracy
