@@ -294,7 +294,7 @@ def _transfer_demo(out_dir: Path, epochs: int = 15):
             boundaries, moved = a.ordinal_anchors_[1::2], a.class_prior_moved_
             a.save(out_dir / "assessor")
             accuracy["proposed, offsets"] = _offsets_accuracy(a, source, adapt, test)
-            agreed = _seed_agreement(a, source, adapt, asm, test)
+            agreed = _seed_agreement(a, source, adapt, test)
     print(f"[9/9] Wear-stage assessment of rig records (6 pitting stages; the rig has a mount resonance, "
           f"run-out and another sensor the twin lacks; {epochs} epochs, one seed: "
           f"{time.perf_counter() - t:.0f} s)")
@@ -327,17 +327,17 @@ def _transfer_demo(out_dir: Path, epochs: int = 15):
     return accuracy
 
 
-def _seed_agreement(fitted, source, adapt, assessed, test):
-    """:class:`twin.transfer.reliability.Agreement` of ``fitted`` (whose assessment of ``test`` is
-    ``assessed``) and the same assessor trained with the next seed: what a user without labels sees."""
+def _seed_agreement(fitted, source, adapt, test):
+    """:class:`twin.transfer.reliability.Agreement` on ``test`` of ``fitted`` and the same assessor
+    trained with the next seed: what a user without labels can check."""
     from twin.transfer.assessor import Assessor
     from twin.transfer.errors import class_prior_notes
-    from twin.transfer.reliability import agreement
+    from twin.transfer.reliability import assessor_agreement
 
     other = Assessor(**{**fitted.get_params(), "seed": fitted.seed + 1})
     with class_prior_notes():       # its warnings are not the demo's subject
         other.fit(source, adapt)
-    return agreement([assessed, other.assess(test)])
+    return assessor_agreement([fitted, other], test)
 
 
 def _offsets_accuracy(fitted, source, adapt, test) -> float:
@@ -378,7 +378,7 @@ def _independent_rig_demo(data: Path, settings, pre, epochs: int, rig: str) -> f
     within, _ = stage_order_scores(confusion_matrix(*asm.window_verdicts(), a.n_classes_))
     with class_prior_notes():       # the same warning again, already caught above
         offsets = _offsets_accuracy(a, source, adapt, test)
-    agreed = _seed_agreement(a, source, adapt, asm, test)
+    agreed = _seed_agreement(a, source, adapt, test)
     what, where = _INDEPENDENT_RIGS[rig]
     print(f"      another simulator of the gearbox ({what}; {time.perf_counter() - t:.0f} s): "
           f"proposed {100 * asm.window_accuracy:.0f} % exact, {100 * within:.0f} % within one stage; "

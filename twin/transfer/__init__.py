@@ -8,7 +8,8 @@ from __future__ import annotations
 
 import importlib
 
-_WHERE = {"Agreement": "reliability", "agreement": "reliability", "METHODS": "assessor", "Assessment": "assessor", "Assessor": "assessor", "RecordAssessment": "assessor",
+_WHERE = {"METHODS": "assessor", "Assessment": "assessor", "Assessor": "assessor", "RecordAssessment": "assessor",
+          "Agreement": "reliability", "agreement": "reliability", "assessor_agreement": "reliability",
           "TargetShift": "domain", "make_target_domain": "domain", "AssessorError": "errors",
           "ClassPriorWarning": "errors",
           "Augmentation": "preprocess", "Preprocessing": "preprocess", "split_records": "preprocess"}

@@ -71,17 +71,12 @@ def _cmd_assess(args: argparse.Namespace) -> int:
     return 0
 
 
-def _same_network(a, b) -> bool:
-    """Whether two fitted assessors carry identical network weights (fit is deterministic)."""
-    import torch
-    sa, sb = a.network_.state_dict(), b.network_.state_dict()
-    return sa.keys() == sb.keys() and all(torch.equal(sa[k], sb[k]) for k in sa)
-
-
 def _cmd_agreement(args: argparse.Namespace) -> int:
     transfer = _lib("twin.transfer")
+    import numpy as np
+
     from twin.transfer.errors import AssessorError
-    from twin.transfer.reliability import agreement
+    from twin.transfer.reliability import assessor_agreement
     if args.json:
         from twin._atomic import check_parent
         check_parent(args.json)
@@ -90,22 +85,17 @@ def _cmd_agreement(args: argparse.Namespace) -> int:
     if len(args.assessors) < 2:
         raise AssessorError(f"agreement: at least 2 assessors needed, got {len(args.assessors)}")
     loaded = [transfer.Assessor.load(Path(d)) for d in args.assessors]
-    for i in range(len(loaded)):
-        for j in range(i):
-            if _same_network(loaded[i], loaded[j]):
-                raise AssessorError(f"agreement: '{args.assessors[j]}' and '{args.assessors[i]}' hold the same network "
-                                    "(the same settings, seed and data), so their agreement says nothing; train "
-                                    "another with a different --seed")
-    res = agreement([a.assess(Path(args.measurements)) for a in loaded])
+    res = assessor_agreement(loaded, Path(args.measurements), names=args.assessors)
+    g = np.array(res.pairwise)
+    off = g[~np.eye(len(g), dtype=bool)]
     print(f"{res.n_assessors} assessors, {res.n_records} records, {res.n_windows} windows: the same stage on "
-          f"{100 * res.window_agreement:.1f} % of windows (pairs {100 * min(min(r) for r in res.pairwise):.1f}-"
-          f"{100 * max(v for i, r in enumerate(res.pairwise) for j, v in enumerate(r) if i != j):.1f} %) and "
+          f"{100 * res.window_agreement:.1f} % of windows (pairs {100 * off.min():.1f}-{100 * off.max():.1f} %) and "
           f"{100 * res.record_agreement:.1f} % of records")
     print(f"so their mean window accuracy on these data is at most {100 * res.accuracy_bound:.1f} %, whatever the true "
           "stages (agreement is necessary for accuracy, not sufficient: members can agree and all be wrong)")
     worst = sorted(zip(res.per_record, res.record_names))[:args.worst]
-    for g, name in worst:
-        print(f"  {name}: windows agree {100 * g:.1f} %")
+    for share, name in worst:
+        print(f"  {name}: windows agree {100 * share:.1f} %")
     if args.json:
         from twin._atomic import atomic_path
         with atomic_path(Path(args.json)) as tmp:

@@ -79,3 +79,22 @@ def test_assessments_that_do_not_line_up_are_refused_by_name():
         pairwise_agreement([[0.5, 1.0], [0.0, 1.0]])
     with pytest.raises(AssessorError, match="no record"):
         agreement([Assessment((), 3, None, None)] * 2)
+
+
+def test_assessor_agreement_assesses_and_refuses_the_same_network(tiny_pre, tiny_data):
+    from twin.transfer.assessor import Assessor
+
+    source, adapt, test = tiny_data
+    fits = [Assessor("cnn", epochs=2, seed=s, preprocessing=tiny_pre, progress=False).fit(source, adapt)
+            for s in (0, 1, 0)]
+    from twin.transfer.reliability import assessor_agreement
+    res = assessor_agreement(fits[:2], test)
+    assert res == agreement([fits[0].assess(test), fits[1].assess(test)])
+    with pytest.raises(AssessorError, match="assessor 0 and assessor 2 hold the same network"):
+        assessor_agreement(fits, test)
+    with pytest.raises(AssessorError, match="'a' and 'c' hold the same network"):
+        assessor_agreement(fits, test, names=["a", "b", "c"])
+    with pytest.raises(AssessorError, match="2 names for 3 assessors"):
+        assessor_agreement(fits, test, names=["a", "b"])
+    with pytest.raises(AssessorError, match="at least 2 assessors"):
+        assessor_agreement(fits[:1], test)
