@@ -188,7 +188,7 @@ def assessor_agreement(assessors: Sequence, data, names: Sequence[str] | None = 
     Raises
     ------
     AssessorError
-        Fewer than two assessors, or two that hold the same network (identical weights: ``fit`` is
+        Fewer than two assessors, one that is not fitted, or two that hold the same network (identical weights: ``fit`` is
         deterministic, so the same settings, seed and data give the same network, and their
         agreement of 1 says nothing), named by their position; or assessments that do not line up
         (:func:`agreement`).
@@ -201,6 +201,9 @@ def assessor_agreement(assessors: Sequence, data, names: Sequence[str] | None = 
     names = [f"assessor {i}" for i in range(len(items))] if names is None else [f"'{n}'" for n in names]
     if len(names) != len(items):
         raise AssessorError(f"agreement: {len(names)} names for {len(items)} assessors")
+    unfitted = [n for a, n in zip(items, names) if getattr(a, "network_", None) is None]
+    if unfitted:
+        raise AssessorError(f"agreement: {unfitted[0]} is not a fitted assessor (call fit, or Assessor.load)")
     weights = [a.network_.state_dict() for a in items]
     for i, j in itertools.combinations(range(len(items)), 2):
         if weights[i].keys() == weights[j].keys() and all(torch.equal(weights[i][k], weights[j][k])

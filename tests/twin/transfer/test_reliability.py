@@ -98,3 +98,5 @@ def test_assessor_agreement_assesses_and_refuses_the_same_network(tiny_pre, tiny
         assessor_agreement(fits, test, names=["a", "b"])
     with pytest.raises(AssessorError, match="at least 2 assessors"):
         assessor_agreement(fits[:1], test)
+    with pytest.raises(AssessorError, match="'b' is not a fitted assessor"):
+        assessor_agreement([fits[0], Assessor("cnn")], test, names=["a", "b"])
