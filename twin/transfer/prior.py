@@ -38,7 +38,7 @@ LTCA rig, which reads its last stage below its fifth, falls from 26 % to 20 %; t
 stay within their scatter.  The quantiles put exactly the prior's share into each stage, so they
 need the adaptation windows balanced more strictly than the offsets do: with the stages off by the
 sampling scatter of 180 windows (about +-17 % each) the emulated rigs read 87 % instead of 97 %,
-where the offsets lose 2-3 points (BENCHMARKS.md, stop 26).
+where the offsets lose 2-4 points (BENCHMARKS.md, stop 26).
 """
 from __future__ import annotations
 
