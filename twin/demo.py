@@ -293,7 +293,7 @@ def _transfer_demo(out_dir: Path, epochs: int = 15):
             assessed = (asm, test)
             boundaries, moved = a.ordinal_anchors_[1::2], a.class_prior_moved_
             a.save(out_dir / "assessor")
-            accuracy["proposed, offsets"] = _offsets_accuracy(a, source, adapt, test)
+            accuracy["proposed, offsets"] = _offsets_accuracy(a, adapt, test)
             agreed = _seed_agreement(a, source, adapt, test)
     print(f"[9/9] Wear-stage assessment of rig records (6 pitting stages; the rig has a mount resonance, "
           f"run-out and another sensor the twin lacks; {epochs} epochs, one seed: "
@@ -340,12 +340,10 @@ def _seed_agreement(fitted, source, adapt, test):
     return assessor_agreement([fitted, other], test)
 
 
-def _offsets_accuracy(fitted, source, adapt, test) -> float:
+def _offsets_accuracy(fitted, adapt, test) -> float:
     """Window accuracy of ``fitted``'s network with the per-stage logit offsets instead of its own
-    class-prior rule: the same settings and seed retrain the same network (fit is deterministic)."""
-    from twin.transfer.assessor import Assessor
-
-    return Assessor(**{**fitted.get_params(), "class_prior": "source"}).fit(source, adapt).score(test)
+    class-prior rule (:meth:`~twin.transfer.assessor.Assessor.rematch`: the same network, no retraining)."""
+    return fitted.rematch(adapt, "source").score(test)
 
 
 # what each simulator that is not the twin is, for the demo's line
@@ -377,7 +375,7 @@ def _independent_rig_demo(data: Path, settings, pre, epochs: int, rig: str) -> f
     asm = a.assess(test)
     within, _ = stage_order_scores(confusion_matrix(*asm.window_verdicts(), a.n_classes_))
     with class_prior_notes():       # the same warning again, already caught above
-        offsets = _offsets_accuracy(a, source, adapt, test)
+        offsets = _offsets_accuracy(a, adapt, test)
     agreed = _seed_agreement(a, source, adapt, test)
     what, where = _INDEPENDENT_RIGS[rig]
     print(f"      another simulator of the gearbox ({what}; {time.perf_counter() - t:.0f} s): "

@@ -6,6 +6,7 @@
     a = Assessor(method="proposed", seed=0).fit("archive.h5", "rig.h5")   # rig labels never read
     a.predict("rig_new.h5")            # stage per record; a.assess(...) adds confidences per window
     a.save("assessor/"); Assessor.load("assessor/").predict(...)        # identical numbers
+    a.rematch("rig.h5", class_prior=None)   # the same network staged without the class-prior match
 
 Methods (``method=``):
 
@@ -215,6 +216,9 @@ class Assessor:
         waveform scale [channel unit], or the mean log spectrum (window,) and the shared scale.
     fit_time_ : float
         Wall time of the training loop [s].
+    source_prior_ : ndarray (K,)
+        The twin's stage proportions in the source windows, which every class-prior match aims at
+        (kept so that :meth:`rematch` can fit another rule without retraining).
     target_log_weights_ : ndarray (K,)
         Logit offsets applied to rig (target-domain) data; zeros without a class-prior match.
     adaptation_stage_counts_ : ndarray (2, K) of int
@@ -522,18 +526,78 @@ class Assessor:
         self.n_classes_ = k
         self.classes_ = np.arange(k)
         self.history_ = history
-        p_adapt, prior = self._forward(xt)[1], None
-        if adapt and self.class_prior is not None:
-            from twin.transfer.prior import match_class_prior, ordinal_anchors
-            prior = np.bincount(ys_fixed.astype(np.int64), minlength=k) / ys_fixed.size
+        self.source_prior_ = np.bincount(ys_fixed.astype(np.int64), minlength=k) / ys_fixed.size
+        self._fit_match(self._forward(xt)[1])
+        self.n_source_windows_ = int(n_s)
+        self.n_target_windows_ = int(xt.shape[0])
+        return self
+
+    def rematch(self, target_unlabelled, class_prior: str | None) -> "Assessor":
+        """A copy of this fitted assessor that stages rig data by another class-prior rule.
+
+        The network, the normalisers and the history are shared; only the match is fitted anew, on
+        the rig's unlabelled adaptation data (the ``target_unlabelled`` given to :meth:`fit`).
+        ``fit`` trains the same network under every rule (the match comes after training), so with
+        the data ``fit`` saw the copy is what ``fit(..., class_prior=class_prior)`` would have given,
+        bit for bit, in the time of one forward pass instead of a training run.  The use: ``fit``
+        warned that the match cost confidence (rig data far from the twin's stage proportions, a
+        run-to-failure history say), and the rig is to be staged with ``class_prior=None`` or the
+        other rule, without retraining.
+
+        Parameters
+        ----------
+        target_unlabelled : records, HDF5/CSV path, or windows (n, window)
+            The rig's adaptation data; labels, if any, are not read.
+        class_prior : {"source", "ordinal", None}
+            The rule, as for the constructor.
+
+        Returns
+        -------
+        Assessor
+            A new fitted assessor; this one is unchanged.
+
+        Raises
+        ------
+        AssessorError
+            Not fitted; an unknown rule; a match asked of the source-only CNN (it reads no rig data);
+            an assessor loaded from a file written before ``source_prior_`` was saved (retrain it).
+
+        Warns
+        -----
+        ClassPriorWarning
+            As :meth:`fit`, when the offsets would cost the adaptation windows much confidence.
+        """
+        import copy
+
+        self._check_fitted()
+        if class_prior not in CLASS_PRIORS:
+            raise AssessorError(f"rematch: class_prior={class_prior!r} is invalid: use 'source', 'ordinal' or None")
+        if self.method == "cnn" and class_prior is not None:
+            raise AssessorError(f"rematch: class_prior={class_prior!r} asks the source-only CNN to read rig data; "
+                                "it matches nothing (use class_prior=None, or a method that adapts)")
+        if class_prior is not None and getattr(self, "source_prior_", None) is None:
+            raise AssessorError("rematch: this assessor has no record of the twin's stage proportions "
+                                "(source_prior_; assessors saved before it was written lack it): retrain it with "
+                                f"class_prior={class_prior!r}")
+        x, *_ = self._windows(target_unlabelled, "rematch", "target")
+        new = copy.copy(self)
+        new.class_prior = class_prior
+        new._fit_match(self._forward(x)[1])
+        return new
+
+    def _fit_match(self, p_adapt: np.ndarray) -> None:
+        """Fit this assessor's class-prior rule to the adaptation windows' network probabilities
+        ``p_adapt`` (n, K), and record its diagnostics (:meth:`_class_prior_check`)."""
+        from twin.transfer.prior import match_class_prior, ordinal_anchors
+        self.target_log_weights_, self.ordinal_anchors_ = np.zeros(p_adapt.shape[1]), None
+        prior = None
+        if self.method != "cnn" and self.class_prior is not None:
+            prior = self.source_prior_
             if self.class_prior == "source":
                 self.target_log_weights_ = match_class_prior(p_adapt, prior)
             else:
                 self.ordinal_anchors_ = ordinal_anchors(p_adapt, prior)
         self._class_prior_check(p_adapt, prior)
-        self.n_source_windows_ = int(n_s)
-        self.n_target_windows_ = int(xt.shape[0])
-        return self
 
     def _class_prior_check(self, p_adapt: np.ndarray, prior: np.ndarray | None) -> None:
         """Record how the match (offsets or ordinal) re-assesses the adaptation windows ``p_adapt``
@@ -565,10 +629,12 @@ class Assessor:
                 f"another stage. Unmatched, they read as stages 0..{k - 1}: {counts}; the match assumes the "
                 f"proportions {', '.join(f'{v:.2f}' for v in prior)}. It had to push windows the network was sure "
                 f"of into other stages. Either the rig's data do not cover the stages in those proportions (a "
-                f"run-to-failure history, say): retrain with class_prior=None (twin train-assessor "
-                f"--no-class-prior); or the rig's records do not fall into the twin's stages, and no setting "
-                f"here fixes that: compare the model with the rig (twin compare, twin diagnose).",
-                ClassPriorWarning, stacklevel=3)
+                f"run-to-failure history, say): stage them without the match, no retraining needed "
+                f"(rematch(rig, class_prior=None); twin rematch ASSESSOR RIG --class-prior none --out DIR; "
+                f"or twin train-assessor --no-class-prior); or the rig's records do not fall into the twin's "
+                f"stages, and no setting here fixes that: compare the model with the rig (twin compare, "
+                f"twin diagnose).",
+                ClassPriorWarning, stacklevel=4)
 
     # ---- inference ------------------------------------------------------------------------------
     def _check_fitted(self) -> None:
@@ -715,6 +781,8 @@ class Assessor:
                   "fit_time": getattr(self, "fit_time_", None),
                   "source_normaliser": self.source_normaliser_.to_dict(),
                   "target_normaliser": self.target_normaliser_.to_dict(),
+                  "source_prior": (None if getattr(self, "source_prior_", None) is None
+                                   else [float(v) for v in self.source_prior_]),
                   "target_log_weights": [float(v) for v in self.target_log_weights_],
                   "ordinal_anchors": (None if getattr(self, "ordinal_anchors_", None) is None
                                       else [float(v) for v in self.ordinal_anchors_]),
@@ -799,6 +867,14 @@ class Assessor:
             raise AssessorError(f"'{cfg_file}': target_log_weights must be {a.n_classes_} finite numbers, "
                                 f"got {weights!r}")
         a.target_log_weights_ = w
+        # written since stop 28 (for rematch); an older file has none and can only be retrained
+        prior, a.source_prior_ = cfg.get("source_prior"), None
+        if prior is not None:
+            arr = _finite_numbers(prior, a.n_classes_)
+            if arr is None or np.any(arr <= 0) or not np.isclose(arr.sum(), 1.0, atol=1e-9):
+                raise AssessorError(f"'{cfg_file}': source_prior must be {a.n_classes_} numbers > 0 that sum to 1, "
+                                    f"got {prior!r}")
+            a.source_prior_ = arr
         # written since stop 25; an adapting ordinal assessor cannot assess without them
         anchors, a.ordinal_anchors_ = cfg.get("ordinal_anchors"), None
         if a.class_prior == "ordinal" and a.method != "cnn":

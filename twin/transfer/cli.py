@@ -1,7 +1,7 @@
 """Command-line handlers of the transfer-learning assessor (wired into ``twin`` by twin/cli.py).
 
-``add_subcommands(sub)`` registers ``train-assessor``, ``assess``, ``agreement`` and ``benchmark-transfer`` on the
-``twin`` sub-parser object.  Handlers only parse and print; the work lives in
+``add_subcommands(sub)`` registers ``train-assessor``, ``rematch``, ``assess``, ``agreement`` and
+``benchmark-transfer`` on the ``twin`` sub-parser object.  Handlers only parse and print; the work lives in
 :mod:`twin.transfer`, imported inside each handler so ``twin --help`` stays free of torch.
 """
 from __future__ import annotations
@@ -36,7 +36,14 @@ def _cmd_train_assessor(args: argparse.Namespace) -> int:
     print(f"{args.method}: {a.n_classes_} stages, {a.n_source_windows_} source / {a.n_target_windows_} target "
           f"windows, {len(a.history_)} epochs in {a.fit_time_:.0f} s; last epoch: loss {last['loss']:.3f}, "
           f"source accuracy {100 * last['source_acc']:.1f} % -> {out}")
-    if a.class_prior is not None and args.method != "cnn":
+    _print_match(a, notes)
+    return 0
+
+
+def _print_match(a, notes) -> None:
+    """What the class-prior match of the fitted assessor ``a`` did to the rig's adaptation windows,
+    and the warnings ``notes`` caught while it was fitted, one 'warning:' line each."""
+    if a.class_prior is not None and a.method != "cnn":
         before, after = (" / ".join(map(str, row)) for row in a.adaptation_stage_counts_)
         changed = f"{100 * a.class_prior_moved_:.1f} % changed stage"
         if a.class_prior == "source":
@@ -48,6 +55,25 @@ def _cmd_train_assessor(args: argparse.Namespace) -> int:
                   + " ".join(f"{v:.2f}" for v in a.ordinal_anchors_[1::2]))
     for note in notes:
         print(f"warning: {note}")
+
+
+def _cmd_rematch(args: argparse.Namespace) -> int:
+    transfer = _lib("twin.transfer")
+    from twin.errors import OutputPathError
+    from twin.transfer.errors import class_prior_notes
+    src, out = Path(args.assessor), Path(args.out)
+    if not out.parent.is_dir():
+        raise OutputPathError(f"output directory '{out.parent}' does not exist (for '{out}')")
+    if out.resolve() == src.resolve():      # the assessor with its old rule is not to be lost
+        raise OutputPathError(f"--out '{out}' is the assessor being re-matched; give a new directory")
+    rule = None if args.class_prior == "none" else args.class_prior
+    a = transfer.Assessor.load(src)
+    with class_prior_notes() as notes:
+        b = a.rematch(Path(args.target), rule)
+    b.save(out)
+    print(f"{a.method}: class prior {a.class_prior or 'none'} -> {b.class_prior or 'none'}, the same network, "
+          f"{b.adaptation_stage_counts_.sum(1)[0]} rig adaptation windows -> {out}")
+    _print_match(b, notes)
     return 0
 
 
@@ -116,8 +142,8 @@ def _cmd_benchmark_transfer(args: argparse.Namespace) -> int:
 
 
 def add_subcommands(sub) -> None:
-    """Register ``train-assessor``, ``assess``, ``agreement`` and ``benchmark-transfer`` on ``sub``
-    (the object returned by ``parser.add_subparsers``)."""
+    """Register ``train-assessor``, ``rematch``, ``assess``, ``agreement`` and ``benchmark-transfer`` on
+    ``sub`` (the object returned by ``parser.add_subparsers``)."""
     p = sub.add_parser("train-assessor", help="train the transfer-learning wear assessor (twin -> rig)")
     p.add_argument("--source", required=True, help="labelled source archive HDF5 (twin archive)")
     p.add_argument("--target", required=True, help="unlabelled rig measurements HDF5 (labels are ignored)")
@@ -154,6 +180,17 @@ def add_subcommands(sub) -> None:
                         "rig data are mostly one stage, e.g. a run-to-failure history; default: match them)")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bars")
     p.set_defaults(handler=_cmd_train_assessor)
+
+    p = sub.add_parser("rematch", help="stage the rig by another class-prior rule without retraining (a copy of "
+                                       "the assessor with the same network)")
+    p.add_argument("assessor", metavar="ASSESSOR", help="directory written by train-assessor")
+    p.add_argument("target", metavar="TARGET", help="the rig's unlabelled adaptation data given to train-assessor "
+                                                    "(HDF5, or CSV + sidecar)")
+    p.add_argument("--class-prior", choices=("source", "ordinal", "none"), required=True,
+                   help="per-stage logit offsets (source), boundaries along the expected stage (ordinal), or no "
+                        "match (none: for rig data far from the archive's stage proportions)")
+    p.add_argument("--out", required=True, help="new directory for the re-matched assessor (not ASSESSOR)")
+    p.set_defaults(handler=_cmd_rematch)
 
     p = sub.add_parser("assess", help="assess the wear stage of measurements with a trained assessor")
     p.add_argument("assessor", metavar="ASSESSOR", help="directory written by train-assessor")

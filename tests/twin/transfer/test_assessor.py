@@ -450,3 +450,67 @@ def test_a_rig_channel_of_another_name_is_read_as_the_twins(tiny_pre, tiny_data,
     with pytest.raises(MeasurementError, match="no channel 'accel_x'"):
         a.predict(test)                                     # rig data must carry the rig's name
     assert a.predict_proba(src, domain="source").shape == (len(src), 3)   # twin data keep theirs
+
+
+def test_rematch_gives_what_fit_gives_under_the_other_rule(tiny_pre, tiny_data, fitted):
+    """fit trains the same network under every rule, so re-matching a fitted assessor on the data fit
+    saw must equal fitting with the other rule, bit for bit; the original is left as it was."""
+    src, adapt, test = tiny_data
+    weights = fitted.target_log_weights_.copy()
+    np.testing.assert_array_equal(fitted.source_prior_, np.full(3, 1 / 3))
+    for rule in ("ordinal", None):
+        direct = tiny_assessor("proposed", tiny_pre, seed=3, class_prior=rule).fit(src, adapt)
+        re = fitted.rematch(adapt, rule)
+        assert re.class_prior == rule and re is not fitted
+        np.testing.assert_array_equal(re.target_log_weights_, direct.target_log_weights_)
+        if rule == "ordinal":
+            np.testing.assert_array_equal(re.ordinal_anchors_, direct.ordinal_anchors_)
+        else:
+            assert re.ordinal_anchors_ is None and not np.any(re.target_log_weights_)
+        np.testing.assert_array_equal(re.adaptation_stage_counts_, direct.adaptation_stage_counts_)
+        assert re.class_prior_moved_ == direct.class_prior_moved_
+        np.testing.assert_array_equal(re.predict_proba(test), direct.predict_proba(test))
+    assert fitted.class_prior == "source" and fitted.ordinal_anchors_ is None
+    np.testing.assert_array_equal(fitted.target_log_weights_, weights)
+    back = fitted.rematch(adapt, "ordinal").rematch(adapt, "source")      # and back again
+    np.testing.assert_array_equal(back.target_log_weights_, weights)
+
+
+def test_rematch_warns_as_fit_does(fitted, tiny_data):
+    from twin.transfer.errors import ClassPriorWarning
+    _, adapt, _ = tiny_data
+    with pytest.warns(ClassPriorWarning, match="rematch\\(rig, class_prior=None\\)"):
+        fitted.rematch(adapt, "source")
+
+
+def test_rematch_after_save_and_load_and_its_typed_errors(tiny_pre, tiny_data, fitted, tmp_path):
+    src, adapt, test = tiny_data
+    d = fitted.save(tmp_path / "a")
+    back = Assessor.load(d)
+    np.testing.assert_array_equal(back.source_prior_, fitted.source_prior_)
+    np.testing.assert_array_equal(back.rematch(adapt, "ordinal").predict_proba(test),
+                                  fitted.rematch(adapt, "ordinal").predict_proba(test))
+    with pytest.raises(AssessorError, match="not fitted"):
+        Assessor(preprocessing=tiny_pre).rematch(adapt, None)
+    with pytest.raises(AssessorError, match="class_prior='median'"):
+        fitted.rematch(adapt, "median")
+    cnn = tiny_assessor("cnn", tiny_pre, epochs=1).fit(src, adapt)
+    with pytest.raises(AssessorError, match="source-only CNN"):
+        cnn.rematch(adapt, "source")
+    assert cnn.rematch(adapt, None).class_prior is None
+    with pytest.raises(MeasurementError, match="no channel"):
+        fitted.rematch(make_records(2, shifted=True, labelled=False, channel="accel_x"), None)
+    cfg = json.loads((d / "config.json").read_text())
+    for bad in ([0.5, 0.5], [0.5, 0.5, 0.5], [0.0, 0.5, 0.5], [0.2, "x", 0.8]):
+        cfg["source_prior"] = bad
+        (d / "config.json").write_text(json.dumps(cfg))
+        with pytest.raises(AssessorError, match=r"source_prior must be 3 numbers > 0 that sum to 1, got \["):
+            Assessor.load(d)
+    del cfg["source_prior"]                                  # saved before stop 28
+    (d / "config.json").write_text(json.dumps(cfg))
+    old = Assessor.load(d)
+    assert old.source_prior_ is None
+    np.testing.assert_array_equal(old.predict_proba(test), fitted.predict_proba(test))
+    assert old.rematch(adapt, None).class_prior is None      # dropping the match needs no proportions
+    with pytest.raises(AssessorError, match="retrain it with class_prior='ordinal'"):
+        old.rematch(adapt, "ordinal")

@@ -236,3 +236,43 @@ def test_agreement_of_two_seeds_and_its_refusals(tmp_path, capsys):
     args = p.parse_args(["agreement", str(tmp_path / "seed0"), str(tmp_path / "seed1"), str(tgt), "--worst", "-1"])
     with pytest.raises(AssessorError, match="--worst must be >= 0, got -1"):
         args.handler(args)
+
+
+def test_rematch_stages_the_rig_by_another_rule_without_retraining(tmp_path, capsys):
+    from twin.errors import OutputPathError
+    from twin.transfer import Assessor
+    src = _file(tmp_path / "src.h5", False, True)
+    tgt = _file(tmp_path / "tgt.h5", True, False)
+    p = _parser()
+    base = ["--source", str(src), "--target", str(tgt), "--epochs", "1", "--method", "mmd", "--no-progress"]
+    for name, flag in (("source", []), ("ordinal", ["--class-prior", "ordinal"])):
+        args = p.parse_args(["train-assessor", *base, "--out", str(tmp_path / name), *flag])
+        assert args.handler(args) == 0
+    capsys.readouterr()
+    args = p.parse_args(["rematch", str(tmp_path / "source"), str(tgt), "--class-prior", "ordinal",
+                         "--out", str(tmp_path / "re")])
+    assert args.handler(args) == 0
+    out = capsys.readouterr().out
+    assert "mmd: class prior source -> ordinal, the same network" in out
+    assert "ordinal class-prior match: rig adaptation windows per stage" in out
+    re, direct = (json.loads((tmp_path / d / "config.json").read_text()) for d in ("re", "ordinal"))
+    assert re["params"]["class_prior"] == "ordinal" and re["ordinal_anchors"] == direct["ordinal_anchors"]
+    import torch
+    w_re, w_src = (torch.load(tmp_path / d / "weights.pt", weights_only=True) for d in ("re", "source"))
+    assert w_re.keys() == w_src.keys() and all(torch.equal(w_re[k], w_src[k]) for k in w_re)
+    args = p.parse_args(["rematch", str(tmp_path / "re"), str(tgt), "--class-prior", "none",
+                         "--out", str(tmp_path / "none")])
+    assert args.handler(args) == 0
+    assert "class prior ordinal -> none" in capsys.readouterr().out
+    assert Assessor.load(tmp_path / "none").class_prior is None
+    # the assessor being re-matched is never overwritten, and a bad --out is refused before any work
+    before = (tmp_path / "source" / "config.json").read_bytes()
+    for out_dir, match in ((tmp_path / "source", "is the assessor being re-matched"),
+                           (tmp_path / "no" / "re", "does not exist")):
+        args = p.parse_args(["rematch", str(tmp_path / "source"), str(tgt), "--class-prior", "none",
+                             "--out", str(out_dir)])
+        with pytest.raises(OutputPathError, match=match):
+            args.handler(args)
+    assert (tmp_path / "source" / "config.json").read_bytes() == before
+    with pytest.raises(SystemExit):
+        p.parse_args(["rematch", str(tmp_path / "source"), str(tgt), "--class-prior", "median", "--out", "x"])
