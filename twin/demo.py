@@ -299,8 +299,8 @@ def _transfer_demo(out_dir: Path, epochs: int = 15):
           f"run-out and another sensor the twin lacks; {epochs} epochs, one seed: "
           f"{time.perf_counter() - t:.0f} s)")
     print("      target test accuracy: " + ", ".join(f"{m} {100 * accuracy[m]:.0f} %" for m in ("cnn", "mmd", "proposed"))
-          + f" (the same proposed network staged by per-stage logit offsets instead: "
-            f"{100 * accuracy['proposed, offsets']:.0f} %)")
+          + f" (the same proposed network staged by per-stage logit offsets instead, re-matched without "
+            f"retraining by twin rematch: {100 * accuracy['proposed, offsets']:.0f} %)")
     print("      ordinal class-prior match (proposed): the rig's stage boundaries along the expected stage, "
           + " ".join(f"{v:.2f}" for v in boundaries) + ", split its windows in the archive's proportions; "
           f"{100 * moved:.1f} % of its adaptation windows changed stage (twin.transfer.prior, stop 25). "
