@@ -305,6 +305,8 @@ def test_target_ceiling_trains_on_the_rigs_first_halves_and_scores_the_second(tm
     assert benchmark.target_ceiling("wear", str(_rig_file(tmp_path, "shuffled.h5", True)), seed=0, epochs=6) < 0.6
 
 
+# two epochs leave the tiny rig's windows in one stage, so the match warns; the warning is not tested here
+@pytest.mark.filterwarnings("ignore::twin.transfer.errors.ClassPriorWarning")
 def test_train_one_uses_each_tasks_class_prior_rule(monkeypatch, tiny_pre, tiny_data):
     """Pitting is staged by the ordinal match (stop 25), wear by the per-stage offsets."""
     from twin.transfer import benchmark
