@@ -560,7 +560,8 @@ class Assessor:
         ------
         AssessorError
             Not fitted; an unknown rule; a match asked of the source-only CNN (it reads no rig data);
-            an assessor loaded from a file written before ``source_prior_`` was saved (retrain it).
+            a match asked of an assessor loaded from a file written before ``source_prior_`` was saved
+            (retrain it).
 
         Warns
         -----
@@ -867,7 +868,7 @@ class Assessor:
             raise AssessorError(f"'{cfg_file}': target_log_weights must be {a.n_classes_} finite numbers, "
                                 f"got {weights!r}")
         a.target_log_weights_ = w
-        # written since stop 28 (for rematch); an older file has none and can only be retrained
+        # written since stop 28, for rematch; without it, rematch can only drop the match
         prior, a.source_prior_ = cfg.get("source_prior"), None
         if prior is not None:
             arr = _finite_numbers(prior, a.n_classes_)
