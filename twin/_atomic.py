@@ -36,6 +36,26 @@ def check_parent(path: str | os.PathLike[str]) -> Path:
     return target
 
 
+def check_output_dir(path: str | os.PathLike[str], what: str = "output", *, create: bool = False) -> Path:
+    """Return ``path`` as a :class:`Path` after checking a directory of results can be written there
+    (its parent exists, and it is a directory or does not exist yet); ``create`` makes it.
+
+    Raises
+    ------
+    OutputPathError
+        A missing parent (never created silently), or ``path`` is a file; ``what`` names the
+        directory in the message ("assessor", "report").
+    """
+    d = Path(path)
+    if d.exists() and not d.is_dir():
+        raise OutputPathError(f"{what} directory '{d}' exists and is not a directory")
+    if not d.parent.is_dir():
+        raise OutputPathError(f"output directory '{d.parent}' does not exist (for '{d}')")
+    if create:
+        d.mkdir(exist_ok=True)
+    return d
+
+
 def _final_mode(target: Path) -> int:
     """Permission bits the finished file should get.
 

@@ -321,7 +321,10 @@ def _transfer_demo(out_dir: Path, epochs: int = 15):
     print("      record        true stage   assessed stage   confidence")
     for r in asm.records[::max(1, len(asm.records) // 6)]:
         print(f"      {r.name:<12}  {r.label:10d}   {r.stage:14d}   {r.confidence:10.2f}")
-    print(f"      assessor saved to {out_dir / 'assessor'} (twin assess {out_dir / 'assessor'} <measurements.h5>)")
+    from twin.transfer.report import write_assessment_report
+    page = write_assessment_report(asm, out_dir / "assessment", "Demo: the proposed method on the rig's test records")
+    print(f"      assessor saved to {out_dir / 'assessor'} (twin assess {out_dir / 'assessor'} <measurements.h5> "
+          f"--report DIR); this table as a figure: {page}")
     for rig in ("lumped", "ltca"):
         accuracy[rig] = _independent_rig_demo(data, settings, pre, epochs, rig)
     return accuracy

@@ -763,16 +763,10 @@ class Assessor:
         """
         import torch
 
-        from twin._atomic import atomic_path
-        from twin.errors import OutputPathError
+        from twin._atomic import atomic_path, check_output_dir
 
         self._check_fitted()
-        d = Path(directory)
-        if d.exists() and not d.is_dir():
-            raise OutputPathError(f"assessor directory '{d}' exists and is not a directory")
-        if not d.parent.is_dir():
-            raise OutputPathError(f"output directory '{d.parent}' does not exist (for '{d}')")
-        d.mkdir(exist_ok=True)
+        d = check_output_dir(directory, "assessor", create=True)
         aug = self._aug()
         params = {k: getattr(self, k) for k in self._PARAMS if k not in ("preprocessing", "augmentation")}
         config = {"format": SAVE_FORMAT, "format_version": SAVE_VERSION, "params": params,

@@ -32,10 +32,13 @@ def _cmd_train_assessor(args: argparse.Namespace) -> int:
     with class_prior_notes() as notes:
         a.fit(Path(args.source), Path(args.target))
     a.save(out)
+    from twin.transfer.report import plot_learning_curves
+    curves = plot_learning_curves({args.method: a.history_}, out / "learning_curves.png",
+                                  f"{args.method}, seed {args.seed}: {args.source} -> {args.target}")
     last = a.history_[-1]
     print(f"{args.method}: {a.n_classes_} stages, {a.n_source_windows_} source / {a.n_target_windows_} target "
           f"windows, {len(a.history_)} epochs in {a.fit_time_:.0f} s; last epoch: loss {last['loss']:.3f}, "
-          f"source accuracy {100 * last['source_acc']:.1f} % -> {out}")
+          f"source accuracy {100 * last['source_acc']:.1f} % -> {out} (learning curves: {curves})")
     _print_match(a, notes)
     return 0
 
@@ -82,6 +85,9 @@ def _cmd_assess(args: argparse.Namespace) -> int:
     if args.json:
         from twin._atomic import check_parent
         check_parent(args.json)     # before the assessment is printed, not after
+    if args.report:
+        from twin._atomic import check_output_dir
+        check_output_dir(args.report, "report")     # before the assessment, not after
     a = transfer.Assessor.load(Path(args.assessor))
     res = a.assess(Path(args.measurements))
     for r in res.records:
@@ -94,6 +100,10 @@ def _cmd_assess(args: argparse.Namespace) -> int:
         with atomic_path(Path(args.json)) as tmp:
             Path(tmp).write_text(json.dumps(res.to_dict(), indent=1))
         print(f"stages -> {args.json}")
+    if args.report:
+        from twin.transfer.report import write_assessment_report
+        page = write_assessment_report(res, args.report, f"{args.assessor} on {args.measurements}")
+        print(f"report -> {page}")
     return 0
 
 
@@ -196,6 +206,9 @@ def add_subcommands(sub) -> None:
     p.add_argument("assessor", metavar="ASSESSOR", help="directory written by train-assessor")
     p.add_argument("measurements", metavar="MEASUREMENTS", help="measurement HDF5 (or CSV + sidecar)")
     p.add_argument("--json", help="write stage and confidence per record and per window to this JSON file")
+    p.add_argument("--report", metavar="DIR",
+                   help="write stages.png (stage probabilities per record), confusion.png (when every record has "
+                        "a label) and report.html into DIR")
     p.set_defaults(handler=_cmd_assess)
 
     p = sub.add_parser("agreement", help="how often assessors trained with other seeds agree on measurements "

@@ -1,5 +1,6 @@
 """Figures and HTML of the transfer-learning assessor: confusion matrices, t-SNE of the high-level
-features (source and target, one panel per method), learning curves.
+features (source and target, one panel per method), learning curves, and the report of one
+assessment (:func:`write_assessment_report`, ``twin assess --report``).
 
 Every file is written atomically (:func:`twin._atomic.atomic_path`); figures are PNG (Agg
 backend, no display needed).  The HTML page embeds the PNGs by relative path.
@@ -14,7 +15,8 @@ import numpy as np
 
 from twin.transfer.errors import AssessorError
 
-__all__ = ["confusion_matrix", "plot_confusion", "plot_learning_curves", "plot_tsne", "write_html"]
+__all__ = ["confusion_matrix", "plot_confusion", "plot_learning_curves", "plot_record_stages", "plot_tsne",
+           "write_assessment_report", "write_html"]
 
 
 def confusion_matrix(y_true: np.ndarray, y_pred: np.ndarray, n_classes: int) -> np.ndarray:
@@ -138,3 +140,60 @@ def write_html(path: str | Path, title: str, blocks: Sequence[tuple[str, str]]) 
     with atomic_path(path) as tmp:
         Path(tmp).write_text("\n".join(parts), encoding="utf-8")
     return Path(path)
+
+
+def plot_record_stages(assessment, path: str | Path, title: str = "") -> Path:
+    """Stage probabilities of every record of ``assessment`` (a
+    :class:`~twin.transfer.assessor.Assessment`): one row per record, one column per stage, the
+    record's mean over its windows in colour; a dot marks the assessed stage and, where the record
+    has a label, a cross the true one.  Records stay in their file order, so a time-ordered series
+    reads as a history from top to bottom."""
+    plt = _plt()
+    recs = assessment.records
+    if not recs:
+        raise AssessorError("plot_record_stages: the assessment holds no record")
+    proba = np.array([r.probabilities for r in recs])
+    n, k = proba.shape
+    fig, ax = plt.subplots(figsize=(1.1 * k + 3.0, min(0.22 * n + 1.6, 40.0)))
+    im = ax.imshow(proba, vmin=0, vmax=1, cmap="Blues", aspect="auto", interpolation="nearest")
+    rows = np.arange(n)
+    ax.scatter([r.stage for r in recs], rows, s=14, c="C1", label="assessed stage", zorder=3)
+    known = [(i, r.label) for i, r in enumerate(recs) if r.label is not None]
+    if known:
+        ax.scatter([lab for _, lab in known], [i for i, _ in known], s=40, marker="x", c="C3", label="true stage",
+                   zorder=4)
+    ax.set_xticks(range(k))
+    ax.set_xlabel("stage")
+    ax.set_yticks(rows if n <= 60 else rows[:: int(np.ceil(n / 60))])
+    ax.set_yticklabels([recs[i].name for i in ax.get_yticks().astype(int)], fontsize=7)
+    ax.legend(loc="lower center", bbox_to_anchor=(0.5, 1.0), ncol=2, fontsize=7, frameon=False)
+    fig.colorbar(im, ax=ax, label="mean stage probability")
+    if title:
+        ax.set_title(title, pad=20)
+    return _save(fig, Path(path))
+
+
+def write_assessment_report(assessment, directory: str | Path, title: str = "Wear-stage assessment") -> Path:
+    """Write ``stages.png`` (:func:`plot_record_stages`), ``confusion.png`` (windows, only when every
+    record has a label) and ``report.html`` (both figures and the table of records) into
+    ``directory``, created if its parent exists.  Returns the HTML page's path.
+
+    Raises
+    ------
+    OutputPathError
+        A missing parent directory, or ``directory`` is a file.
+    """
+    from twin._atomic import check_output_dir
+    d = check_output_dir(directory, "report", create=True)
+    blocks = [("Stage probabilities per record", plot_record_stages(assessment, d / "stages.png", title).name)]
+    if assessment.window_accuracy is not None:
+        cm = confusion_matrix(*assessment.window_verdicts(), assessment.n_stages)
+        plot_confusion({"windows": cm}, d / "confusion.png", "true against assessed stage, per window")
+        blocks.append((f"Confusion matrix (records {100 * assessment.record_accuracy:.1f} %, windows "
+                       f"{100 * assessment.window_accuracy:.1f} %)", "confusion.png"))
+    lines = [f"{'record':<16} {'stage':>5} {'confidence':>10} {'windows':>7} {'label':>5}"]
+    for r in assessment.records:
+        lines.append(f"{r.name:<16} {r.stage:>5d} {r.confidence:>10.2f} {len(r.window_stages):>7d} "
+                     f"{'' if r.label is None else r.label:>5}")
+    blocks.append(("Records", "\n".join(lines)))
+    return write_html(d / "report.html", title, blocks)

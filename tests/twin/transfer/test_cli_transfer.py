@@ -67,7 +67,31 @@ def test_train_then_assess(tmp_path, capsys):
     r = out["records"][0]
     assert {"name", "stage", "confidence", "windows", "label"} <= set(r)
     assert len(r["windows"]) == (6000 - 2048) // 1024 + 1      # 0.3 s at 20 kHz, hop 1024
-    assert "accuracy" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "accuracy" in out and f"learning curves: {tmp_path / 'model' / 'learning_curves.png'}" in out
+    assert (tmp_path / "model" / "learning_curves.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_assess_writes_a_report_and_refuses_a_bad_report_path_before_any_work(tmp_path, capsys):
+    from twin.errors import OutputPathError
+    src = _file(tmp_path / "src.h5", False, True)
+    tgt = _file(tmp_path / "tgt.h5", True, True)
+    p = _parser()
+    args = p.parse_args(["train-assessor", "--source", str(src), "--target", str(tgt), "--out",
+                         str(tmp_path / "model"), "--epochs", "1", "--method", "cnn", "--no-progress"])
+    assert args.handler(args) == 0
+    capsys.readouterr()
+    args = p.parse_args(["assess", str(tmp_path / "model"), str(tgt), "--report", str(tmp_path / "rep")])
+    assert args.handler(args) == 0
+    assert f"report -> {tmp_path / 'rep' / 'report.html'}" in capsys.readouterr().out
+    page = (tmp_path / "rep" / "report.html").read_text()
+    assert "stages.png" in page and "confusion.png" in page and "s1r2" in page
+    (tmp_path / "afile").write_text("keep")
+    for bad, match in ((tmp_path / "no" / "rep", "does not exist"), (tmp_path / "afile", "is not a directory")):
+        args = p.parse_args(["assess", str(tmp_path / "nomodel"), str(tgt), "--report", str(bad)])
+        with pytest.raises(OutputPathError, match=match):
+            args.handler(args)
+    assert capsys.readouterr().out == "" and (tmp_path / "afile").read_text() == "keep"
 
 
 def test_shaft_speed_and_remove_level_reach_the_saved_preprocessing(tmp_path):
