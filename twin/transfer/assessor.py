@@ -347,6 +347,8 @@ class Assessor:
             x = np.asarray(data, dtype=np.float64)
             if x.ndim != 2 or x.shape[1] != pre.window:
                 raise AssessorError(f"{what}: windows must have shape (n, {pre.window}), got {x.shape}")
+            if x.shape[0] == 0:
+                raise AssessorError(f"{what}: no windows (shape {x.shape})")
             if not np.all(np.isfinite(x)):
                 raise AssessorError(f"{what}: windows contain non-finite samples")
             if labels is None:

@@ -165,6 +165,10 @@ def test_wrong_window_shape_names_the_shape(fitted):
         fitted.predict(np.zeros((4, 50)))
     with pytest.raises(AssessorError, match=r"\(n, 64\).*\(64,\)"):
         fitted.predict(np.zeros(64))
+    # an empty array has the right width but nothing to assess: named, not numpy's concatenate error
+    for verb in (fitted.predict, fitted.predict_proba, lambda x: fitted.rematch(x, "source")):
+        with pytest.raises(AssessorError, match=r"no windows \(shape \(0, 64\)\)"):
+            verb(np.zeros((0, 64)))
 
 
 def test_missing_channel_names_record_and_channel(fitted):
