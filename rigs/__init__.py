@@ -1,0 +1,1 @@
+"""Independent simulators the twin is validated against (see rigs/README.md)."""
