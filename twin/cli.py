@@ -242,6 +242,41 @@ def _cmd_effects(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_modes(args: argparse.Namespace) -> int:
+    from twin._atomic import check_parent
+    modes = _lib("twin.modes")
+    for path in (args.json, args.plot):           # refuse a bad output path before the analysis
+        if path is not None:
+            check_parent(path)
+    survey = modes.survey_file(Path(args.measurements), args.record, channels=args.channel, fmin=args.fmin,
+                               fmax=args.fmax, resolution=args.resolution)
+    print(modes.survey_table(survey, args.min_confidence))
+    if args.json:
+        modes.write_survey_json(survey, args.json, file=str(args.measurements), record=args.record,
+                                min_confidence=args.min_confidence)
+        print(f"modes -> {args.json}")
+    if args.plot:
+        _lib("twin.plotting").plot_modal_survey(survey, args.plot)
+        print(f"Campbell diagram -> {args.plot}")
+    return 0
+
+
+def _add_modes_parser(sub) -> None:
+    p = sub.add_parser("modes", help="natural frequencies of a run-up or hammer record (orders and fixed lines "
+                                     "set apart)")
+    p.add_argument("measurements", metavar="MEAS", help="measurement HDF5 (or CSV + sidecar)")
+    p.add_argument("--record", help="record name (default: the first)")
+    p.add_argument("--channel", action="append", help="vibration channel (repeatable; default: every one)")
+    p.add_argument("--fmin", type=float, help="lowest frequency [Hz] (default: 4 bins)")
+    p.add_argument("--fmax", type=float, help="highest frequency [Hz] (default: min(0.4 fs, 10 kHz))")
+    p.add_argument("--resolution", type=float, help="bin spacing [Hz] (default: from the record length)")
+    p.add_argument("--min-confidence", type=float, default=0.3,
+                   help="confidence a mode needs to be used for calibration (default: 0.3)")
+    p.add_argument("--json", type=Path, help="write the modes, lines and orders here")
+    p.add_argument("--plot", type=Path, help="write a Campbell diagram (PNG) here")
+    p.set_defaults(handler=_cmd_modes)
+
+
 def _loop_arguments(p: argparse.ArgumentParser, *, out: bool) -> None:
     p.add_argument("scenario", help="scenario file (its model and calibrated parameters)")
     p.add_argument("--measurements", required=True, help="measurement file (HDF5 or CSV + sidecar)")
@@ -323,6 +358,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--resume", action="store_true", help="continue from <out>/checkpoint.json")
     p.add_argument("--no-progress", action="store_true", help="quiet")
     p.set_defaults(handler=_cmd_calibrate)
+
+    _add_modes_parser(sub)
 
     p = sub.add_parser("compare", help="compare the model with a measurement and list where it fails")
     p.add_argument("scenario", metavar="SCENARIO", help="scenario .yaml (FMU and parameters)")

@@ -284,3 +284,49 @@ def plot_degradation_stages(stages: Sequence[tuple[str, "SimulationResult"]], pa
         fig.savefig(tmp, format="png", dpi=110)
     plt.close(fig)
     return target
+
+
+def plot_modal_survey(survey, path: str | os.PathLike[str], *, title: str | None = None) -> Path:
+    """Campbell diagram of a run-up (or the FRF of a hammer test) with what ``twin modes`` found.
+
+    Run-up: left, the spectrogram in dB re its local floor against shaft speed, with the
+    speed-locked orders as rays, the modes as solid and the fixed lines as dotted horizontal
+    lines; right, the stationary spectrum the modes were read from. Hammer test: the FRF
+    magnitude with the modes marked.
+    """
+    target = _png_target(path)
+    fig = _new_figure(1)
+    fig.clear()
+    fig.set_size_inches(11.0, 6.0)
+    modes = [m for m in survey.modes]
+    if survey.method == "runup" and survey.slice_speed is not None and survey.spectrogram_db is not None:
+        ax, side = fig.subplots(1, 2, sharey=True, gridspec_kw={"width_ratios": [3, 1]})
+        speed = survey.slice_speed
+        order = np.argsort(speed)
+        ax.pcolormesh(speed[order], survey.f, survey.spectrogram_db[:, order], shading="nearest",
+                      cmap="viridis", vmin=-10, vmax=30, rasterized=True)
+        for o in survey.orders:
+            ax.plot(speed[order], o.order * speed[order], color="w", lw=0.6, ls="--", alpha=0.7)
+        ax.set_xlabel("shaft speed [Hz]")
+        ax.set_ylabel("frequency [Hz]")
+        tops = [m.frequency for m in modes] + [ln.frequency for ln in survey.lines]
+        ax.set_ylim(survey.band[0], min(survey.band[1], 1.4 * max(tops)) if tops else survey.band[1])
+        side.plot(survey.stationary_db, survey.f, color="k", lw=0.7)
+        side.set_xlabel("stationary level [dB re floor]")
+        axes = (ax, side)
+    else:
+        side = fig.subplots(1, 1)
+        side.plot(survey.f, survey.stationary_db, color="k", lw=0.7)
+        side.set_xlabel("frequency [Hz]")
+        side.set_ylabel("|H| [dB re median]")
+        axes = (side,)
+    horizontal = survey.method == "runup" and survey.slice_speed is not None
+    for a in axes:
+        line = a.axhline if horizontal else a.axvline
+        for m in modes:
+            line(m.frequency, color="tab:red", lw=0.9, alpha=0.4 + 0.6 * m.confidence)
+        for ln in survey.lines:
+            line(ln.frequency, color="tab:cyan", lw=0.9, ls=":")
+    axes[0].set_title(title or f"{survey.method}: {len(modes)} modes (red), {len(survey.lines)} fixed lines "
+                      f"(dotted), {len(survey.orders)} orders (dashed)")
+    return _save(fig, target)

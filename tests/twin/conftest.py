@@ -1,0 +1,57 @@
+"""A synthetic run-up of a structure the twin does not model: a sum of modes driven by
+broadband noise, speed-locked orders and a fixed, non-synchronous drive line, plus sensor noise.
+
+Known answers for :mod:`twin.signals.runup`: every mode, order and line is set here.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy import signal as sps
+
+
+def _mode_filter(fn: float, zeta: float, fs: float):
+    """Acceleration per unit force of one mode, s^2 / (s^2 + 2 zeta wn s + wn^2), by the bilinear
+    transform pre-warped at fn (so the resonance sits exactly at fn)."""
+    wn = 2 * np.pi * fn
+    k = wn / np.tan(wn / (2 * fs))              # pre-warped 2*fs
+    a0 = k * k + 2 * zeta * wn * k + wn * wn
+    b = np.array([k * k, -2 * k * k, k * k]) / a0
+    a = np.array([1.0, (2 * wn * wn - 2 * k * k) / a0, (k * k - 2 * zeta * wn * k + wn * wn) / a0])
+    return b, a
+
+
+def synthetic_runup(*, fs=12800.0, duration=6.0, speeds=(2.0, 20.0),
+                    modes=((87.0, 0.02), (218.0, 0.02), (430.0, 0.015), (512.0, 0.025), (767.0, 0.02),
+                           (1248.0, 0.02), (1927.0, 0.03)),
+                    orders=((1.0, 0.3), (2.0, 0.2), (19.0, 1.0), (38.0, 0.5), (57.0, 0.3), (19 / 52, 0.2)),
+                    lines=((300.0, 3.0),), broadband=1.0, noise=0.02, seed=0):
+    """(x [m/s2], angle [rad], truth) of a run-up from speeds[0] to speeds[1] Hz.
+
+    ``orders``: (shaft order, force amplitude at the top speed; grows with speed squared);
+    ``lines``: (fixed frequency [Hz], force amplitude) of drive lines;
+    ``broadband``: sd of the white force at the top speed (grows with speed).
+    """
+    rng = np.random.default_rng(seed)
+    n = int(round(duration * fs))
+    t = np.arange(n) / fs
+    speed = speeds[0] + (speeds[1] - speeds[0]) * t / duration
+    angle = 2 * np.pi * np.cumsum(speed) / fs
+    rel = speed / speeds[1]
+    force = broadband * rel * rng.standard_normal(n)
+    for order, amp in orders:
+        force += amp * rel ** 2 * np.cos(order * angle + rng.uniform(0, 2 * np.pi))
+    for f, amp in lines:
+        force += amp * np.cos(2 * np.pi * f * t + rng.uniform(0, 2 * np.pi))
+    x = np.zeros(n)
+    for fn, zeta in modes:
+        b, a = _mode_filter(fn, zeta, fs)
+        x += sps.lfilter(b, a, force)
+    x += noise * np.std(x) * rng.standard_normal(n)
+    truth = {"modes": [m for m in modes], "orders": [o for o, _ in orders], "lines": [f for f, _ in lines]}
+    return x, angle, truth
+
+
+@pytest.fixture(scope="session")
+def runup_factory():
+    return synthetic_runup

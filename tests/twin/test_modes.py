@@ -1,0 +1,89 @@
+"""twin modes: the shaft reference from any tachometer kind, several sensors, JSON, plot, CLI."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from twin.cli import main
+from twin.errors import MeasurementError
+from twin.measurements import Record, write_measurements
+from twin.modes import merge_surveys, survey_file, survey_record
+
+FS = 12800.0
+
+
+@pytest.fixture(scope="module")
+def runup(runup_factory):
+    return runup_factory(fs=FS, seed=0)
+
+
+def _record(x, angle, **channels_units):
+    channels = {"accel_pinion_casing": x, **{k: v for k, (v, _) in channels_units.items()}}
+    units = {"accel_pinion_casing": "m/s2", **{k: u for k, (_, u) in channels_units.items()}}
+    return channels, units
+
+
+def test_encoder_speed_channel_and_pulse_tachometer_give_the_same_modes(runup):
+    x, angle, truth = runup
+    speed = np.gradient(angle) * FS / (2 * np.pi)
+    pulses = (np.sin(angle) > 0).astype(float)
+    encoder = Record("r", *_record(x, angle, encoder=(angle, "rad")), FS, tachometer="encoder", tachometer_kind="angle")
+    by_speed = Record("r", *_record(x, angle, speed=(speed, "Hz")), FS)
+    by_pulse = Record("r", *_record(x, angle, tacho=(pulses, "V")), FS, tachometer="tacho", tachometer_kind="pulse",
+                      pulses_per_rev=1)
+    results = [survey_record(r) for r in (encoder, by_speed, by_pulse)]
+    for s in results:
+        assert any(abs(o.order - 19.0) < 0.05 for o in s.orders)
+        assert not any(abs(m.frequency - 300.0) < 2 for m in s.modes)
+        for fn, _ in truth["modes"][:6]:
+            assert min(abs(s.frequencies() - fn)) / fn < 0.02
+
+
+def test_two_sensors_merge_into_one_list(runup):
+    x, angle, _ = runup
+    y = 0.5 * x + 0.01 * np.std(x) * np.random.default_rng(1).standard_normal(x.size)
+    rec = Record("r", {"accel_pinion_casing": x, "accel_gear_casing": y, "encoder": angle},
+                 {"accel_pinion_casing": "m/s2", "accel_gear_casing": "m/s2", "encoder": "rad"}, FS,
+                 tachometer="encoder", tachometer_kind="angle")
+    both = survey_record(rec)
+    one = survey_record(rec, channels=["accel_pinion_casing"])
+    assert both.channels == ("accel_pinion_casing", "accel_gear_casing")
+    assert len(both.modes) == len(one.modes)
+    assert all(set(m.evidence["channels"]) <= set(both.channels) for m in both.modes)
+    assert merge_surveys([one]) is one
+
+
+def test_missing_channel_is_named(runup):
+    x, angle, _ = runup
+    rec = Record("r", {"accel_pinion_casing": x}, {"accel_pinion_casing": "m/s2"}, FS)
+    with pytest.raises(MeasurementError, match="no channel 'nope'"):
+        survey_record(rec, channels=["nope"])
+
+
+def test_cli_table_json_and_plot(runup, tmp_path, capsys):
+    x, angle, _ = runup
+    h5 = tmp_path / "rig.h5"
+    write_measurements([Record("runup", {"accel_pinion_casing": x, "encoder": angle},
+                               {"accel_pinion_casing": "m/s2", "encoder": "rad"}, FS, nominal_speed=20.0,
+                               tachometer="encoder", tachometer_kind="angle")], h5)
+    assert main(["modes", str(h5), "--record", "runup", "--json", str(tmp_path / "m.json"),
+                 "--plot", str(tmp_path / "m.png")]) == 0
+    out = capsys.readouterr().out
+    assert "structural modes" in out and "fixed non-synchronous lines" in out and "orders" in out
+    data = json.loads((tmp_path / "m.json").read_text())
+    assert data["record"] == "runup" and data["method"] == "runup"
+    assert len(data["modes"]) == 7 and data["lines"][0]["frequency_hz"] == pytest.approx(300.0, abs=0.5)
+    assert (tmp_path / "m.png").stat().st_size > 10_000
+    assert survey_file(h5).frequencies().size == 7
+
+
+def test_cli_bad_record_and_bad_output_path(runup, tmp_path, capsys):
+    x, angle, _ = runup
+    h5 = tmp_path / "rig.h5"
+    write_measurements([Record("runup", {"accel_pinion_casing": x}, {"accel_pinion_casing": "m/s2"}, FS)], h5)
+    assert main(["modes", str(h5), "--record", "steady"]) == 2
+    assert "record 'steady': no such record" in capsys.readouterr().err
+    assert main(["modes", str(h5), "--json", str(tmp_path / "no" / "m.json")]) == 2
+    assert "does not exist" in capsys.readouterr().err

@@ -1,0 +1,169 @@
+"""``twin modes``: natural frequencies of a measured record, with orders and fixed lines set apart.
+
+A run-up (any record with a tachometer, an encoder or a speed channel) goes through
+:func:`twin.signals.runup.analyse_runup`; a hammer test (a force channel in N) through
+:func:`twin.signals.impact.analyse_impacts`. With several vibration channels each is analysed
+and the results are merged: a mode seen by any sensor is a mode of the structure, kept with the
+estimate of the sensor that saw it most clearly.
+
+    survey = survey_file("rig.h5", record="runup")
+    survey.frequencies(min_confidence=0.5)      # Hz, ascending
+    write_survey_json(survey, "modes.json"); plot_survey(survey, "modes.png")
+"""
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from twin.errors import MeasurementError
+from twin.signals.survey import Line, ModalSurvey, Mode, Order
+
+VIBRATION_UNITS = ("m/s2", "m/s", "m")
+#: Default confidence a mode needs to be used for calibration.
+MIN_CONFIDENCE = 0.3
+
+
+def shaft_angle(record) -> np.ndarray | None:
+    """Unwrapped reference-shaft angle [rad] per sample, or None when the record has no speed.
+
+    From the tachometer (pulse train or encoder angle), else from a speed channel (unit ``Hz``
+    or ``rad/s``), else None. A pulse tachometer leaves NaN before its first and after its last
+    edge.
+    """
+    from twin.signals import shaft_angle_from_encoder, shaft_angle_from_speed, shaft_angle_from_tacho
+
+    fs = record.sample_rate
+    if record.tachometer is not None:
+        x = record[record.tachometer]
+        if record.tachometer_kind == "angle":
+            return shaft_angle_from_encoder(x)
+        return shaft_angle_from_tacho(x, fs, record.pulses_per_rev or 1)
+    for name in record.channel_names:
+        unit = record.units[name]
+        if unit in ("Hz", "rad/s"):
+            speed = np.asarray(record[name], float) / (2 * np.pi if unit == "rad/s" else 1.0)
+            return shaft_angle_from_speed(speed.size, fs, speed)
+    return None
+
+
+def _force_channel(record) -> str | None:
+    forces = [n for n in record.channel_names if record.units[n] == "N"]
+    return forces[0] if forces else None
+
+
+def survey_record(record, *, channels=None, fmin: float | None = None, fmax: float | None = None,
+                  resolution: float | None = None) -> ModalSurvey:
+    """Modes, fixed lines and orders of one record (see the module docstring)."""
+    from twin.signals.impact import analyse_impacts
+    from twin.signals.runup import analyse_runup
+
+    vib = list(channels) if channels else [n for n in record.channel_names if record.units[n] in VIBRATION_UNITS
+                                           and n != record.tachometer]
+    missing = [c for c in vib if c not in record]
+    if missing:
+        raise MeasurementError(record.source or "<memory>", record.name,
+                               f"no channel {missing[0]!r} (it has {', '.join(record.channel_names)})")
+    if not vib:
+        raise MeasurementError(record.source or "<memory>", record.name,
+                               "no vibration channel (unit m/s2, m/s or m) to read modes from")
+    force = _force_channel(record)
+    surveys = []
+    if force is not None:
+        for c in vib:
+            surveys.append(replace(analyse_impacts(record[force], record[c], record.sample_rate, fmin=fmin, fmax=fmax),
+                                   channels=(c,)))
+    else:
+        angle = shaft_angle(record)
+        keep = slice(None)
+        if angle is not None and not np.all(np.isfinite(angle)):
+            ok = np.flatnonzero(np.isfinite(angle))
+            keep = slice(int(ok[0]), int(ok[-1]) + 1)
+            angle = angle[keep]
+        if angle is None and record.nominal_speed is not None:
+            from twin.signals import shaft_angle_from_speed
+            angle = shaft_angle_from_speed(record.n_samples, record.sample_rate, float(record.nominal_speed))
+        for c in vib:
+            surveys.append(replace(analyse_runup(np.asarray(record[c])[keep], record.sample_rate, angle, fmin=fmin,
+                                                 fmax=fmax, resolution=resolution), channels=(c,)))
+    return merge_surveys(surveys)
+
+
+def merge_surveys(surveys) -> ModalSurvey:
+    """One survey from several sensors' surveys of the same record (modes within 1 % merged)."""
+    if len(surveys) == 1:
+        return surveys[0]
+    modes: list[Mode] = []
+    for s in surveys:
+        for m in s.modes:
+            m = replace(m, evidence={**m.evidence, "channels": list(s.channels)})
+            same = [i for i, o in enumerate(modes)
+                    if abs(o.frequency - m.frequency) <= max(0.01 * m.frequency, 2 * s.resolution)]
+            if not same:
+                modes.append(m)
+                continue
+            i = same[0]
+            seen = sorted(set(modes[i].evidence["channels"]) | set(s.channels))
+            best = m if m.confidence > modes[i].confidence else modes[i]
+            modes[i] = replace(best, evidence={**best.evidence, "channels": seen})
+    lines: list[Line] = []
+    orders: list[Order] = []
+    for s in surveys:
+        lines += [ln for ln in s.lines if all(abs(ln.frequency - o.frequency) > 2 * s.resolution for o in lines)]
+        orders += [o for o in s.orders if all(abs(o.order - p.order) > 0.05 for p in orders)]
+    first = surveys[0]
+    notes = tuple(dict.fromkeys(n for s in surveys for n in s.notes))
+    return replace(first, modes=tuple(sorted(modes, key=lambda m: m.frequency)),
+                   lines=tuple(sorted(lines, key=lambda ln: ln.frequency)),
+                   orders=tuple(sorted(orders, key=lambda o: o.order)), notes=notes,
+                   channels=tuple(c for s in surveys for c in s.channels))
+
+
+def survey_file(path, record: str | None = None, **kwargs) -> ModalSurvey:
+    """Survey of record ``record`` (default: the first) of a measurement file."""
+    from twin.measurements import load_measurements
+
+    mset = load_measurements(path)
+    if record is not None and record not in mset.names:
+        raise MeasurementError(str(path), record, f"no such record (the file has {', '.join(mset.names)})")
+    return survey_record(mset[record] if record is not None else mset[0], **kwargs)
+
+
+def write_survey_json(survey: ModalSurvey, path, **extra) -> Path:
+    """The survey as JSON (modes, lines, orders, notes), written atomically."""
+    from twin._atomic import atomic_path
+
+    with atomic_path(path) as tmp:
+        Path(tmp).write_text(json.dumps({**extra, **survey.to_dict()}, indent=2))
+    return Path(path)
+
+
+def survey_table(survey: ModalSurvey, min_confidence: float = MIN_CONFIDENCE) -> str:
+    """The survey as text: modes, lines, orders and notes."""
+    rows = [f"{survey.method} survey, band {survey.band[0]:g}-{survey.band[1]:g} Hz, "
+            f"resolution {survey.resolution:.3g} Hz, channels {', '.join(survey.channels) or '-'}",
+            "", "structural modes (confidence >= %.2f used for calibration)" % min_confidence,
+            "   freq [Hz]  damping  confidence  evidence"]
+    for m in survey.modes:
+        mark = " " if m.confidence >= min_confidence else "-"
+        ev = m.evidence
+        crossing = ev.get("orders_crossing") or []
+        bits = [ev.get("reason", "")]
+        if crossing:
+            bits.append(f"crossed by orders {', '.join(f'{o:g}' for o in crossing[:4])}"
+                        + (" ..." if len(crossing) > 4 else ""))
+        if ev.get("line_on_top_hz"):
+            bits.append(f"line on top at {ev['line_on_top_hz']} Hz")
+        damping = f"{m.damping:7.4f}" if np.isfinite(m.damping) else "    n/a"
+        rows.append(f"{mark}{m.frequency:10.2f}  {damping}  {m.confidence:10.2f}  {'; '.join(b for b in bits if b)}")
+    if not survey.modes:
+        rows.append("   (none)")
+    if survey.lines:
+        rows += ["", "fixed non-synchronous lines (not modes)", "   freq [Hz]  level [dB]  evidence"]
+        rows += [f" {ln.frequency:10.2f}  {ln.level_db:10.1f}  {ln.evidence.get('reason', '')}" for ln in survey.lines]
+    if survey.orders:
+        rows += ["", "speed-locked orders (not modes): " + ", ".join(f"{o.order:g}" for o in survey.orders)]
+    rows += [f"note: {n}" for n in survey.notes]
+    return "\n".join(rows)
