@@ -163,11 +163,44 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
         scenario = scenario.with_overrides(executor={"type": "local", "workers": args.workers})
     report = _lib("twin.calibration.run").run_calibration(scenario, Path(args.measurements), Path(args.out),
                                                           progress=not args.no_progress, seed=args.seed,
-                                                          resume=args.resume)
+                                                          resume=args.resume, modes_from=args.modes_from)
+    print(f"modes: {report.modes_source}")
     print(report.table())
-    print(f"calibrated parameters -> {Path(args.out) / 'calibrated.json'} and calibrated.ssv; "
+    for w in report.warnings:
+        print(f"warning: {w}")
+    print(f"calibrated scenario -> {report.scenario_file} (parameters in calibrated.json and calibrated.ssv); "
           f"report -> {Path(args.out) / 'report.html'}")
     return 0
+
+
+def _cmd_sensitivity(args: argparse.Namespace) -> int:
+    from twin._atomic import atomic_path, check_parent
+    if args.json is not None:
+        check_parent(args.json)
+    scenario = _lib("twin.scenario").load_scenario(Path(args.scenario))
+    sens = _lib("twin.calibration.run").scenario_sensitivity(
+        scenario, Path(args.measurements) if args.measurements else None, modes_from=args.modes_from,
+        n_modes=args.modes, executor=_executor(args.workers))
+    print(sens.table())
+    if args.json is not None:
+        import json
+        with atomic_path(args.json) as tmp:
+            Path(tmp).write_text(json.dumps(sens.to_dict(), indent=2))
+        print(f"sensitivities -> {args.json}")
+    return 0
+
+
+def _add_sensitivity_parser(sub) -> None:
+    p = sub.add_parser("sensitivity", help="which parameters the measured modes identify (what parameters: auto "
+                                           "calibrates), with bounds from physics")
+    p.add_argument("scenario", metavar="SCENARIO", help="scenario .yaml (model and parameters)")
+    p.add_argument("--measurements", help="measurement HDF5 with the record the modes are read from")
+    p.add_argument("--modes-from", metavar="RECORD", help="run-up or hammer record of the measured modes")
+    p.add_argument("--modes", type=int, default=8,
+                   help="without measurements: the model's first N visible modes (default: 8)")
+    p.add_argument("--workers", type=int, help="local worker processes (default: one)")
+    p.add_argument("--json", type=Path, help="write the sensitivities and the choice here")
+    p.set_defaults(handler=_cmd_sensitivity)
 
 
 def _cmd_compare(args: argparse.Namespace) -> int:
@@ -356,10 +389,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--workers", type=int, help="local worker processes for the evaluations")
     p.add_argument("--seed", type=int, help="override the scenario's seed")
     p.add_argument("--resume", action="store_true", help="continue from <out>/checkpoint.json")
+    p.add_argument("--modes-from", metavar="RECORD",
+                   help="read the measured modes from this run-up or hammer record (see twin modes); without a "
+                        "calibration block the parameters are chosen automatically")
     p.add_argument("--no-progress", action="store_true", help="quiet")
     p.set_defaults(handler=_cmd_calibrate)
 
     _add_modes_parser(sub)
+    _add_sensitivity_parser(sub)
 
     p = sub.add_parser("compare", help="compare the model with a measurement and list where it fails")
     p.add_argument("scenario", metavar="SCENARIO", help="scenario .yaml (FMU and parameters)")

@@ -472,6 +472,8 @@ class FMU:
         """Return ``(f, x0, state_names)`` where ``f(x) -> xdot`` uses the FMU's Model Exchange interface.
 
         ``x0`` (n,) holds the initial states; the caller must call ``f.close()`` when done.
+        ``f.outputs(x, names)`` gives variables (outputs) at state ``x``; ``f.set({name: value})``
+        changes parameters or inputs for the following evaluations (calculated parameters follow).
         """
         md = self.model_description
         if md.modelExchange is None:
@@ -501,6 +503,18 @@ class FMU:
                 model.setContinuousStates(x.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), nx)
                 model.getDerivatives(dx.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), nx)
                 return dx.copy()
+
+            def outputs(self_inner, x, names: Sequence[str]) -> np.ndarray:
+                """Values of the variables ``names`` (outputs) at state ``x``."""
+                x = np.ascontiguousarray(x, dtype=float)
+                model.setContinuousStates(x.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), nx)
+                return np.array(model.getReal([self.variable(n).value_reference for n in names]), dtype=float)
+
+            def set(self_inner, values: Mapping[str, float]) -> None:
+                """Set parameters or inputs (by name) for the following evaluations."""
+                if values:
+                    model.setReal([self.variable(n).value_reference for n in values],
+                                  [float(v) for v in values.values()])
 
             def close(self_inner):
                 model.terminate()

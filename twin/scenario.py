@@ -55,8 +55,14 @@ _PROFILE = {
 CALIBRATION_SCHEMA: dict[str, Any] = {
     "type": "object", "additionalProperties": False, "required": ["parameters"],
     "properties": {
-        "parameters": {"type": "object", "minProperties": 1,
-                       "additionalProperties": {"type": "array", "items": {"type": "number"}, "minItems": 2, "maxItems": 2}},
+        "parameters": {"oneOf": [
+            {"const": "auto", "description": "the parameters the measured modes identify, with bounds from physics"},
+            {"type": "object", "minProperties": 1,
+             "additionalProperties": {"type": "array", "items": {"type": "number"}, "minItems": 2, "maxItems": 2}}]},
+        "modes_from": {"type": "string", "description": "record (run-up or hammer test) the measured modes are read from"},
+        "min_confidence": {"type": "number", "minimum": 0, "maximum": 1},
+        "objectives": {"type": "array", "minItems": 1, "uniqueItems": True,
+                       "items": {"enum": ["waveform", "correlation", "frequencies", "modes"]}},
         "algorithm": {"enum": ["mogoa", "nsga2"]},
         "pop_size": {"type": "integer", "minimum": 2},
         "n_gen": {"type": "integer", "minimum": 1},
@@ -271,7 +277,9 @@ def scenario_from_dict(data: Any, source: Path | None = None) -> Scenario:
     validator = jsonschema.Draft202012Validator(SCHEMA)
     for err in sorted(validator.iter_errors(data), key=lambda e: list(map(str, e.absolute_path))):
         msg = err.message
-        if err.validator == "oneOf":
+        if err.validator == "oneOf" and list(err.absolute_path)[:2] == ["calibration", "parameters"]:
+            msg = "must be 'auto' or a mapping of parameter name to [lower, upper]"
+        elif err.validator == "oneOf":
             msg = ("must be a number or one of {constant: v}, {ramp: {from, to, start, duration}}, "
                    "{steps: [[t, v], ...]}, {table: {file, column, time_column}}")
         elif err.validator == "additionalProperties":

@@ -25,6 +25,14 @@ from twin.errors import ParameterError
 log = logging.getLogger(__name__)
 
 
+#: Objectives a calibration can minimise (see the module docstring of each):
+#: waveform = paper f1, 1 - corr of the synchronous averages; correlation = paper f2, 1 - corr of the
+#: dB spectra; frequencies = paper f3, sum of squared mode errors [Hz^2]; modes = mean squared mode
+#: error in units of each mode's uncertainty, against the modes a sensor sees (visible modes).
+OBJECTIVES = ("waveform", "correlation", "frequencies", "modes")
+SIGNAL_OBJECTIVES = ("waveform", "correlation")
+
+
 @dataclass(frozen=True)
 class CalibrationTarget:
     """What the model must reproduce: one measured record and the measured natural frequencies."""
@@ -39,6 +47,18 @@ class CalibrationTarget:
     fmax: float = 5000.0
     shaft_hz: float | None = None       # actual pinion speed [Hz] (tacho); None: from the GMF line
     teeth: int = 19                     # pinion teeth, to find the GMF line
+    objectives: tuple[str, ...] = ("waveform", "correlation", "frequencies")
+    mode_rel_sd: np.ndarray | None = None   # (k,) relative uncertainty of each measured mode ("modes")
+
+    @property
+    def needs_simulation(self) -> bool:
+        return any(o in SIGNAL_OBJECTIVES for o in self.objectives)
+
+    @property
+    def rel_sd(self) -> np.ndarray:
+        from twin.calibration.sensitivity import MODEL_FORM
+        base = np.zeros(self.natural_frequencies.size) if self.mode_rel_sd is None else self.mode_rel_sd
+        return np.sqrt(np.asarray(base, float) ** 2 + MODEL_FORM ** 2)
 
     @property
     def measured_shaft_hz(self) -> float:
@@ -59,7 +79,7 @@ class EvalTask:
 
 
 def evaluate_candidate(task: EvalTask) -> tuple[np.ndarray, dict]:
-    """Objectives (f1, f2, f3) of one parameter set; shape (3,). Raises on simulation failure."""
+    """Objectives of one parameter set, in the order of ``target.objectives``. Raises on failure."""
     from twin.calibration.objectives import frequency_mismatch, spectrum_mismatch, waveform_mismatch
     from twin.linearize import modes, state_jacobian
     from twin.operating import operating_point, simulate_operating_point
@@ -67,20 +87,33 @@ def evaluate_candidate(task: EvalTask) -> tuple[np.ndarray, dict]:
     tg = task.target
     start, inputs = operating_point(tg.drive_hz, tg.load)
     params = {**task.parameters, **start}
-    block = simulate_operating_point(task.fmu_path, tg.drive_hz, tg.load, parameters=task.parameters,
-                                     settle=task.settle, duration=task.duration,
-                                     channels=[tg.channel, "motor_speed"], output_interval=1.0 / tg.sample_rate)
-    sim, speed = block[:, 0], block[:, 1]
-    model_shaft_hz = float(np.mean(speed)) / (2 * math.pi)
-    n = min(sim.size, tg.signal.size)
-    f1 = waveform_mismatch(sim[:n], tg.signal[:n], tg.sample_rate, model_shaft_hz,
-                           measured_shaft_hz=task.measured_shaft_hz)
-    f2 = spectrum_mismatch(sim[:n], tg.signal[:n], tg.sample_rate, fmin=tg.fmin, fmax=tg.fmax)
-    jac, _ = state_jacobian(task.fmu_path, parameters=params, inputs=inputs, settle=0.02, window=2.5e-3,
-                            samples=4)
-    freqs, _ = modes(jac)
-    f3 = frequency_mismatch(freqs[: tg.natural_frequencies.size + 4], tg.natural_frequencies)
-    return np.array([f1, f2, f3]), {"natural_frequencies": freqs[: tg.natural_frequencies.size + 4].tolist()}
+    values: dict[str, float] = {}
+    info: dict = {}
+    if tg.needs_simulation:
+        block = simulate_operating_point(task.fmu_path, tg.drive_hz, tg.load, parameters=task.parameters,
+                                         settle=task.settle, duration=task.duration,
+                                         channels=[tg.channel, "motor_speed"], output_interval=1.0 / tg.sample_rate)
+        sim, speed = block[:, 0], block[:, 1]
+        model_shaft_hz = float(np.mean(speed)) / (2 * math.pi)
+        n = min(sim.size, tg.signal.size)
+        if "waveform" in tg.objectives:
+            values["waveform"] = waveform_mismatch(sim[:n], tg.signal[:n], tg.sample_rate, model_shaft_hz,
+                                                   measured_shaft_hz=task.measured_shaft_hz)
+        if "correlation" in tg.objectives:
+            values["correlation"] = spectrum_mismatch(sim[:n], tg.signal[:n], tg.sample_rate, fmin=tg.fmin,
+                                                      fmax=tg.fmax)
+    if "frequencies" in tg.objectives:
+        jac, _ = state_jacobian(task.fmu_path, parameters=params, inputs=inputs, settle=0.02, window=2.5e-3,
+                                samples=4)
+        freqs, _ = modes(jac)
+        values["frequencies"] = frequency_mismatch(freqs[: tg.natural_frequencies.size + 4], tg.natural_frequencies)
+        info["natural_frequencies"] = freqs[: tg.natural_frequencies.size + 4].tolist()
+    if "modes" in tg.objectives:
+        from twin.calibration.modal_fit import modes_objective
+        values["modes"], matched = modes_objective(task.fmu_path, task.parameters, tg.natural_frequencies, tg.rel_sd,
+                                                   speed_hz=tg.drive_hz, load_nm=tg.load, channels=(tg.channel,))
+        info["matched_frequencies"] = matched.tolist()
+    return np.array([values[o] for o in tg.objectives]), info
 
 
 def _guarded_eval(task: EvalTask):
@@ -113,26 +146,28 @@ class ParameterSpace:
 
 def make_problem(fmu_path: Path, space: ParameterSpace, target: CalibrationTarget, *, executor,
                  settle: float = 0.1, duration: float = 0.3, fixed: Mapping[str, float] | None = None):
-    """A pymoo Problem with 3 objectives (f1, f2, f3) and 1 constraint (evaluation failed)."""
+    """A pymoo Problem with the target's objectives and 1 constraint (evaluation failed)."""
     from pymoo.core.problem import Problem
 
-    shaft_hz = target.measured_shaft_hz      # once, not per candidate
+    shaft_hz = target.measured_shaft_hz if target.needs_simulation else target.drive_hz   # once, not per candidate
+    failed_score = {"waveform": 2.0, "correlation": 2.0, "frequencies": 1e12, "modes": 1e12}
 
     class CalibrationProblem(Problem):
         def __init__(self):
-            super().__init__(n_var=len(space.names), n_obj=3, n_ieq_constr=1, xl=space.lower, xu=space.upper)
+            super().__init__(n_var=len(space.names), n_obj=len(target.objectives), n_ieq_constr=1, xl=space.lower,
+                             xu=space.upper)
             self.history: list[dict] = []
 
         def _evaluate(self, X, out, *args, **kwargs):
             tasks = [EvalTask(str(fmu_path), {**(fixed or {}), **space.to_dict(x)}, target, settle, duration,
                               shaft_hz) for x in X]
             results = executor.map(_guarded_eval, tasks, desc="calibration evaluations")
-            F = np.empty((len(X), 3))
+            F = np.empty((len(X), len(target.objectives)))
             G = np.zeros((len(X), 1))
             for i, r in enumerate(results):
                 if isinstance(r, Exception):
                     log.warning("evaluation of %s failed and is scored infeasible: %s", tasks[i].parameters, r)
-                    F[i] = (2.0, 2.0, 1e12)
+                    F[i] = [failed_score[o] for o in target.objectives]
                     G[i] = 1.0
                     self.history.append({"x": X[i].tolist(), "failed": str(r)})
                 else:
@@ -148,7 +183,7 @@ def make_problem(fmu_path: Path, space: ParameterSpace, target: CalibrationTarge
 class CalibrationResult:
     names: tuple[str, ...]
     X: np.ndarray                   # (m, d) Pareto-optimal parameter sets
-    F: np.ndarray                   # (m, 3) their objectives (f1, f2, f3)
+    F: np.ndarray                   # (m, n_obj) their objectives, in the target's order
     chosen: dict[str, float]        # least-crowded pick (paper Eq. 9)
     knee: dict[str, float]
     n_evals: int
@@ -160,8 +195,13 @@ class CalibrationResult:
 def calibrate(fmu_path: Path, space: ParameterSpace, target: CalibrationTarget, *, algorithm: str = "mogoa",
               pop_size: int = 20, n_gen: int = 10, seed: int = 0, executor=None, checkpoint: Path | None = None,
               settle: float = 0.1, duration: float = 0.3, fixed: Mapping[str, float] | None = None,
-              verbose: bool = False, resume: bool = False, refine: bool = False) -> CalibrationResult:
+              verbose: bool = False, resume: bool = False, refine: bool = False,
+              nominal: Mapping[str, float] | None = None) -> CalibrationResult:
     """Calibrate ``space`` against ``target`` with MOGOA or NSGA-II (see the module docstring).
+
+    ``refine`` polishes the pick on the modes alone: with the "modes" objective by the fit in
+    log-parameters about ``nominal`` (default: the middle of the box in log) with the bounds as
+    prior (:func:`twin.calibration.modal_fit.fit_modes`), else by :func:`refine_modes`.
 
     With ``resume=True`` and an existing ``checkpoint``, the run continues: the last checkpointed
     generation seeds the population and only the remaining generations are run. The evaluation
@@ -209,10 +249,22 @@ def calibrate(fmu_path: Path, space: ParameterSpace, target: CalibrationTarget, 
     knee = knee_point(F)
     failed = sum(1 for h in problem.history if "failed" in h)
     chosen = space.to_dict(X[pick])
-    if refine:
-        # polish from the front member with the best frequency fit, not from an extreme of the front
-        start = X[int(np.argmin(F[:, 2]))]
-        chosen = space.to_dict(refine_modes(Path(fmu_path), space, target, start, fixed=fixed))
+    modal = [o for o in ("modes", "frequencies") if o in target.objectives]
+    if refine and modal:
+        # polish from the front member with the best mode fit, not from an extreme of the front
+        start = X[int(np.argmin(F[:, target.objectives.index(modal[0])]))]
+        if modal[0] == "modes":
+            from twin.calibration.modal_fit import fit_modes
+            mid = np.sqrt(space.lower * space.upper)
+            nom = np.array([float((nominal or {}).get(n, m)) for n, m in zip(space.names, mid)])
+            # from the nominal set, where the modes were matched, following them step by step: a
+            # population member far from it may hold two modes in swapped places
+            chosen = space.to_dict(fit_modes(Path(fmu_path), space.names, space.lower, space.upper, nom, nom,
+                                             target.natural_frequencies, target.rel_sd, fixed=dict(fixed or {}),
+                                             speed_hz=target.drive_hz, load_nm=target.load,
+                                             channels=(target.channel,)))
+        else:
+            chosen = space.to_dict(refine_modes(Path(fmu_path), space, target, start, fixed=fixed))
     return CalibrationResult(space.names, X, F, chosen, space.to_dict(X[knee]),
                              len(problem.history), algorithm, failed, problem.history)
 

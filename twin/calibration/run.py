@@ -1,33 +1,41 @@
 """``twin calibrate``: a scenario's ``calibration:`` block, a measurement file, and a report.
 
-Scenario block::
+Scenario block (every key but ``parameters`` optional)::
 
     calibration:
-      parameters: {kt12: [1000, 2500], I1: [3.0e-3, 6.0e-3]}   # bounds in SI units
+      parameters: auto            # or {kt12: [1000, 2500], I1: [3.0e-3, 6.0e-3]}: bounds in SI units
+      modes_from: runup           # record whose run-up (or hammer test) gives the measured modes
+      min_confidence: 0.3         # modes of that record used for calibration
+      natural_frequencies: [22, 87, 218, 430]   # or typed by hand [Hz]
+      foundation_modes: [13, 41]  # removed from the measured modes (paper: hammer test)
+      record: steady              # steady record for the signal objectives (default: the first other one)
+      objectives: [correlation, modes]   # of waveform, correlation, frequencies, modes
       algorithm: mogoa            # or nsga2
       pop_size: 16
       n_gen: 8
-      record: healthy             # record name in the measurement file (default: the first)
-      natural_frequencies: [22, 87, 218, 430, 512, 767, 1248, 1927]   # measured modes [Hz]
-      foundation_modes: [13, 41]  # removed from natural_frequencies (paper: hammer test)
       record_duration: 0.3        # s simulated per evaluation, after settle_time
       settle_time: 0.1
       band: [10, 5000]            # Hz, spectrum objective
       refine: true                # polish the pick by least squares on the modes (default)
 
+``parameters: auto`` chooses the parameters the measured modes can identify, with bounds from
+physics (:mod:`twin.calibration.sensitivity`). The default objectives are the paper's
+(waveform, correlation, frequencies) with hand-typed modes and explicit parameters, and
+(correlation, modes) otherwise.
+
 Outputs in ``out_dir``:
-- ``calibrated.json`` and ``calibrated.ssv``: the least-crowded pick (paper Eq. 9);
-- ``knee.json``;
-- ``pareto.csv``;
-- ``checkpoint.json``;
-- ``report.html``, with the paper's Table 2 for this run and PSD overlays before and after
-  (``report_psd.png``).
+- ``calibrated.yaml``: the calibrated scenario, which ``twin compare``, ``diagnose``,
+  ``archive`` (and every command taking a scenario) accept, valid wherever it is moved with
+  its directory; ``calibrated.json`` and ``calibrated.ssv``: the parameter set;
+- ``knee.json``, ``pareto.csv``, ``checkpoint.json``;
+- ``modes.json`` (modes read from a record), ``sensitivity.json`` (with ``parameters: auto``);
+- ``report.html`` with the paper's Table 2 for this run, warnings (parameters ending on a bound)
+  and PSD overlays before and after (``report_psd.png``).
 """
 from __future__ import annotations
 
-import csv
-import html
-from dataclasses import dataclass
+import json
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -35,173 +43,253 @@ import numpy as np
 from twin.errors import ScenarioError
 from twin.scenario import CALIBRATION_SCHEMA
 
+
 @dataclass(frozen=True)
 class CalibrationReport:
     result: object                  # CalibrationResult
     measured_modes: np.ndarray      # (k,) Hz
-    before_modes: np.ndarray        # (k,) matched model modes before
+    before_modes: np.ndarray        # (k,) matched model modes before (NaN: no model mode within reach)
     after_modes: np.ndarray         # (k,) matched model modes after
-    objectives_before: np.ndarray   # (3,)
-    objectives_after: np.ndarray    # (3,)
+    objectives_before: np.ndarray   # (n_obj,)
+    objectives_after: np.ndarray    # (n_obj,)
     out_dir: Path
+    objectives: tuple[str, ...] = ("waveform", "correlation", "frequencies")
+    warnings: tuple[str, ...] = ()
+    sensitivity: object | None = None
+    modes_source: str = "typed in the scenario"
+    scenario_file: Path | None = None
+    notes: tuple[str, ...] = field(default_factory=tuple)
 
     def table(self) -> str:
         """The paper's Table 2 for this run, as text."""
         rows = ["  measured [Hz]   before [Hz]  diff [%]   after [Hz]  diff [%]"]
         for m, b, a in zip(self.measured_modes, self.before_modes, self.after_modes):
-            rows.append(f"  {m:13.1f} {b:13.1f} {100 * (b - m) / m:+9.1f} {a:12.1f} {100 * (a - m) / m:+9.1f}")
+            rows.append(f"  {m:13.1f} {_col(b, m)} {_col(a, m)}")
         return "\n".join(rows)
 
 
-def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, executor=None,
-                    progress: bool = True, seed: int | None = None, resume: bool = False) -> CalibrationReport:
-    """Calibrate the scenario's FMU to one measured record (see the module docstring)."""
-    import jsonschema
+def _col(model: float, measured: float) -> str:
+    if not np.isfinite(model):
+        return f"{'none':>13s} {'':>9s}"
+    return f"{model:13.1f} {100 * (model - measured) / measured:+9.1f}"
 
-    from twin.calibration.objectives import match_modes
-    from twin.calibration.problem import (CalibrationTarget, EvalTask, ParameterSpace, calibrate,
-                                          evaluate_candidate, write_parameter_set)
-    from twin.executor import make_executor
-    from twin.measurements import load_measurements
-    from twin.signals import remove_foundation_modes
+
+def _block(scenario, modes_from: str | None) -> dict:
+    import jsonschema
 
     spec = scenario.raw.get("calibration")
     if spec is None:
-        raise ScenarioError([(str(scenario.source), "calibration", "the scenario has no calibration block")])
-    errors = [(str(scenario.source), "calibration." + ".".join(map(str, e.absolute_path)), e.message)
+        if modes_from is None:
+            raise ScenarioError([(str(scenario.source), "calibration", "the scenario has no calibration block "
+                                  "(add one, or give --modes-from RECORD to calibrate the parameters chosen "
+                                  "automatically to that record's modes)")])
+        spec = {"parameters": "auto"}
+    spec = dict(spec)
+    if modes_from is not None:
+        spec["modes_from"] = modes_from
+    errors = [(str(scenario.source), "calibration." + ".".join(map(str, e.absolute_path)),
+               "must be 'auto' or a mapping of parameter name to [lower, upper]"
+               if e.validator == "oneOf" else e.message)
               for e in jsonschema.Draft202012Validator(CALIBRATION_SCHEMA).iter_errors(spec)]
     if errors:
         raise ScenarioError(errors)
-    out_dir = Path(out_dir)
-    if not out_dir.parent.exists():
-        from twin.errors import OutputPathError
-        raise OutputPathError(f"parent directory {out_dir.parent} does not exist")
-    out_dir.mkdir(exist_ok=True)
+    return spec
 
+
+def measured_modes(spec: dict, mset, source: str, out_dir: Path) -> tuple[np.ndarray, np.ndarray, str]:
+    """(frequencies [Hz], relative sd, description) of the measured modes the block asks for."""
+    from twin.modes import MIN_CONFIDENCE, survey_record, write_survey_json
+    from twin.signals import remove_foundation_modes
+
+    if spec.get("modes_from"):
+        name = spec["modes_from"]
+        if name not in mset.names:
+            raise ScenarioError([(source, "calibration.modes_from",
+                                  f"no record {name!r} in the measurements (they have {', '.join(mset.names)})")])
+        survey = survey_record(mset[name])
+        write_survey_json(survey, out_dir / "modes.json", record=name)
+        threshold = float(spec.get("min_confidence", MIN_CONFIDENCE))
+        used = [m for m in survey.modes if m.confidence >= threshold]
+        if not used:
+            raise ScenarioError([(source, "calibration.modes_from", f"record {name!r} shows no mode with "
+                                  f"confidence >= {threshold:g} (see {out_dir / 'modes.json'})")])
+        freqs = np.array([m.frequency for m in used])
+        rel = np.array([m.evidence.get("frequency_sd_hz", 0.0) / m.frequency for m in used])
+        what = (f"{freqs.size} modes read from record {name!r} ({survey.method}, confidence >= {threshold:g}; "
+                f"{len(survey.lines)} fixed lines and {len(survey.orders)} orders set aside)")
+    elif spec.get("natural_frequencies"):
+        freqs = np.asarray(spec["natural_frequencies"], float)
+        rel = np.zeros(freqs.size)
+        what = "typed in the scenario"
+    else:
+        raise ScenarioError([(source, "calibration.natural_frequencies",
+                              "give the measured natural frequencies, or modes_from: RECORD to read them from a "
+                              "run-up or hammer record")])
+    if spec.get("foundation_modes"):
+        kept, removed = remove_foundation_modes(freqs, np.asarray(spec["foundation_modes"]))
+        keep = np.isin(freqs, kept)
+        freqs, rel = freqs[keep], rel[keep]
+        print(f"removed foundation modes {list(np.round(removed, 1))} Hz from the measured list")
+    return freqs, rel, what
+
+
+def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, executor=None,
+                    progress: bool = True, seed: int | None = None, resume: bool = False,
+                    modes_from: str | None = None) -> CalibrationReport:
+    """Calibrate the scenario's FMU to a measurement file (see the module docstring)."""
+    from twin._atomic import check_output_dir
+    from twin.calibration.modal_fit import mode_errors, on_bounds
+    from twin.calibration.objectives import match_modes
+    from twin.calibration.output import write_calibrated_scenario
+    from twin.calibration.problem import (CalibrationTarget, EvalTask, ParameterSpace, calibrate,
+                                          evaluate_candidate, write_parameter_set)
+    from twin.calibration.report import psd_overlay, write_html, write_pareto
+    from twin.calibration.sensitivity import model_modes, mode_sensitivity
+    from twin.executor import make_executor
+    from twin.measurements import load_measurements
+    from twin.measurements.resample import resample_record
+
+    spec = _block(scenario, modes_from)
+    source = str(scenario.source)
+    out_dir = check_output_dir(out_dir, "calibration output", create=True)
     duration = float(spec.get("record_duration", 0.3))
     settle = float(spec.get("settle_time", 0.1))
     channel = (scenario.outputs or ("accel_pinion_casing",))[0]
-    mset = load_measurements(measurements, min_duration=duration, channels=[channel],
-                             resample_to=scenario.sample_rate)
+    mset = load_measurements(measurements)
     for note in mset.notes:
         print(f"note: {note}")
-    rec = mset[spec["record"]] if "record" in spec else mset[0]
+    freqs, rel_sd, modes_what = measured_modes(spec, mset, source, out_dir)
+    steady_name = spec.get("record") or next((n for n in mset.names if n != spec.get("modes_from")), mset.names[0])
+    if steady_name not in mset.names:
+        raise ScenarioError([(source, "calibration.record", f"no record {steady_name!r} in the measurements")])
+    rec = mset[steady_name]
+    if channel not in rec:
+        raise ScenarioError([(source, "output.variables", f"record {rec.name!r} has no channel {channel!r} "
+                              f"(it has {', '.join(rec.channel_names)})")])
+    if rec.sample_rate != scenario.sample_rate:
+        rec, note = resample_record(rec, scenario.sample_rate)
+        if note:
+            print(f"note: {note}")
     if rec.nominal_speed is None or rec.load is None:
         raise ScenarioError([(str(measurements), f"records.{rec.name}",
                               "calibration needs the record attributes nominal_speed [Hz] and load [N.m]")])
-    modes_measured = np.asarray(spec.get("natural_frequencies", []), float)
-    if modes_measured.size == 0:
-        raise ScenarioError([(str(scenario.source), "calibration.natural_frequencies",
-                              "give the measured natural frequencies (e.g. from a run-up and a hammer test)")])
-    if spec.get("foundation_modes"):
-        modes_measured, removed = remove_foundation_modes(modes_measured, np.asarray(spec["foundation_modes"]))
-        print(f"removed foundation modes {list(np.round(removed, 1))} Hz from the measured list")
+    if rec.duration < duration:
+        raise ScenarioError([(str(measurements), f"records.{rec.name}",
+                              f"the record lasts {rec.duration:.3g} s, shorter than record_duration {duration:g} s")])
+    auto = spec["parameters"] == "auto"
+    default_obj = (["waveform", "correlation", "frequencies"]
+                   if not auto and not spec.get("modes_from") else ["correlation", "modes"])
+    objectives = tuple(spec.get("objectives", default_obj))
     band = spec.get("band", [10.0, 5000.0])
     n = int(round(duration * rec.sample_rate))
     target = CalibrationTarget(np.asarray(rec[channel][-n:], float), rec.sample_rate, float(rec.nominal_speed),
-                               float(rec.load), modes_measured, channel=channel, fmin=band[0], fmax=band[1])
-    space = ParameterSpace.from_bounds(spec["parameters"])
+                               float(rec.load), freqs, channel=channel, fmin=band[0], fmax=band[1],
+                               objectives=objectives, mode_rel_sd=rel_sd)
     fmu = scenario.fmu_path()
-    fixed = {k: v for k, v in scenario.parameters.items() if k not in space.names}
+    fixed = dict(scenario.parameters)
     ex = executor or make_executor(scenario.executor)
     try:
-        shaft = target.measured_shaft_hz
-        before, before_info = evaluate_candidate(EvalTask(str(fmu), dict(fixed), target, settle, duration, shaft))
+        sensitivity = None
+        if auto:
+            sensitivity = mode_sensitivity(fmu, fixed, freqs, speed_hz=target.drive_hz, load_nm=target.load,
+                                           rel_sd=rel_sd, channels=(channel,), executor=ex)
+            (out_dir / "sensitivity.json").write_text(json.dumps(sensitivity.to_dict(), indent=2))
+            if not sensitivity.chosen:
+                raise ScenarioError([(source, "calibration.parameters", "no parameter is identifiable from the "
+                                      "measured modes:\n" + sensitivity.table())])
+            if progress:
+                print(sensitivity.table())
+            bounds = sensitivity.bounds()
+            nominal = {c.name: c.nominal for c in sensitivity.candidates}
+        else:
+            bounds = spec["parameters"]
+            nominal = {}
+        space = ParameterSpace.from_bounds(bounds)
+        fixed = {k: v for k, v in fixed.items() if k not in space.names}
+        kw = dict(speed_hz=target.drive_hz, load_nm=target.load, channels=(channel,))
+        shaft = target.measured_shaft_hz if target.needs_simulation else target.drive_hz
+        before, _ = evaluate_candidate(EvalTask(str(fmu), {**fixed, **nominal}, target, settle, duration, shaft))
         result = calibrate(fmu, space, target, algorithm=spec.get("algorithm", "mogoa"),
                            pop_size=int(spec.get("pop_size", 16)), n_gen=int(spec.get("n_gen", 8)),
                            seed=scenario.seed if seed is None else seed, executor=ex,
                            checkpoint=out_dir / "checkpoint.json", settle=settle, duration=duration, fixed=fixed,
-                           verbose=progress, resume=resume, refine=bool(spec.get("refine", True)))
-        after, after_info = evaluate_candidate(EvalTask(str(fmu), {**fixed, **result.chosen}, target, settle,
-                                                        duration, shaft))
+                           verbose=progress, resume=resume, refine=bool(spec.get("refine", True)),
+                           nominal=nominal or None)
+        after, _ = evaluate_candidate(EvalTask(str(fmu), {**fixed, **result.chosen}, target, settle, duration, shaft))
     finally:
         if executor is None:
             ex.close()
-    write_parameter_set({**fixed, **result.chosen}, out_dir / "calibrated.json")
-    write_parameter_set({**fixed, **result.chosen}, out_dir / "calibrated.ssv", name=f"{scenario.name}-calibrated")
+    chosen = result.chosen
+    warnings = [f"{n} = {chosen[n]:.6g} ended on a bound of [{lo:.6g}, {hi:.6g}]: the measured modes pull it "
+                "beyond what physics allows, so the model's structure may lack something the rig has"
+                for n, lo, hi in zip(space.names, space.lower, space.upper)
+                if n in on_bounds(space.names, [chosen[k] for k in space.names], space.lower, space.upper)]
+    for w in warnings:
+        print(f"warning: {w}")
+    full = {**fixed, **chosen}
+    write_parameter_set(full, out_dir / "calibrated.json")
+    write_parameter_set(full, out_dir / "calibrated.ssv", name=f"{scenario.name}-calibrated")
     write_parameter_set({**fixed, **result.knee}, out_dir / "knee.json")
-    _write_pareto(result, out_dir / "pareto.csv")
-    mb = np.asarray(before_info["natural_frequencies"])
-    ma = np.asarray(after_info["natural_frequencies"])
-    report = CalibrationReport(result, modes_measured, mb[match_modes(mb, modes_measured)],
-                               ma[match_modes(ma, modes_measured)], before, after, out_dir)
-    _psd_overlay(fmu, target, fixed, result.chosen, settle, duration, out_dir / "report_psd.png")
-    _write_html(report, scenario, measurements, out_dir / "report.html")
+    write_pareto(result, objectives, out_dir / "pareto.csv")
+    scenario_file = write_calibrated_scenario(scenario, out_dir / "calibrated.yaml", "calibrated.json",
+                                              note=f"{Path(measurements).name}, {modes_what}", calibrated=chosen)
+    if "modes" in objectives:
+        mb = mode_errors(model_modes(fmu, {**fixed, **nominal}, **kw), freqs, target.rel_sd)[1]
+        ma = mode_errors(model_modes(fmu, full, **kw), freqs, target.rel_sd)[1]
+    else:
+        from twin.linearize import natural_frequencies
+        b = natural_frequencies(fmu, n=freqs.size + 4, parameters={**fixed, **nominal, **_start(target)})
+        a = natural_frequencies(fmu, n=freqs.size + 4, parameters={**full, **_start(target)})
+        mb, ma = b[match_modes(b, freqs)], a[match_modes(a, freqs)]
+    report = CalibrationReport(result, freqs, mb, ma, before, after, out_dir, objectives, tuple(warnings),
+                               sensitivity, modes_what, scenario_file)
+    psd_overlay(fmu, target, {**fixed, **nominal}, chosen, settle, duration, out_dir / "report_psd.png")
+    write_html(report, scenario, measurements, out_dir / "report.html")
     return report
 
 
-def _write_pareto(result, path: Path) -> None:
-    from twin._atomic import atomic_path
-    with atomic_path(path) as tmp:
-        with open(tmp, "w", newline="") as f:
-            w = csv.writer(f)
-            w.writerow([*result.names, "f1_waveform", "f2_spectrum", "f3_frequencies_Hz2"])
-            for x, fv in zip(result.X, result.F):
-                w.writerow([*map(repr, map(float, x)), *map(repr, map(float, fv))])
+def _start(target) -> dict:
+    from twin.operating import operating_point
+    return operating_point(target.drive_hz, target.load)[0]
 
 
-def _simulate(fmu, target, params, settle, duration):
-    from twin.operating import simulate_operating_point
-    return simulate_operating_point(fmu, target.drive_hz, target.load, parameters=params, settle=settle,
-                                    duration=duration, channels=[target.channel],
-                                    output_interval=1 / target.sample_rate)[:, 0]
+def scenario_sensitivity(scenario, measurements: str | Path | None = None, *, modes_from: str | None = None,
+                         n_modes: int = 8, executor=None):
+    """The sensitivity study ``parameters: auto`` runs (:class:`twin.calibration.sensitivity.Sensitivity`).
 
+    Measured modes from ``modes_from`` (or the scenario's calibration block) when measurements
+    are given; otherwise the model's own first ``n_modes`` visible modes, i.e. what a run-up of
+    a rig exactly like the model would identify. The operating point is the steady record's, or
+    the scenario's speed and load at its start time (20 Hz, 20 N.m when it has none).
+    """
+    import tempfile
 
-def _psd_overlay(fmu, target, fixed, chosen, settle, duration, path: Path) -> None:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from twin.calibration.sensitivity import model_modes, mode_sensitivity
+    from twin.measurements import load_measurements
 
-    from twin._atomic import atomic_path
-    from twin.signals import welch_psd
-    res = max(2.0, 4.0 * target.sample_rate / target.signal.size)
-    fig, ax = plt.subplots(figsize=(10, 4.5))
-    for label, x, style in (("measured", target.signal, dict(color="k", lw=1.2)),
-                            ("model before", _simulate(fmu, target, fixed, settle, duration), dict(color="tab:red", lw=0.8)),
-                            ("model after", _simulate(fmu, target, {**fixed, **chosen}, settle, duration),
-                             dict(color="tab:blue", lw=0.8))):
-        f, p = welch_psd(x, target.sample_rate, resolution=res)
-        band = (f >= target.fmin) & (f <= target.fmax)
-        ax.semilogy(f[band], p[band], label=label, **style)
-    for m in target.natural_frequencies:
-        ax.axvline(m, color="0.6", ls=":", lw=0.8)
-    ax.set_xlabel("frequency [Hz]")
-    ax.set_ylabel(f"PSD of {target.channel} [(m/s2)^2/Hz]")
-    ax.set_title("Calibration: PSD before and after (dotted: measured natural frequencies)")
-    ax.legend()
-    ax.grid(alpha=0.3)
-    fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=110)
-    plt.close(fig)
-
-
-def _write_html(report: CalibrationReport, scenario, measurements, path: Path) -> None:
-    from twin._atomic import atomic_path
-    r = report.result
-    rows = "".join(
-        f"<tr><td>{m:.1f}</td><td>{b:.1f}</td><td>{100 * (b - m) / m:+.1f}</td><td>{a:.1f}</td>"
-        f"<td>{100 * (a - m) / m:+.1f}</td></tr>"
-        for m, b, a in zip(report.measured_modes, report.before_modes, report.after_modes))
-    params = "".join(f"<tr><td>{html.escape(k)}</td><td>{v:.6g}</td><td>{r.knee[k]:.6g}</td></tr>"
-                     for k, v in r.chosen.items())
-    ob, oa = report.objectives_before, report.objectives_after
-    doc = f"""<!doctype html><html><head><meta charset="utf-8"><title>Calibration: {html.escape(scenario.name)}</title>
-<style>body{{font-family:sans-serif;max-width:60em;margin:2em auto}}table{{border-collapse:collapse}}
-td,th{{border:1px solid #ccc;padding:.25em .6em;text-align:right}}</style></head><body>
-<h1>Calibration of {html.escape(scenario.fmu)} ({html.escape(scenario.name)})</h1>
-<p>Measurements: {html.escape(str(measurements))}. Algorithm: {r.algorithm}, {r.n_evals} evaluations
-({r.failed_evals} failed and scored infeasible). Final pick: least-crowded member of the Pareto front (paper Eq. 9).</p>
-<h2>Natural frequencies (paper Table 2 for this run)</h2>
-<table><tr><th>measured [Hz]</th><th>model before [Hz]</th><th>diff [%]</th><th>model after [Hz]</th><th>diff [%]</th></tr>{rows}</table>
-<h2>Objectives</h2>
-<table><tr><th></th><th>f1 = 1 - corr(waveforms)</th><th>f2 = 1 - corr(spectra)</th><th>f3 [Hz&sup2;]</th></tr>
-<tr><td>before</td><td>{ob[0]:.4f}</td><td>{ob[1]:.4f}</td><td>{ob[2]:.4g}</td></tr>
-<tr><td>after</td><td>{oa[0]:.4f}</td><td>{oa[1]:.4f}</td><td>{oa[2]:.4g}</td></tr></table>
-<h2>Calibrated parameters</h2>
-<table><tr><th>parameter</th><th>least-crowded pick</th><th>knee point</th></tr>{params}</table>
-<p>Files: calibrated.json, calibrated.ssv (SSP parameter values), knee.json, pareto.csv, checkpoint.json.</p>
-<h2>PSD before and after</h2><img src="report_psd.png" style="max-width:100%">
-</body></html>"""
-    with atomic_path(path) as tmp:
-        Path(tmp).write_text(doc)
+    spec = dict(scenario.raw.get("calibration") or {})
+    if modes_from is not None:
+        spec["modes_from"] = modes_from
+    speed = scenario.inputs.get("motor_speed_ref")
+    load = scenario.inputs.get("load_torque")
+    speed_hz = speed(scenario.start_time) / (2 * np.pi) if speed is not None else 20.0
+    load_nm = load(scenario.start_time) if load is not None else 20.0
+    channel = (scenario.outputs or ("accel_pinion_casing",))[0]
+    fmu = scenario.fmu_path()
+    values = dict(scenario.parameters)
+    if measurements is not None and (spec.get("modes_from") or spec.get("natural_frequencies")):
+        mset = load_measurements(measurements)
+        with tempfile.TemporaryDirectory() as tmp:
+            freqs, rel, _ = measured_modes(spec, mset, str(scenario.source), Path(tmp))
+        steady = [r for r in mset if r.name != spec.get("modes_from") and r.nominal_speed and r.load is not None]
+        if steady:
+            speed_hz, load_nm = float(steady[0].nominal_speed), float(steady[0].load)
+    elif spec.get("natural_frequencies"):
+        freqs = np.asarray(spec["natural_frequencies"], float)
+        rel = np.zeros(freqs.size)
+    else:
+        mm = model_modes(fmu, values, speed_hz=speed_hz, load_nm=load_nm, channels=(channel,))
+        freqs = mm.frequency[mm.visible][:n_modes]
+        rel = np.zeros(freqs.size)
+    return mode_sensitivity(fmu, values, freqs, speed_hz=speed_hz, load_nm=load_nm, rel_sd=rel, channels=(channel,),
+                            executor=executor)

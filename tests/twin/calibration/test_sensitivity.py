@@ -1,0 +1,68 @@
+"""Candidate parameters and their physical bounds, the identifiable subset, matching measured modes."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from twin.calibration.sensitivity import (Candidate, candidate_parameters, match_measured, model_modes,
+                                          mode_sensitivity, select_identifiable)
+
+
+def _cands(n):
+    return [Candidate(f"p{j}", 1.0, 0.5, 2.0, "test") for j in range(n)]
+
+
+def test_candidates_are_physical_parameters_with_bounds_from_physics(gearbox_fmu):
+    cands = {c.name: c for c in candidate_parameters(gearbox_fmu, {"kt12": 1800.0})}
+    assert cands["kt12"].nominal == 1800.0
+    assert cands["kt12"].lower == pytest.approx(600.0) and cands["kt12"].upper == pytest.approx(5400.0)
+    assert cands["I1"].lower == pytest.approx(0.7 * 4.3e-3) and "inertia" in cands["I1"].reason
+    assert cands["kt35"].upper == pytest.approx(1.6 * 1.5e4)                  # a shaft, not a coupling
+    assert cands["ky4"].upper == pytest.approx(4 * 5e7)                       # a support
+    assert cands["mesh_stiffness_scale"].lower == pytest.approx(0.6)
+    for excluded in ("ct12", "cx4", "c_mesh", "module", "alpha", "sensor_angle_pinion", "load_start", "z2"):
+        assert excluded not in cands
+    assert not any("[" in n for n in cands)
+
+
+def test_collinear_and_insensitive_parameters_are_left_out_by_name():
+    rng = np.random.default_rng(0)
+    S = rng.normal(0.0, 0.3, (6, 4))
+    S = np.column_stack([S, -S[:, 1], 1e-4 * rng.normal(size=6)])     # p4 = -p1 exactly, p5 does nothing
+    chosen, left_out, info, cond = select_identifiable(S, _cands(6), np.full(6, 0.01))
+    assert set(chosen) >= {"p0", "p2", "p3"} and ("p1" in chosen) != ("p4" in chosen)
+    dup = "p4" if "p1" in chosen else "p1"
+    assert "cannot tell them apart" in left_out[dup] and ("p1" if dup == "p4" else "p4") in left_out[dup]
+    assert "hardly depend" in left_out["p5"]
+    assert np.isfinite(cond) and cond < 100
+
+
+def test_never_more_parameters_than_modes():
+    S = np.random.default_rng(1).normal(0.0, 0.5, (3, 8))
+    chosen, left_out, _, _ = select_identifiable(S, _cands(8), np.full(3, 0.01))
+    assert len(chosen) == 3 and len(left_out) == 5
+
+
+def test_measured_modes_far_from_every_model_mode_stay_unmatched(gearbox_fmu):
+    mm = model_modes(gearbox_fmu, {}, speed_hz=20.0, load_nm=20.0)
+    visible = mm.frequency[mm.visible]
+    measured = np.array([visible[2] * 1.02, visible[3] * 0.99, 0.5 * (visible[4] + visible[5]) * 1.6])
+    idx = match_measured(mm, measured)
+    assert mm.frequency[idx[0]] == pytest.approx(visible[2]) and mm.frequency[idx[1]] == pytest.approx(visible[3])
+    assert idx[2] == -1 or abs(np.log(mm.frequency[idx[2]] / measured[2])) <= 0.15
+
+
+def test_the_twins_own_modes_identify_one_parameter_per_mode_group(gearbox_fmu):
+    mm = model_modes(gearbox_fmu, {}, speed_hz=20.0, load_nm=20.0)
+    freqs = mm.frequency[mm.visible][:6]
+    sens = mode_sensitivity(gearbox_fmu, {}, freqs, speed_hz=20.0, load_nm=20.0)
+    assert 3 <= len(sens.chosen) <= 6
+    assert sens.S.shape == (6, len(sens.candidates))
+    # the brake inertia and coupling 4 set the lowest mode together: never both
+    assert not {"I13", "kt1213"} <= set(sens.chosen)
+    # the two input-shaft pedestals are mirror images: the modes cannot tell them apart
+    assert not {"ky4", "ky6"} <= set(sens.chosen)
+    assert set(sens.left_out) == {c.name for c in sens.candidates} - set(sens.chosen)
+    bounds = sens.bounds()
+    assert all(lo < hi for lo, hi in bounds.values()) and set(bounds) == set(sens.chosen)
+    assert "not identifiable" in sens.table() and sens.to_dict()["chosen"] == list(sens.chosen)

@@ -1,0 +1,334 @@
+"""Which parameters the measured modes can identify, and within which physical bounds.
+
+1. **Candidates.** Every tunable scalar parameter of the FMU whose unit says it is a mass, an
+   inertia, a stiffness (or the mesh-stiffness scale), with bounds from physics
+   (:data:`PHYSICS_BOUNDS`: masses and inertias come from the geometry to within about 30 %,
+   shaft stiffnesses to within a factor 1.6, couplings, bearings and supports to within a factor
+   3-4), narrowed to the model's own ``min``/``max`` when it declares them.
+2. **Modes.** The model is linearised about the operating point (:mod:`twin.linearize`) with
+   the sensor output and the mesh excitation; a model mode counts as *visible* when it makes a
+   peak of the mesh-to-sensor response, the way a measured mode shows in a run-up. Measured modes
+   are matched to visible model modes (minimum total |ln f_model/f_measured| in units of the
+   measurement's uncertainty; a measured mode with no model mode within 15 % stays unmatched).
+3. **Sensitivities** ``S[i, j] = d ln f_i / d ln p_j`` by one-sided differences (2 %), modes
+   followed by their shapes (MAC) so that two crossing modes are not confused.
+4. **Identifiable subset** by QR with column pivoting on the weighted matrix
+   ``S[i, j] * h_j / s_i`` (``h_j`` half the log-range of the bounds, ``s_i`` the relative
+   uncertainty of mode i): a column is kept while the information it adds beyond the columns
+   already kept, ``|R_kk|^2``, is at least :data:`MIN_INFORMATION` times the prior's (its bounds').
+   A parameter left out is reported with why: the modes hardly depend on it, or it moves them
+   the way a kept parameter does (named).
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+
+#: (unit, words in the description, relative bounds [lower, upper] about the nominal, reason); the
+#: first rule whose unit matches and whose words (if any) occur in the description applies
+PHYSICS_BOUNDS: tuple[tuple[str, tuple[str, ...], tuple[float, float], str], ...] = (
+    ("kg.m2", (), (0.7, 1.4), "inertia: from the geometry of steel parts, within about 30 %"),
+    ("kg", (), (0.7, 1.4), "mass: from the geometry, within about 30 %"),
+    ("N.m/rad", ("shaft",), (0.6, 1.6), "shaft torsional stiffness: from the diameter (d^4), within a factor 1.6"),
+    ("N.m/rad", (), (1 / 3, 3.0), "coupling stiffness: catalogue values scatter by a factor 3"),
+    ("N/m", ("pedestal", "ground"), (0.25, 4.0), "support stiffness: bolted joints and foundation, a factor 4"),
+    ("N/m", (), (1 / 3, 3.0), "shaft-and-bearing stiffness: bearing clearance and preload, a factor 3"),
+    ("", ("calibration multiplier", "pair stiffness"), (0.6, 1.5),
+     "mesh stiffness: ISO 6336 single-pair stiffness is good to about -40/+50 %"),
+)
+#: A kept column must add at least this many times the prior's information (posterior sd at most
+#: 1/sqrt(1 + 4) = 45 % of the prior's).
+MIN_INFORMATION = 4.0
+#: Relative model-form uncertainty of a model mode [-], added in quadrature to the measurement's.
+MODEL_FORM = 0.01
+#: A measured mode with no visible model mode within this relative distance stays unmatched.
+MATCH_REACH = 0.15
+#: Parameters moved together to form a transmission error (mesh excitation) in GearTwin models.
+MESH_EXCITATION = "profile_deviation"
+
+
+@dataclass(frozen=True)
+class Candidate:
+    name: str
+    nominal: float
+    lower: float
+    upper: float
+    reason: str
+
+    @property
+    def half_log_range(self) -> float:
+        return 0.5 * math.log(self.upper / self.lower)
+
+
+def candidate_parameters(fmu_path: str | Path, values: Mapping[str, float] | None = None) -> list[Candidate]:
+    """Physical, tunable scalar parameters of the FMU with bounds from physics (see the docstring)."""
+    from twin.fmu import FMU
+
+    values = dict(values or {})
+    out = []
+    with FMU(fmu_path) as fmu:
+        svs = {sv.name: sv for sv in fmu.model_description.modelVariables}
+        for v in fmu.parameters:
+            if v.type != "Real" or v.causality != "parameter" or "[" in v.name or "." in v.name:
+                continue
+            rule = _bounds_rule(v.unit, v.description)
+            if rule is None:
+                continue
+            nominal = float(values.get(v.name, v.start if v.start is not None else 0.0))
+            if not nominal > 0:
+                continue
+            (lo, hi), reason = rule
+            lower, upper = nominal * lo, nominal * hi
+            sv = svs.get(v.name)
+            declared_min = getattr(sv, "min", None) if sv is not None else None
+            declared_max = getattr(sv, "max", None) if sv is not None else None
+            if declared_min is not None and float(declared_min) > lower and float(declared_min) < nominal:
+                lower, reason = float(declared_min), reason + "; model min"
+            if declared_max is not None and float(declared_max) < upper and float(declared_max) > nominal:
+                upper, reason = float(declared_max), reason + "; model max"
+            out.append(Candidate(v.name, nominal, lower, upper, reason))
+    return out
+
+
+def _bounds_rule(unit: str, description: str):
+    text = (description or "").lower()
+    for rule_unit, words, bounds, reason in PHYSICS_BOUNDS:
+        if unit != rule_unit:
+            continue
+        if words and not any(w in text for w in words):
+            continue
+        if rule_unit == "" and not words:
+            continue
+        return bounds, reason
+    return None
+
+
+@dataclass(frozen=True)
+class ModelModes:
+    """Model modes at one parameter set: all oscillatory ones and which of them a sensor shows."""
+
+    frequency: np.ndarray         # (m,) Hz
+    damping: np.ndarray           # (m,)
+    visible: np.ndarray           # (m,) bool
+    shapes: np.ndarray            # (n, m) complex
+    gain_db: np.ndarray           # (m,) peak gain of the mode alone, dB re the most visible
+
+
+def model_modes(fmu_path, parameters: Mapping[str, float], *, speed_hz: float, load_nm: float,
+                channels: Sequence[str] = ("accel_pinion_casing",), fmax: float = 10_000.0) -> ModelModes:
+    """Linearise at the operating point and find the visible modes (see the module docstring)."""
+    from scipy.signal import find_peaks
+
+    from twin.linearize import frequency_response, linear_model, modal_model
+    from twin.operating import operating_point
+
+    start, inputs = operating_point(speed_hz, load_nm)
+    excitations = {"mesh": [MESH_EXCITATION + "[*]"]}
+    lm = linear_model(fmu_path, parameters={**parameters, **start}, inputs=inputs, outputs=list(channels),
+                      excitations=excitations, settle=0.02, window=2.5e-3, samples=4)
+    mm = modal_model(lm)
+    keep = mm.frequency <= fmax
+    freq, damp, shapes = mm.frequency[keep], mm.damping[keep], mm.shapes[:, keep]
+    gain = mm.gain[:, :, keep].max(axis=(0, 1))
+    visible = np.zeros(freq.size, dtype=bool)
+    if freq.size:
+        grid = np.geomspace(max(1.0, 0.5 * freq.min()), min(fmax, 1.5 * freq.max()), 6000)
+        sub = type(mm)(freq, damp, shapes, mm.gain[:, :, keep], mm.eigenvalues[keep], mm.residues[:, :, keep])
+        h = frequency_response(sub, grid)
+        for k in range(h.shape[0]):
+            for e in range(h.shape[1]):
+                level = 20 * np.log10(np.maximum(np.abs(h[k, e]), 1e-300))
+                peaks, _ = find_peaks(level, prominence=3.0)
+                for p in peaks:
+                    near = np.abs(np.log(freq / grid[p])) <= np.maximum(0.03, 2 * damp)
+                    if near.any():
+                        i = np.flatnonzero(near)[np.argmax(gain[near])]
+                        visible[i] = True
+    top = gain[visible].max() if visible.any() else (gain.max() if gain.size else 1.0)
+    return ModelModes(freq, damp, visible, shapes, 20 * np.log10(np.maximum(gain, 1e-300) / top))
+
+
+def match_measured(model: ModelModes, measured: np.ndarray, rel_sd: np.ndarray | None = None) -> np.ndarray:
+    """Index of the visible model mode matched to each measured mode, -1 where none is within reach."""
+    measured = np.asarray(measured, float)
+    rel_sd = np.full(measured.size, MODEL_FORM) if rel_sd is None else np.asarray(rel_sd, float)
+    idx = np.flatnonzero(model.visible)
+    out = np.full(measured.size, -1, dtype=int)
+    if idx.size == 0 or measured.size == 0:
+        return out
+    dist = np.abs(np.log(model.frequency[idx][None, :] / measured[:, None]))
+    cost = dist / rel_sd[:, None]
+    big = 1e6
+    cost = np.where(dist <= MATCH_REACH, cost, big)
+    # dummy columns: leaving a measured mode unmatched costs as much as the reach itself
+    dummy = np.full((measured.size, measured.size), MATCH_REACH / rel_sd.min() * 2)
+    rows, cols = linear_sum_assignment(np.hstack([cost, dummy]))
+    for r, c in zip(rows, cols):
+        if c < idx.size and cost[r, c] < big:
+            out[r] = idx[c]
+    return out
+
+
+def _mac(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Modal assurance criterion between the columns of a (n, p) and b (n, q): (p, q) in [0, 1]."""
+    num = np.abs(a.conj().T @ b) ** 2
+    den = np.outer(np.sum(np.abs(a) ** 2, axis=0), np.sum(np.abs(b) ** 2, axis=0))
+    return num / np.maximum(den, 1e-300)
+
+
+def follow_index(base: ModelModes, moved: ModelModes, which: np.ndarray) -> np.ndarray:
+    """Index in ``moved`` of each base mode ``which`` (one-to-one, by shape (MAC) and frequency).
+
+    Reliable for small changes of the parameters (a finite difference, one step of a fit): modes
+    that veer apart under a large change can exchange shapes.
+    """
+    mac = _mac(base.shapes[:, which], moved.shapes)
+    closeness = np.abs(np.log(moved.frequency[None, :] / base.frequency[which][:, None]))
+    rows, cols = linear_sum_assignment(-(mac - closeness))
+    out = np.empty(which.size, dtype=int)
+    out[rows] = cols
+    return out
+
+
+def follow(base: ModelModes, moved: ModelModes, which: np.ndarray) -> np.ndarray:
+    """Frequencies [Hz] in ``moved`` of the base modes ``which`` (see :func:`follow_index`)."""
+    return moved.frequency[follow_index(base, moved, which)]
+
+
+@dataclass(frozen=True)
+class Sensitivity:
+    """d ln f / d ln p of the matched modes, the chosen subset and why the others are left out."""
+
+    modes_hz: np.ndarray                  # (k,) model frequencies of the matched modes at nominal
+    measured_hz: np.ndarray               # (k,)
+    rel_sd: np.ndarray                    # (k,) relative uncertainty of each mode
+    candidates: tuple[Candidate, ...]
+    S: np.ndarray                         # (k, p)
+    chosen: tuple[str, ...]
+    left_out: Mapping[str, str]           # name -> reason
+    information: Mapping[str, float]      # name -> |R_kk|^2 in pivot order (kept and first left out)
+    condition: float                      # of the weighted, chosen columns
+    unmatched_hz: tuple[float, ...] = ()
+    notes: tuple[str, ...] = field(default_factory=tuple)
+
+    def bounds(self) -> dict[str, list[float]]:
+        by = {c.name: c for c in self.candidates}
+        return {n: [by[n].lower, by[n].upper] for n in self.chosen}
+
+    def table(self) -> str:
+        by = {c.name: c for c in self.candidates}
+        head = "  parameter        " + "".join(f"{f:>9.0f}" for f in self.modes_hz) + "   bounds"
+        rows = ["d ln f / d ln p of the matched model modes [Hz at nominal]:", head]
+        order = list(self.chosen) + [c.name for c in self.candidates if c.name not in self.chosen]
+        for n in order:
+            j = [c.name for c in self.candidates].index(n)
+            mark = "*" if n in self.chosen else " "
+            rows.append(f"{mark} {n:<16s}" + "".join(f"{v:9.3f}" for v in self.S[:, j])
+                        + f"   [{by[n].lower:.4g}, {by[n].upper:.4g}]")
+        rows.append(f"chosen (*): {', '.join(self.chosen) or 'none'}; condition number {self.condition:.3g}")
+        for n, why in self.left_out.items():
+            rows.append(f"  not identifiable: {n}: {why}")
+        if self.unmatched_hz:
+            rows.append("  measured modes the model has no visible mode for (within 15 %): "
+                        + ", ".join(f"{f:.1f} Hz" for f in self.unmatched_hz))
+        rows += [f"note: {n}" for n in self.notes]
+        return "\n".join(rows)
+
+    def to_dict(self) -> dict:
+        return {"modes_hz": self.modes_hz.tolist(), "measured_hz": self.measured_hz.tolist(),
+                "relative_sd": self.rel_sd.tolist(),
+                "parameters": [{"name": c.name, "nominal": c.nominal, "bounds": [c.lower, c.upper],
+                                "bounds_reason": c.reason, "d_ln_f_d_ln_p": self.S[:, j].tolist(),
+                                "chosen": c.name in self.chosen, "left_out": self.left_out.get(c.name)}
+                               for j, c in enumerate(self.candidates)],
+                "chosen": list(self.chosen), "condition": self.condition,
+                "unmatched_measured_hz": list(self.unmatched_hz), "notes": list(self.notes)}
+
+
+def mode_sensitivity(fmu_path, values: Mapping[str, float], measured_hz, *, speed_hz: float, load_nm: float,
+                     rel_sd=None, channels: Sequence[str] = ("accel_pinion_casing",),
+                     candidates: Sequence[Candidate] | None = None, step: float = 0.02,
+                     executor=None) -> Sensitivity:
+    """Sensitivities of the measured modes' model counterparts and the identifiable subset."""
+    measured = np.asarray(measured_hz, float)
+    rel = np.sqrt((np.full(measured.size, 0.0) if rel_sd is None else np.asarray(rel_sd, float)) ** 2
+                  + MODEL_FORM ** 2)
+    cands = list(candidates) if candidates is not None else candidate_parameters(fmu_path, values)
+    kw = dict(speed_hz=speed_hz, load_nm=load_nm, channels=tuple(channels))
+    base = model_modes(fmu_path, values, **kw)
+    match = match_measured(base, measured, rel)
+    ok = match >= 0
+    which = match[ok]
+    notes = []
+    if not ok.any():
+        raise ValueError("no measured mode has a visible model mode within 15 %: the model and the record "
+                         f"do not share a mode (measured {np.round(measured, 1).tolist()} Hz, visible model "
+                         f"{np.round(base.frequency[base.visible], 1).tolist()} Hz)")
+    tasks = [(str(fmu_path), {**values, c.name: c.nominal * (1 + step)}, kw) for c in cands]
+    if executor is not None:
+        moved = executor.map(_modes_task, tasks, desc="sensitivities")
+    else:
+        moved = [_modes_task(t) for t in tasks]
+    S = np.empty((which.size, len(cands)))
+    for j, mv in enumerate(moved):
+        S[:, j] = np.log(follow(base, mv, which) / base.frequency[which]) / math.log(1 + step)
+    chosen, left_out, info, cond = select_identifiable(S, cands, rel[ok])
+    return Sensitivity(base.frequency[which], measured[ok], rel[ok], tuple(cands), S, chosen, left_out, info, cond,
+                       tuple(float(f) for f in measured[~ok]), tuple(notes))
+
+
+def _modes_task(task):
+    path, values, kw = task
+    return model_modes(path, values, **kw)
+
+
+def select_identifiable(S: np.ndarray, candidates: Sequence[Candidate], rel_sd: np.ndarray, *,
+                        min_information: float = MIN_INFORMATION, max_parameters: int | None = None):
+    """(chosen names, {left-out name: reason}, {name: information}, condition) by pivoted QR."""
+    from scipy.linalg import qr
+
+    half = np.array([c.half_log_range for c in candidates])
+    Sw = S * half[None, :] / rel_sd[:, None]
+    k = Sw.shape[0]
+    limit = min(k, max_parameters or k)
+    _, R, piv = qr(Sw, pivoting=True, mode="economic")
+    diag = np.abs(np.diag(R))
+    chosen_idx: list[int] = []
+    info: dict[str, float] = {}
+    for pos, j in enumerate(piv[: diag.size]):
+        info[candidates[j].name] = float(diag[pos] ** 2)
+        if diag[pos] ** 2 < min_information or len(chosen_idx) >= limit:
+            break
+        chosen_idx.append(int(j))
+    chosen = tuple(candidates[j].name for j in chosen_idx)
+    left_out: dict[str, str] = {}
+    norms = np.linalg.norm(Sw, axis=0)
+    for j, c in enumerate(candidates):
+        if j in chosen_idx:
+            continue
+        if norms[j] ** 2 < min_information:
+            shift = float(np.max(np.abs(S[:, j])) * 2 * c.half_log_range * 100)
+            left_out[c.name] = (f"the modes hardly depend on it (across its bounds they move by at most "
+                                f"{shift:.2g} %)")
+            continue
+        if chosen_idx:
+            # the kept parameter whose effect on the modes is most alike (cosine of the columns)
+            A = Sw[:, chosen_idx]
+            cos = (A.T @ Sw[:, j]) / (np.linalg.norm(A, axis=0) * norms[j])
+            best = int(np.argmax(np.abs(cos)))
+            if abs(cos[best]) >= 0.9:
+                left_out[c.name] = (f"moves the modes as {chosen[best]} does (cosine {cos[best]:+.2f}): the modes "
+                                    "cannot tell them apart")
+            else:
+                left_out[c.name] = (f"adds too little beyond the chosen parameters (most alike: {chosen[best]}, "
+                                    f"cosine {cos[best]:+.2f}; information {float(norms[j] ** 2):.2g} before, less "
+                                    "after them)")
+        else:
+            left_out[c.name] = "no parameter can be chosen"
+    cond = float(np.linalg.cond(Sw[:, chosen_idx])) if chosen_idx else float("inf")
+    return chosen, left_out, info, cond
