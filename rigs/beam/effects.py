@@ -2,7 +2,7 @@
 
 | name | implementation |
 |---|---|
-| pinion_runout | eccentric pinion: separation along the line of action and a shorter path of contact as the centre distance grows, once per pinion revolution |
+| pinion_runout | eccentric pinion: its teeth reach the line of action early or late (separation and contact timing) and the path of contact shortens as the centre distance grows, once per pinion revolution |
 | gear_runout | the same on the gear, once per gear revolution |
 | drive_ripple | armature-torque ripple of the drive at a fixed frequency (a supply interharmonic), locked to no shaft |
 | casing_resonance | the pinion-side accelerometer sits on a bracket with its own lightly damped resonance |
@@ -15,12 +15,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 DEFAULTS = {
-    "pinion_runout": {"eccentricity": 40e-6, "phase": 0.7},
-    "gear_runout": {"eccentricity": 60e-6, "phase": 2.1},
-    "drive_ripple": {"frequency": 257.0, "amplitude": 0.35, "phase": 0.0},
-    "casing_resonance": {"frequency": 3300.0, "damping": 0.012, "channel": "accel_pinion_casing"},
-    "local_tooth_fault": {"tooth": 5, "from_pitch": -1.3e-3, "to_pitch": 1.1e-3,
-                          "face_from": 0.0, "face_to": 0.5, "depth": 40e-6},
+    "pinion_runout": {"eccentricity": 80e-6, "phase": 0.7},
+    "gear_runout": {"eccentricity": 150e-6, "phase": 2.1},
+    "drive_ripple": {"frequency": 347.0, "amplitude": 0.8, "phase": 0.0},
+    "casing_resonance": {"frequency": 3300.0, "damping": 0.03, "channel": "accel_pinion_casing"},
+    "local_tooth_fault": {"tooth": 5, "from_pitch": -1.8e-3, "to_pitch": 1.6e-3,
+                          "face_from": 0.0, "face_to": 0.9, "depth": 40e-6},
     "bearing_outer_race": {"bearing": 1, "severity": 0.35, "pulse": 0.12e-3, "jitter": 0.01},
     "coupling_misalignment": {"force": 45.0, "torque": 0.12, "phase": 0.3},
 }

@@ -218,8 +218,8 @@ def run(n_steps, n_settle, par, Ph, G0, G1, two_zw, w2, gvec, B, G_ser, series, 
         dg_y = par[42] * np.cos(-th_g + par[43])
         dg_z = par[42] * np.sin(-th_g + par[43])
         e_run = -(dp_y * sa + dp_z * ca) + (dg_y * sa + dg_z * ca)
-        shrink = max((dg_y - dp_y) / sa, 0.0)
-        s = par[3] * th_p
+        shrink = (dg_y - dp_y) / sa       # path of contact shortens as the centres part
+        s = par[3] * th_p + dp_y * sa + dp_z * ca     # eccentric pinion: its teeth arrive early/late
         delta = d_pred
         for it in range(50):
             ftot, ktot = _mesh(delta, s, par, gap_p, gap_g, comp_p, width_p, hertz_a, du,

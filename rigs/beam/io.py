@@ -83,5 +83,6 @@ def write(path, records) -> Path:
                                  "records": {r.name: r.truth for r in records}}), f, indent=1)
 
     _atomic(path, h5)
+    os.chmod(path, 0o644)
     _atomic(Path(str(path) + ".truth.json"), truth)
     return path

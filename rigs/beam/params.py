@@ -143,9 +143,10 @@ class Brake:
 @dataclass(frozen=True)
 class Surfaces:
     """Micro-geometry of run-in flanks of ground test gears (about ISO 1328 grade 5)."""
-    pitch_error: float = 1.0e-6       # r.m.s. single pitch deviation [m]
-    form_error: float = 0.6e-6        # r.m.s. of a low-order profile form deviation
-    waviness: float = 0.3e-6          # r.m.s. waviness
+    pitch_error: float = 0.6e-6       # r.m.s. single pitch deviation [m]
+    form_error: float = 0.6e-6        # r.m.s. of the low-order profile form common to all teeth
+    form_scatter: float = 0.15e-6     # r.m.s. of its tooth-to-tooth variation
+    waviness: float = 0.2e-6          # r.m.s. waviness
     waviness_length: float = 0.7e-3   # correlation length [m]
     roughness: float = 0.4e-6         # Rq of one profile trace [m]
     roughness_length: float = 40.0e-6  # its correlation length along the profile

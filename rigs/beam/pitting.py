@@ -23,6 +23,7 @@ import numpy as np
 N_FACE = 64            # raster columns across the face width
 MAX_PITS = 600
 SPREAD_LENGTH = 5.0e-3  # m, load-spreading length of the tooth body across the face
+RIDGE_FLATTENING = 2.5e-6  # m, sinking of a contact line carrying twice its nominal line load
 
 
 def pit_population(rng: np.random.Generator, hazard: np.ndarray, u: np.ndarray, width: float,
@@ -96,6 +97,11 @@ def slice_contact(depth: np.ndarray, body: np.ndarray, hertz_lin: np.ndarray, wi
     # a contact line entirely inside pits bears on the shallowest pit bottom
     gap[lost] = depth[lost].min(axis=-1) if lost.any() else 0.0
     w = np.where(lost, 1.0, w)
+    # the ridges left between pits carry the concentrated load and flatten plastically:
+    # the loaded line sinks by RIDGE_FLATTENING (1/w - 1), at most to the pit bottom
+    count = np.count_nonzero(depth > 0, axis=-1)
+    bottom = depth.sum(axis=-1) / np.maximum(count, 1)
+    gap = np.where(lost, gap, np.minimum(RIDGE_FLATTENING * (1.0 / np.maximum(w, 0.03) - 1.0), bottom))
     need = (w < 0.999) & ~lost
     ti, ui = np.nonzero(need)
     if ti.size:

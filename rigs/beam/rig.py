@@ -179,7 +179,9 @@ class Rig:
         chans["encoder"] = acquire.encoder(out[:, 2], fs_in, s.sample_rate, n_out, s.encoder_lines,
                                            self.encoder_line_errors)
         true_speed = out[:, 6] / (2 * np.pi)
-        name = name or f"{kind}_{speeds[1]:g}Hz_{load:g}Nm_seed{seed}"
+        if name is None:
+            what = eff.name if eff else ("pitting" if dmg.pitting else "wear" if dmg.wear else "healthy")
+            name = f"{kind}_{speeds[1]:g}Hz_{load:g}Nm_{what}_seed{seed}"
         modes = self.modes(speeds[1], load_true, lubricated=bool(lubricated))
         truth = {
             "rig": VERSION, "record": name, "kind": kind, "seed": int(seed),

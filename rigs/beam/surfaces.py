@@ -50,11 +50,14 @@ def flank_deviations(rng, s, u, n_teeth, contact, tip_at_end: bool, edge, edge_l
     t = 2 * (u - u[0]) / (u[-1] - u[0]) - 1
     out = np.empty((n_teeth, u.size))
     pos = rng.normal(0, s.pitch_error / np.sqrt(2), n_teeth)
-    for k in range(n_teeth):
+
+    def legendre(rms):
         c = rng.normal(0, 1, 3)
-        form = c[0] * t + c[1] * (1.5 * t**2 - 0.5) + c[2] * (2.5 * t**3 - 1.5 * t)
-        form *= s.form_error / np.sqrt((form**2).mean() + 1e-30)
-        out[k] = (pos[k] + form
+        f = c[0] * t + c[1] * (1.5 * t**2 - 0.5) + c[2] * (2.5 * t**3 - 1.5 * t)
+        return f * rms / np.sqrt((f**2).mean() + 1e-30)
+    common = legendre(s.form_error)          # the same dressing of the tool on every tooth
+    for k in range(n_teeth):
+        out[k] = (pos[k] + common + legendre(s.form_scatter)
                   + _gauss_process(rng, u, s.waviness, s.waviness_length, contact)
                   + _gauss_process(rng, u, rough, s.roughness_length, contact))
     x = (u - (u[-1] - edge_len)) if tip_at_end else (edge_len - u)

@@ -12,7 +12,8 @@ worn pair, recomputed after each of N increments, so deep wear near the pinion r
 gear tip unloads itself and the profile shape evolves. The depth per increment is scaled so
 the mean depth over the pinion's active flank grows by target/N: the unknown wear coefficient
 and running time collapse into the damage measure. Each increment is smoothed over the
-Hertzian contact width (semi-elliptic pressure).
+Hertzian contact width widened by SPREAD (semi-elliptic kernel): the contact of neighbouring
+points (the contact shifts on the changing profile, debris spreads) smooths the worn profile.
 """
 from __future__ import annotations
 
@@ -21,6 +22,8 @@ import numpy as np
 from .contact import cycle_positions, static_mesh
 
 INCREMENTS = 12
+SPREAD = 0.6e-3   # m: wear debris and the contact shifting on the changing profile spread each
+#                   increment over neighbouring points (a smoother worn profile)
 
 
 def _smooth(x, half_width_cells):
@@ -55,8 +58,8 @@ def archard_profiles(mean_depth: float, geo, tables, force: float, z1: int, z2: 
             ok = valid[:, n]
             order = np.argsort(pos[ok, n])
             f_u = np.maximum(f_u, np.interp(u, pos[ok, n][order], forces[ok, n][order], left=0, right=0))
-        rate_p = _smooth(f_u * slide / rho1, half / du)
-        rate_g = _smooth(f_u * slide / (ratio * rho2) * ratio, half / du)
+        rate_p = _smooth(f_u * slide / rho1, (half + SPREAD) / du)
+        rate_g = _smooth(f_u * slide / (ratio * rho2) * ratio, (half + SPREAD) / du)
         scale = (mean_depth / INCREMENTS) / rate_p.mean()
         h_p += scale * rate_p
         h_g += scale * rate_g
