@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 DEFAULTS = {
     "pinion_runout": {"eccentricity": 80e-6, "phase": 0.7},
-    "gear_runout": {"eccentricity": 150e-6, "phase": 2.1},
+    "gear_runout": {"eccentricity": 200e-6, "phase": 2.1},
     "drive_ripple": {"frequency": 347.0, "amplitude": 0.8, "phase": 0.0},
     "casing_resonance": {"frequency": 3300.0, "damping": 0.03, "channel": "accel_pinion_casing"},
     "local_tooth_fault": {"tooth": 5, "from_pitch": -1.8e-3, "to_pitch": 1.6e-3,

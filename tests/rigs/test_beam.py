@@ -22,7 +22,7 @@ def rig():
 def records(rig):
     names = [None, "pinion_runout", "gear_runout", "drive_ripple", "casing_resonance",
              "local_tooth_fault", "bearing_outer_race", "coupling_misalignment"]
-    return {n: rig.steady(20.0, 20.0, 0.8, effect=n, seed=1) for n in names}
+    return {n: rig.steady(20.0, 20.0, 1.0, effect=n, seed=1) for n in names}
 
 
 def _spec(x):
@@ -174,7 +174,7 @@ def test_pitting_raises_sidebands_monotonically(rig):
     level = []
     for s in range(len(PITTING_EDGES) - 1):
         c = 0.5 * (PITTING_EDGES[s] + PITTING_EDGES[s + 1])
-        r = rig.steady(20.0, 20.0, 0.35, damage={"pitting": c}, seed=3)
+        r = rig.steady(20.0, 20.0, 0.5, damage={"pitting": c}, seed=3)
         level.append(_sidebands(r, "accel_pinion_casing", 1.0, offsets=range(1, 9)))
     assert np.all(np.diff(level) > 0), level
 
@@ -183,7 +183,7 @@ def test_wear_raises_mesh_content_monotonically(rig):
     level = []
     for s in range(len(WEAR_EDGES) - 1):
         c = 0.5 * (WEAR_EDGES[s] + WEAR_EDGES[s + 1])
-        r = rig.steady(10.0, 5.0, 0.4, damage={"wear": c}, seed=3)
+        r = rig.steady(10.0, 5.0, 0.5, damage={"wear": c}, seed=3)
         level.append(_sidebands(r, "accel_pinion_casing", 1.0, offsets=range(0, 4)))
         assert r.truth["lubricated"] is False
     assert np.all(np.diff(level) > 0), level
