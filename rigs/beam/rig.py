@@ -132,13 +132,17 @@ class Rig:
 
     def _stages(self, kind, edges, speed, load, per_stage, duration, seed, at_centre):
         rng = np.random.default_rng([self.box_seed, int(seed), 77])
+        n_stage = len(edges) - 1
+        # record names carry no stage: a seeded running number (the stage is in the truth file)
+        number = rng.permutation(n_stage * per_stage)
         out = []
-        for s in range(len(edges) - 1):
+        for s in range(n_stage):
             for i in range(per_stage):
                 lo, hi = edges[s], edges[s + 1]
                 value = 0.5 * (lo + hi) if at_centre else float(rng.uniform(lo, hi))
                 out.append(self.steady(speed, load, duration, damage={kind: value},
-                                       seed=int(rng.integers(0, 2**31)), name=f"{kind}_s{s}_r{i}",
+                                       seed=int(rng.integers(0, 2**31)),
+                                       name=f"{kind}_record_{number[s * per_stage + i]:03d}",
                                        speed_scatter=0.02, load_scatter=0.10, label=s))
         return out
 
@@ -179,9 +183,8 @@ class Rig:
         chans["encoder"] = acquire.encoder(out[:, 2], fs_in, s.sample_rate, n_out, s.encoder_lines,
                                            self.encoder_line_errors)
         true_speed = out[:, 6] / (2 * np.pi)
-        if name is None:
-            what = eff.name if eff else ("pitting" if dmg.pitting else "wear" if dmg.wear else "healthy")
-            name = f"{kind}_{speeds[1]:g}Hz_{load:g}Nm_{what}_seed{seed}"
+        if name is None:   # distinct per effect and seed; says nothing of damage
+            name = f"{kind}_{speeds[1]:g}Hz_{load:g}Nm_{eff.name if eff else 'base'}_seed{seed}"
         modes = self.modes(speeds[1], load_true, lubricated=bool(lubricated))
         truth = {
             "rig": VERSION, "record": name, "kind": kind, "seed": int(seed),

@@ -198,6 +198,14 @@ def test_bad_input_is_refused_by_name(rig, tmp_path):
         write(tmp_path / "a.txt", [rig.steady(duration=0.1)])
 
 
+def test_stage_records_hide_their_stage(rig, monkeypatch):
+    seen = []
+    monkeypatch.setattr(Rig, "steady", lambda self, *a, **k: seen.append(k) or k["name"])
+    names = rig.wear_stages(per_stage=2, duration=0.1, seed=1)
+    assert sorted(names) == [f"wear_record_{i:03d}" for i in range(8)]
+    assert [k["label"] for k in seen] == [0, 0, 1, 1, 2, 2, 3, 3]
+
+
 def test_scattered_gearboxes_differ(rig):
     a, b = rig.scattered(1), rig.scattered(2)
     fa = [m.frequency for m in a.modes()][:6]
