@@ -1,13 +1,27 @@
 """Effects a gearbox of this rig can carry, each with its own implementation and default size.
 
-| name | size (unit) | what it is here |
-|---|---|---|
-| ``pinion_runout`` | eccentricity [m] | pitch-circle centre off the rotation axis: TE along the line of action, the teeth's engagement shifted along it (phase modulation of the mesh), centre-distance (backlash) change and mass unbalance, all at the pinion's rotation |
-| ``gear_runout`` | eccentricity [m] | the same on the gear |
-| ``drive_ripple`` | torque amplitude [N m] | the VFD's DC-link ripple on the motor air-gap torque: twice the mains (100 Hz, from the supply's phase unbalance) and half as much at 300 Hz (the six-pulse rectifier): locked to the mains, to no shaft |
-| ``casing_resonance`` | modal participation at the pinion sensor [m/sqrt(kg)] | a lightly damped inspection-cover panel under the pinion-side accelerometer, an extra panel mode (``frequency`` [Hz], ``damping``) |
-| ``local_tooth_fault`` | stiffness loss [-] | one pinion tooth with a root crack (its pair stiffness times 1 - size) and a spall of ``depth`` [m] in its dedendum, across the whole face, from the lowest point of single contact to the pitch point, where it carries the load alone |
-| ``bearing_outer_race`` | defect length [m] | a spall in the outer race of the pinion-shaft bearing (62xx, 9 balls) in the load zone: each ball unloads while it crosses the spall and strikes its far edge, at the ball-pass frequency with 1 % slip jitter. Not in the twin's catalogue |
+``pinion_runout`` (size: eccentricity [m])
+    The pitch-circle centre off the rotation axis: TE along the line of action, the teeth's
+    engagement shifted along it (phase modulation of the mesh), centre-distance (backlash)
+    change, mass unbalance, and a lead wobble across the face of ``wobble_ratio`` times the
+    run-out (a tilted gear), which modulates the face contact once per turn.
+``gear_runout`` (eccentricity [m])
+    The same on the gear.
+``drive_ripple`` (torque amplitude [N m])
+    The VFD's DC-link ripple on the motor air-gap torque: twice the mains (100 Hz, from the
+    supply's phase unbalance) and half as much at 300 Hz (six-pulse rectifier). Locked to the
+    mains, to no shaft.
+``casing_resonance`` (modal participation at the pinion sensor [m/sqrt(kg)])
+    A lightly damped inspection-cover panel under the pinion-side accelerometer: an extra
+    panel mode (``frequency`` [Hz], ``damping``).
+``local_tooth_fault`` (stiffness loss [-])
+    One pinion tooth with a root crack (its pair stiffness times 1 - size) and a spall of
+    ``depth`` [m] across the face in its dedendum, from the lowest point of single contact to
+    the pitch point, where it carries the load alone.
+``bearing_outer_race`` (defect length [m])
+    A spall in the outer race of the pinion-shaft bearing (62xx, 9 balls) in the load zone:
+    each ball unloads while it crosses the spall and strikes its far edge, at the ball-pass
+    frequency with 1 % slip jitter. Not in the twin's catalogue.
 """
 from __future__ import annotations
 
@@ -22,7 +36,7 @@ DEFAULTS = {
     "pinion_runout": {"size": 80e-6},
     "gear_runout": {"size": 100e-6},
     "drive_ripple": {"size": 0.3, "frequency": None},           # frequency: the drive's own
-    "casing_resonance": {"size": 0.5, "frequency": 3250.0, "damping": 0.008},
+    "casing_resonance": {"size": 0.5, "frequency": 3700.0, "damping": 0.008},
     "local_tooth_fault": {"size": 0.35, "depth": 3e-6},
     "bearing_outer_race": {"size": 1.0e-3},
 }
@@ -54,7 +68,8 @@ class Effect:
         out = replace(self, **{k: (getattr(self, k) if getattr(self, k) is not None else v)
                                for k, v in d.items()})
         if out.size is None or not np.isfinite(out.size) or out.size < 0:
-            raise ValueError(f"effect {self.name!r}: size must be finite and >= 0, got {out.size!r}")
+            raise ValueError(
+                f"effect {self.name!r}: size must be finite and >= 0, got {out.size!r}")
         return out
 
     def as_dict(self) -> dict:

@@ -14,7 +14,8 @@ class A (``sqrt(2) ** (A - 5)`` times the class-5 value, d and m in mm, result i
 The real deviations of a gearbox are drawn with a standard deviation of a fraction of these
 tolerances; single pitch deviations close over a revolution (their cumulative sum is the tooth
 position error); profile slope and form are mostly the tool's (common to all teeth of a gear)
-plus a tooth-specific share. Surface roughness is a Gaussian profile with an exponential correlation, fixed
+plus a tooth-specific share. Surface roughness is a Gaussian profile with an exponential
+correlation, fixed
 for the gearbox, so it repeats with the hunting period.
 """
 from __future__ import annotations

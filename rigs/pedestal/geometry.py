@@ -22,6 +22,7 @@ sum over the pairs in contact equals ``c_gamma b``, which gives ``a = 3/4 (1 - 1
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -42,7 +43,7 @@ class GearPair:
     z1: int = 19
     z2: int = 52
     module: float = 3.0e-3
-    pressure_angle: float = np.deg2rad(20.0)
+    pressure_angle: float = math.radians(20.0)
     face_width: float = 30.0e-3
     addendum: float = 1.0          # in modules
     dedendum: float = 1.25         # in modules (basic rack h_fP)
@@ -119,7 +120,7 @@ class GearPair:
         return rho1, self.tangent_length - rho1
 
     def sliding_ratio(self, s: np.ndarray) -> np.ndarray:
-        """(v1 - v2) / v1 of the flank surface speeds, per unit pinion roll; 0 at the pitch point."""
+        """(v1 - v2) / v1 of the flank surface speeds; 0 at the pitch point."""
         rho1, rho2 = self.radii_of_curvature(s)
         return (rho1 - rho2 * self.z1 / self.z2) / rho1
 

@@ -25,12 +25,12 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .structure import I_B, I_G, I_M, I_P, I_XA, I_XG, I_XP, I_YA, I_YG, I_YP  # noqa: F401
+from .structure import I_B, I_G, I_M, I_P, I_XG, I_XP, I_YG, I_YP
 
 
 @njit(cache=True, fastmath=False)
-def _rhs(x, v, z, te, w_ref, i, P, mass, K, C, g, tabs, pin_dev, pin_k, gear_dev, gear_k,
-         ext_torque, ext_force, force_dirs, acc, out):
+def _rhs(x, v, z, te, w_ref, i, P, mass, K_ptr, K_col, K_val, C_val, g, tabs, pin_dev, pin_k,
+         gear_dev, gear_k, ext_torque, ext_force, force_dirs, acc, out):
     """Fill ``acc`` with accelerations; return (dz, dte, mesh force, delta)."""
     n = mass.size
     rb1, rb2, pb, L, ds, u0 = P[0], P[1], P[2], P[3], P[4], P[5]
@@ -136,18 +136,20 @@ def _rhs(x, v, z, te, w_ref, i, P, mass, K, C, g, tabs, pin_dev, pin_k, gear_dev
         if fm != 0.0:
             for j in range(n):
                 out[j] += fm * force_dirs[m, j]
+    # K and C share one sparsity pattern, held in compressed rows
     for r in range(n):
         acc_r = out[r]
-        for c in range(n):
-            acc_r -= K[r, c] * x[c] + C[r, c] * v[c]
+        for q in range(K_ptr[r], K_ptr[r + 1]):
+            c = K_col[q]
+            acc_r -= K_val[q] * x[c] + C_val[q] * v[c]
         acc[r] = acc_r / mass[r]
     return err, (cmd - te) / lag, f_mesh, delta
 
 
 @njit(cache=True, fastmath=False)
-def integrate(x0, v0, z0, te0, dt, n_steps, w_ref, P, mass, K, C, g, tabs, pin_dev, pin_k,
-              gear_dev, gear_k, ext_torque, ext_force, force_dirs, rows, acc_out, theta_out,
-              force_out, delta_out):
+def integrate(x0, v0, z0, te0, dt, n_steps, w_ref, P, mass, K_ptr, K_col, K_val, C_val, g, tabs,
+              pin_dev, pin_k, gear_dev, gear_k, ext_torque, ext_force, force_dirs, rows, acc_out,
+              theta_out, force_out, delta_out):
     """Advance ``n_steps`` RK4 steps; outputs (arrays of length n_steps) are filled in place."""
     n = mass.size
     x = x0.copy()
@@ -167,8 +169,9 @@ def integrate(x0, v0, z0, te0, dt, n_steps, w_ref, P, mass, K, C, g, tabs, pin_d
         wr0 = w_ref[i]
         wr1 = w_ref[i + 1]
         wrm = 0.5 * (wr0 + wr1)
-        dz1, dt1, fm, dl = _rhs(x, v, z, te, wr0, i, P, mass, K, C, g, tabs, pin_dev, pin_k,
-                                gear_dev, gear_k, ext_torque, ext_force, force_dirs, a1, scratch)
+        dz1, dt1, fm, dl = _rhs(x, v, z, te, wr0, i, P, mass, K_ptr, K_col, K_val, C_val, g,
+                                tabs, pin_dev, pin_k, gear_dev, gear_k, ext_torque, ext_force,
+                                force_dirs, a1, scratch)
         for s in range(rows.shape[0]):
             acc = 0.0
             for j in range(n):
@@ -181,23 +184,23 @@ def integrate(x0, v0, z0, te0, dt, n_steps, w_ref, P, mass, K, C, g, tabs, pin_d
         for j in range(n):
             xs[j] = x[j] + h * v[j]
             vs[j] = v[j] + h * a1[j]
-        dz2, dt2, _, _ = _rhs(xs, vs, z + h * dz1, te + h * dt1, wrm, i, P, mass, K, C, g, tabs,
-                              pin_dev, pin_k, gear_dev, gear_k, ext_torque, ext_force,
-                              force_dirs, a2, scratch)
+        dz2, dt2, _, _ = _rhs(xs, vs, z + h * dz1, te + h * dt1, wrm, i, P, mass, K_ptr, K_col,
+                              K_val, C_val, g, tabs, pin_dev, pin_k, gear_dev, gear_k,
+                              ext_torque, ext_force, force_dirs, a2, scratch)
         for j in range(n):
             k2x[j] = vs[j]
             xs[j] = x[j] + h * k2x[j]
             vs[j] = v[j] + h * a2[j]
-        dz3, dt3, _, _ = _rhs(xs, vs, z + h * dz2, te + h * dt2, wrm, i, P, mass, K, C, g, tabs,
-                              pin_dev, pin_k, gear_dev, gear_k, ext_torque, ext_force,
-                              force_dirs, a3, scratch)
+        dz3, dt3, _, _ = _rhs(xs, vs, z + h * dz2, te + h * dt2, wrm, i, P, mass, K_ptr, K_col,
+                              K_val, C_val, g, tabs, pin_dev, pin_k, gear_dev, gear_k,
+                              ext_torque, ext_force, force_dirs, a3, scratch)
         for j in range(n):
             k3x[j] = vs[j]
             xs[j] = x[j] + dt * k3x[j]
             vs[j] = v[j] + dt * a3[j]
-        dz4, dt4, _, _ = _rhs(xs, vs, z + dt * dz3, te + dt * dt3, wr1, i, P, mass, K, C, g,
-                              tabs, pin_dev, pin_k, gear_dev, gear_k, ext_torque, ext_force,
-                              force_dirs, a4, scratch)
+        dz4, dt4, _, _ = _rhs(xs, vs, z + dt * dz3, te + dt * dt3, wr1, i, P, mass, K_ptr,
+                              K_col, K_val, C_val, g, tabs, pin_dev, pin_k, gear_dev, gear_k,
+                              ext_torque, ext_force, force_dirs, a4, scratch)
         for j in range(n):
             x[j] += dt / 6.0 * (v[j] + 2.0 * k2x[j] + 2.0 * k3x[j] + vs[j])
             v[j] += dt / 6.0 * (a1[j] + 2.0 * a2[j] + 2.0 * a3[j] + a4[j])
@@ -207,3 +210,12 @@ def integrate(x0, v0, z0, te0, dt, n_steps, w_ref, P, mass, K, C, g, tabs, pin_d
 
 
 N_PARAMS = 32
+
+
+def compressed_rows(K: np.ndarray, C: np.ndarray):
+    """Row pointers, columns and values of K and C on their common sparsity pattern."""
+    mask = (K != 0) | (C != 0)
+    ptr = np.concatenate([[0], np.cumsum(mask.sum(axis=1))]).astype(np.int64)
+    rows, cols = np.nonzero(mask)
+    return ptr, cols.astype(np.int64), np.ascontiguousarray(K[rows, cols]), \
+        np.ascontiguousarray(C[rows, cols])

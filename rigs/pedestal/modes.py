@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .structure import BASE_DOF, LinearStructure
+from .structure import LinearStructure
 
 _GROUPS = {
     "theta_motor": "motor rotor", "theta_meter": "torque meter", "theta_pinion": "pinion torsion",
@@ -123,5 +123,3 @@ def mode_table(modes: tuple[Mode, ...], count: int = 10) -> str:
                      f"{m.observability:.3g} | {m.label} |")
     return "\n".join(lines)
 
-
-assert len(BASE_DOF) == 16

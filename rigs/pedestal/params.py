@@ -14,15 +14,15 @@ import numpy as np
 
 @dataclass(frozen=True)
 class Drivetrain:
-    """Torsional chain motor - coupling - torque meter - coupling - pinion | gear - coupling - brake."""
+    """Torsional chain: motor, coupling, torque meter, coupling, pinion | gear, coupling, brake."""
 
     motor_inertia: float = 0.0125          # [kg m2] rotor + fan
     meter_inertia: float = 1.6e-3          # [kg m2] torque-meter flanges + coupling hubs
     pinion_inertia: float = 4.5e-4         # [kg m2] pinion + shaft + coupling hub
     gear_inertia: float = 8.5e-3           # [kg m2] gear + shaft + coupling hub
     brake_inertia: float = 0.018           # [kg m2] particle-brake rotor
-    motor_meter_stiffness: float = 3.3e3   # [N m/rad] jaw coupling in series with half the meter shaft
-    meter_pinion_stiffness: float = 5.5e3  # [N m/rad] half meter shaft, second coupling, pinion shaft
+    motor_meter_stiffness: float = 3.3e3   # [N m/rad] jaw coupling + half the meter shaft
+    meter_pinion_stiffness: float = 5.5e3  # [N m/rad] half meter shaft + coupling + pinion shaft
     gear_brake_stiffness: float = 4.2e3    # [N m/rad] gear shaft and brake coupling
     coupling_damping_ratio: float = 0.08   # [-] elastomer spiders
     speed_bandwidth: float = 4.0           # [Hz] closed-loop speed bandwidth of the VFD loop
@@ -44,7 +44,7 @@ class Structure:
     gear_pedestal_mass: float = 2.4        # [kg]
     pinion_support_stiffness: float = 1.2e8  # [N/m] shaft bending in series with both bearings
     gear_support_stiffness: float = 2.0e8    # [N/m]
-    pinion_pedestal_stiffness: float = 4.0e8  # [N/m] pedestal bolted into the casing wall (y; x is 0.8x)
+    pinion_pedestal_stiffness: float = 4.0e8  # [N/m] pedestal into the casing wall (y; x: 0.8x)
     gear_pedestal_stiffness: float = 6.0e8    # [N/m]
     support_damping_ratio: float = 0.03    # [-] bearings and shafts
     pedestal_damping_ratio: float = 0.02   # [-] bolted joints

@@ -1,12 +1,12 @@
 """``Rig``: one gearbox of the pedestal rig, its modes and its records."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
 from . import simulate
-from .effects import Effect, as_effect
+from .effects import Effect
 from .geometry import GearPair
 from .modes import Mode, linear_modes
 from .params import SCATTERED, Acquisition, Drivetrain, Flanks, GearboxIdentity, Structure, \
@@ -55,6 +55,13 @@ class Rig:
         return replace(self, **{k: replace(v, **changes[k]) for k, v in sections.items()},
                        identity=identity_from_seed(int(seed) + 1), scatter=float(scatter))
 
+    def describe(self) -> dict:
+        """All parameters of this gearbox as plain data (for the truth file)."""
+        return {"gears": asdict(self.gears), "drivetrain": asdict(self.drivetrain),
+                "structure": asdict(self.structure), "flanks": asdict(self.flanks),
+                "acquisition": asdict(self.acquisition), "identity": asdict(self.identity),
+                "scatter": self.scatter, "version": VERSION}
+
     # -- linearisation -----------------------------------------------------------------------
     def modes(self, speed: float = 20.0, load: float = 20.0, effect=None,
               damage=None) -> tuple[Mode, ...]:
@@ -93,6 +100,8 @@ class Rig:
             attrs["commanded_speed_to"] = float(speeds[1])
         truth = {"simulator": VERSION, "kind": kind, "seed": int(seed),
                  "gearbox_seed": self.identity.seed, "scatter": self.scatter,
+                 "gearbox": self.describe(),
+                 "sensor_mount_frequencies": list(self.structure.mount_frequencies),
                  "true_speed_factor": float(speed_factor),
                  "true_speed": [float(speeds[0] * speed_factor), float(speeds[1] * speed_factor)],
                  "true_load": float(true_load), "lubricated": bool(lubricated),

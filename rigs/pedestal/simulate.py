@@ -162,7 +162,8 @@ def run(rig, case: Case, speed_hz: np.ndarray, duration: float, seed: int, name:
     fmesh = np.empty(n)
     delta = np.empty(n)
     tb = case.tables
-    kernel.integrate(x0, v0, z0, te0, dt, n, w_ref, P, struct.mass, struct.K, struct.C,
+    kernel.integrate(x0, v0, z0, te0, dt, n, w_ref, P, struct.mass,
+                     *kernel.compressed_rows(struct.K, struct.C),
                      struct.mesh_vector, tb.shape, tb.pinion_dev, tb.pinion_k, tb.gear_dev,
                      tb.gear_k, ext_t, ext_f, force_dirs, struct.sensor_rows, acc, theta,
                      fmesh, delta)
@@ -217,7 +218,6 @@ def _initial_state(rig, case: Case, w0: float, rng):
     f[I_M] = t_in
     f[I_B] = -case.load
     x0 = np.linalg.solve(K, f)
-    x0[I_M] = x0[I_M] - x0[I_M]
     hunt = gears.z1 * gears.z2 // np.gcd(gears.z1, gears.z2)
     u0 = (int(rng.integers(0, hunt)) + float(rng.uniform())) * gears.base_pitch
     # lift the gear by the deviation of the pair in contact so the mesh starts loaded

@@ -98,5 +98,6 @@ def apply_wear(tables: ToothTables, gears: GearPair, seed: int, mean_depth: floa
                          gear_k=tables.gear_k * soft2[:, None])
     summary = {"kind": "wear", "mean_depth": float(mean_depth),
                "gear_mean_depth": float(h2.mean()),
-               "pinion_max_depth": float(h1.max()), "backlash_increase": float(h1.mean() + h2.mean())}
+               "pinion_max_depth": float(h1.max()),
+               "backlash_increase": float(h1.mean() + h2.mean())}
     return new, summary
