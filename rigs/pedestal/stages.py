@@ -58,16 +58,18 @@ def stage_records(rig, kind: str, per_stage: int, duration: float, seed: int) ->
         raise ValueError(f"stage kind must be 'pitting' or 'wear', got {kind!r}")
     if int(per_stage) < 1:
         raise ValueError(f"per_stage must be >= 1, got {per_stage!r}")
+    per_stage = int(per_stage)
     stages = pitting_stages() if kind == "pitting" else wear_stages()
     rng = np.random.default_rng([int(seed), 77])
     out = []
     for st in stages:
-        for j in range(int(per_stage)):
-            size = st.draw(rng)
-            rec_seed = int(rng.integers(0, 2 ** 31))
+        # records within a stage in the order of the test (damage does not heal); names are a
+        # running number, so nothing the twin reads carries the stage or the damage
+        draws = sorted((st.draw(rng), int(rng.integers(0, 2 ** 31))) for _ in range(per_stage))
+        for size, rec_seed in draws:
             rec = rig.steady(speed=st.speed, load=st.load, duration=duration,
                              damage=Damage(kind, size), seed=rec_seed,
-                             name=f"{kind}_s{st.label}_{j:02d}", lubricated=st.lubricated,
+                             name=f"{kind}_{len(out):03d}", lubricated=st.lubricated,
                              speed_scatter=SPEED_SCATTER, load_scatter=LOAD_SCATTER)
             rec.truth.update({"label": st.label, "stage_band": [st.low, st.high]})
             out.append(rec)

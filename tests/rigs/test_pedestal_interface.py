@@ -99,11 +99,16 @@ def test_stage_helpers_and_stage_records():
     assert len(pit) == 6 and len(wear) == 4
     assert all(s.speed == 20.0 and s.load == 20.0 and s.lubricated for s in pit)
     assert pit[-1].high == pytest.approx(0.20) and wear[1].low == pytest.approx(60e-6)
-    recs = rig.stage_records("wear", per_stage=1, duration=0.05, seed=1)
-    assert [r.truth["label"] for r in recs] == [0, 1, 2, 3]
-    for r, st in zip(recs, wear):
+    recs = rig.stage_records("wear", per_stage=2, duration=0.05, seed=1)
+    assert [r.truth["label"] for r in recs] == [0, 0, 1, 1, 2, 2, 3, 3]
+    assert [r.name for r in recs] == [f"wear_{i:03d}" for i in range(8)]
+    sizes = [r.truth["damage"]["size"] for r in recs]
+    assert sizes == sorted(sizes)                      # in the order of the test
+    for r in recs:
+        st = wear[r.truth["label"]]
         assert st.low <= r.truth["damage"]["size"] < st.high
         assert r.attributes["nominal_speed"] == 10.0
+        assert "label" not in r.attributes and "damage" not in r.attributes
 
 
 def test_bad_inputs_are_typed_errors_naming_the_value(tmp_path):
