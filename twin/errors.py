@@ -55,6 +55,15 @@ class ParameterError(TwinError):
     """A parameter name or value is not acceptable for the FMU."""
 
 
+class UnitError(ParameterError):
+    """A unit cannot be read, or a value cannot be converted between two units."""
+
+
+class SSPError(TwinError):
+    """An SSP file (.ssp, .ssd, .ssv) cannot be read or written; the message names the file and the
+    element, parameter or unit at fault."""
+
+
 class OutputPathError(TwinError):
     """An output path cannot be written (missing directory, unknown suffix, ...)."""
 
