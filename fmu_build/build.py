@@ -17,11 +17,10 @@ import sys
 import tempfile
 import zipfile
 from pathlib import Path
-from xml.sax.saxutils import escape
 
 from twin.errors import BuildError
 
-BUILDER_VERSION = "4"
+BUILDER_VERSION = "5"
 DEFAULT_STEP_SIZE = 5e-6
 _HERE = Path(__file__).resolve().parent
 _TEMPLATE = _HERE / "templates" / "fmi2_wrapper.c"
@@ -55,7 +54,7 @@ def _sources_hash(modelica_dir: Path, model: str, step_size: float) -> str:
     h = hashlib.sha256()
     h.update(f"{BUILDER_VERSION}|{model}|{step_size!r}|{' '.join(CFLAGS)}".encode())
     for f in sorted(modelica_dir.rglob("*")):
-        if f.is_file() and f.suffix in (".mo", ".order"):
+        if f.is_file() and f.suffix in (".mo", ".order", ".md"):
             h.update(str(f.relative_to(modelica_dir)).encode())
             h.update(f.read_bytes())
     for f in sorted(_HERE.rglob("*")):
@@ -63,7 +62,9 @@ def _sources_hash(modelica_dir: Path, model: str, step_size: float) -> str:
             h.update(f.name.encode())
             h.update(f.read_bytes())
     import casadi
+    import markdown
     import rumoca
+    h.update(f"markdown {markdown.__version__}".encode())
     h.update(f"casadi {casadi.__version__} rumoca {rumoca.version() if callable(getattr(rumoca, 'version', None)) else getattr(rumoca, '__version__', '')}".encode())
     return h.hexdigest()
 
@@ -113,35 +114,43 @@ def build_fmu(model: str = "GearTwin.Gearbox21", modelica_dir: Path | str = "mod
     if not force and fmu_path.exists() and stamp.exists() and stamp.read_text().strip() == digest:
         return fmu_path
 
+    from . import description
+    from .annotations import default_experiment, library_metadata
     from .flat import parse_flat
+    from .structure import model_structure
     from .symbolic import build_ode
 
+    src_file = model_file(modelica_dir, model)
+    experiment = default_experiment(src_file, model.split(".")[-1])
+    metadata = library_metadata(modelica_dir, model)
     flat_text = flatten(modelica_dir, model)
     ode = build_ode(parse_flat(flat_text))
     identifier = model.replace(".", "_")
     guid = "{" + digest[:8] + "-" + digest[8:12] + "-" + digest[12:16] + "-" + digest[16:20] + "-" + digest[20:32] + "}"
+    info = description.BuildInfo(model=model, identifier=identifier, guid=guid, step_size=step_size,
+                                 builder_version=BUILDER_VERSION, experiment=experiment, metadata=metadata,
+                                 generated=description.generation_time())
+    structure = model_structure(ode)
+    readme = src_file.with_name(f"{model.split('.')[-1]}.readme.md")
 
     with tempfile.TemporaryDirectory(prefix="fmu_build_") as tmp:
         tmp = Path(tmp)
         root = tmp / "fmu"
         (root / "sources").mkdir(parents=True)
         (root / "binaries" / "linux64").mkdir(parents=True)
+        (root / "documentation").mkdir()
         prefix = "m" + digest[:10]
         _generate_c(ode, root / "sources", prefix, guid, step_size)
         shutil.copy(_TEMPLATE, root / "sources" / "fmi2_wrapper.c")
-        shutil.copy(_HERE / "templates" / "twin_math.h", root / "sources" / "twin_math.h")
+        for header in ("twin_math.h", "model_core.h"):
+            shutil.copy(_HERE / "templates" / header, root / "sources" / header)
         hdr = _fmi_headers()
         for name in ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"):
             shutil.copy(hdr / name, root / "sources" / name)
         (root / "sources" / "model_flat.mo").write_text(flat_text)
-        (root / "modelDescription.xml").write_text(_model_description(ode, identifier, guid, step_size, model),
-                                                  encoding="utf-8")
-        (root / "sources" / "buildDescription.xml").write_text(
-            '<?xml version="1.0" encoding="UTF-8"?>\n<fmiBuildDescription fmiVersion="3.0">\n'
-            f'  <BuildConfiguration modelIdentifier="{identifier}">\n'
-            '    <SourceFileSet language="C99">\n'
-            '      <SourceFile name="fmi2_wrapper.c"/>\n      <SourceFile name="model_functions.c"/>\n'
-            '    </SourceFileSet>\n    <Library name="m"/>\n  </BuildConfiguration>\n</fmiBuildDescription>\n')
+        (root / "modelDescription.xml").write_text(description.fmi2(ode, info, structure), encoding="utf-8")
+        (root / "documentation" / "index.html").write_text(description.documentation_html(ode, info, readme),
+                                                           encoding="utf-8")
         so = root / "binaries" / "linux64" / f"{identifier}.so"
         cmd = ["gcc", *CFLAGS, "-I", str(root / "sources"), "-o", str(so),
                str(root / "sources" / "fmi2_wrapper.c"), str(root / "sources" / "model_functions.c"), "-lm"]
@@ -167,11 +176,21 @@ def _zip_reproducible(root: Path, target: Path) -> None:
             zf.writestr(info, f.read_bytes())
 
 
-def _c_array(values) -> str:
+def _c_double(v: float | None, missing: str) -> str:
+    if v is None:
+        return missing
+    return repr(float(v))
+
+
+def _c_array(values, missing: str = "0.0") -> str:
     vals = list(values)
     if not vals:
         return "{0}"
-    return "{" + ", ".join(repr(float(v)) for v in vals) + "}"
+    return "{" + ", ".join(_c_double(v, missing) for v in vals) + "}"
+
+
+def _c_names(variables) -> str:
+    return "{" + (", ".join(json.dumps(v.name) for v in variables) or '""') + "}"
 
 
 def _generate_c(ode, src: Path, prefix: str, guid: str, step_size: float) -> None:
@@ -194,8 +213,9 @@ def _generate_c(ode, src: Path, prefix: str, guid: str, step_size: float) -> Non
     generated.write_text('#include "twin_math.h"\n' + generated.read_text())
     nx, nu, ny, np_, nq = (len(ode.states), len(ode.inputs), len(ode.outputs), len(ode.parameters),
                            len(ode.calculated))
-    lay = _layout(ode)
-    names = ", ".join(json.dumps(v.name) for v in ode.states) or '""'
+    from .description import layout
+
+    lay = layout(ode)
     info = f"""/* Generated by fmu_build {BUILDER_VERSION}: sizes and defaults of {ode.name}. */
 #ifndef MODEL_INFO_H
 #define MODEL_INFO_H
@@ -230,116 +250,17 @@ def _generate_c(ode, src: Path, prefix: str, guid: str, step_size: float) -> Non
 static const double P_DEFAULT[{max(np_, 1)}] = {_c_array(v.start for v in ode.parameters)};
 static const double U_DEFAULT[{max(nu, 1)}] = {_c_array(v.start for v in ode.inputs)};
 static const int C_VALUES[{max(len(ode.constants), 1)}] = {{{', '.join(str(int(v.start)) for v in ode.constants) or '0'}}};
-static const char *STATE_NAMES[{max(nx, 1)}] = {{{names}}};
+static const double P_MIN[{max(np_, 1)}] = {_c_array((v.min for v in ode.parameters), "-INFINITY")};
+static const double P_MAX[{max(np_, 1)}] = {_c_array((v.max for v in ode.parameters), "INFINITY")};
+static const double U_MIN[{max(nu, 1)}] = {_c_array((v.min for v in ode.inputs), "-INFINITY")};
+static const double U_MAX[{max(nu, 1)}] = {_c_array((v.max for v in ode.inputs), "INFINITY")};
+static const double X_NOMINAL[{max(nx, 1)}] = {_c_array((v.nominal for v in ode.states), "1.0")};
+static const char *const P_NAMES[{max(np_, 1)}] = {_c_names(ode.parameters)};
+static const char *const U_NAMES[{max(nu, 1)}] = {_c_names(ode.inputs)};
+static const char *STATE_NAMES[{max(nx, 1)}] = {_c_names(ode.states)};
 #endif
 """
     (src / "model_info.h").write_text(info)
-
-
-def _layout(ode) -> dict:
-    p = 0
-    q = p + len(ode.parameters)
-    u = q + len(ode.calculated)
-    y = u + len(ode.inputs)
-    x = y + len(ode.outputs)
-    dx = x + len(ode.states)
-    step = dx + len(ode.states)
-    return {"p": p, "q": q, "u": u, "y": y, "x": x, "dx": dx, "step": step, "out": step + 1, "end": step + 2}
-
-
-def _model_description(ode, identifier: str, guid: str, step_size: float, model: str) -> str:
-    lay = _layout(ode)
-    units = sorted({v.unit for v in [*ode.parameters, *ode.calculated, *ode.inputs, *ode.outputs, *ode.states]
-                    if v.unit} | {f"{v.unit}/s" for v in ode.states if v.unit} | {"s"})
-    rows = []
-    index = {}
-
-    def add(vr, v, causality, variability, initial=None, start=None, extra="", type_="Real"):
-        index[(type_, vr)] = len(rows) + 1
-        attrs = [f'name="{escape(v.name, {chr(34): "&quot;"})}"', f'valueReference="{vr}"']
-        if v.description:
-            attrs.append(f'description="{escape(v.description, {chr(34): "&quot;"})}"')
-        attrs += [f'causality="{causality}"', f'variability="{variability}"']
-        if initial:
-            attrs.append(f'initial="{initial}"')
-        inner = []
-        if v.unit and type_ == "Real":
-            inner.append(f'unit="{escape(v.unit)}"')
-        if start is not None:
-            inner.append(f'start="{start!r}"' if type_ == "Real" else f'start="{int(start)}"')
-        rows.append(f'    <ScalarVariable {" ".join(attrs)}>\n      <{type_} {" ".join(inner)}{extra}/>\n    </ScalarVariable>')
-
-    for i, v in enumerate(ode.parameters):
-        add(lay["p"] + i, v, "parameter", "tunable", "exact", float(v.start))
-    for i, v in enumerate(ode.calculated):
-        add(lay["q"] + i, v, "calculatedParameter", "tunable", "calculated")
-    for i, v in enumerate(ode.inputs):
-        add(lay["u"] + i, v, "input", "continuous", None, float(v.start))
-    for i, v in enumerate(ode.outputs):
-        add(lay["y"] + i, v, "output", "continuous", "calculated")
-    for i, v in enumerate(ode.states):
-        add(lay["x"] + i, v, "local", "continuous", "calculated")
-    for i, v in enumerate(ode.states):
-        from .symbolic import Variable
-        dv = Variable(f"der({v.name})", "derivative", f"{v.unit}/s" if v.unit else "", f"Time derivative of {v.name}")
-        add(lay["dx"] + i, dv, "local", "continuous", "calculated",
-            extra=f' derivative="{index[("Real", lay["x"] + i)]}"')
-    from .symbolic import Variable
-    add(lay["step"], Variable("solver.step_size", "", "s", "Largest internal Runge-Kutta 4 step of the co-simulation"),
-        "parameter", "tunable", "exact", float(step_size))
-    add(lay["out"], Variable("solver.output_interval", "", "s",
-                             "Interval of the outputs buffered inside each doStep (0 = off)"),
-        "parameter", "tunable", "exact", 0.0)
-    for i, v in enumerate(ode.constants):
-        add(i, v, "local", "constant", "exact", v.start, type_="Integer")
-
-    unit_defs = "\n".join(f'    <Unit name="{escape(u)}"/>' for u in units)
-    outputs_xml = "\n".join(f'      <Unknown index="{index[("Real", lay["y"] + i)]}"/>' for i in range(len(ode.outputs)))
-    ders_xml = "\n".join(f'      <Unknown index="{index[("Real", lay["dx"] + i)]}"/>' for i in range(len(ode.states)))
-    init_idx = sorted([index[("Real", lay["y"] + i)] for i in range(len(ode.outputs))] +
-                      [index[("Real", lay["q"] + i)] for i in range(len(ode.calculated))] +
-                      [index[("Real", lay["x"] + i)] for i in range(len(ode.states))] +
-                      [index[("Real", lay["dx"] + i)] for i in range(len(ode.states))])
-    init_xml = "\n".join(f'      <Unknown index="{i}"/>' for i in init_idx)
-    desc = escape(ode.description or model, {'"': "&quot;"})
-    return f"""<?xml version="1.0" encoding="UTF-8"?>
-<fmiModelDescription fmiVersion="2.0" modelName="{escape(model)}" guid="{guid}" description="{desc}"
-  generationTool="gear-twin fmu_build {BUILDER_VERSION} (rumoca + CasADi + gcc)" variableNamingConvention="structured"
-  numberOfEventIndicators="0">
-  <ModelExchange modelIdentifier="{identifier}" canGetAndSetFMUstate="true" canSerializeFMUstate="true"
-    completedIntegratorStepNotNeeded="true" canNotUseMemoryManagementFunctions="true">
-    <SourceFiles>
-      <File name="fmi2_wrapper.c"/>
-      <File name="model_functions.c"/>
-    </SourceFiles>
-  </ModelExchange>
-  <CoSimulation modelIdentifier="{identifier}" canHandleVariableCommunicationStepSize="true"
-    canGetAndSetFMUstate="true" canSerializeFMUstate="true" canNotUseMemoryManagementFunctions="true">
-    <SourceFiles>
-      <File name="fmi2_wrapper.c"/>
-      <File name="model_functions.c"/>
-    </SourceFiles>
-  </CoSimulation>
-  <UnitDefinitions>
-{unit_defs}
-  </UnitDefinitions>
-  <DefaultExperiment startTime="0.0" stopTime="1.0" stepSize="{step_size!r}"/>
-  <ModelVariables>
-{chr(10).join(rows)}
-  </ModelVariables>
-  <ModelStructure>
-    <Outputs>
-{outputs_xml}
-    </Outputs>
-    <Derivatives>
-{ders_xml}
-    </Derivatives>
-    <InitialUnknowns>
-{init_xml}
-    </InitialUnknowns>
-  </ModelStructure>
-</fmiModelDescription>
-"""
 
 
 def main(argv=None) -> int:

@@ -46,6 +46,9 @@ class Variable:
     description: str = ""
     start: float = 0.0
     type: str = "Real"
+    min: float | None = None        # Modelica attributes min, max, nominal (constants)
+    max: float | None = None
+    nominal: float | None = None
 
 
 @dataclass
@@ -352,6 +355,9 @@ def build_ode(flat: FlatModel) -> OdeModel:
         e = d.attrs.get(key)
         return e[1] if e is not None and e[0] == "str" else ""
 
+    def bounds(d, names) -> list[dict]:
+        return _bounds(d, names, env)
+
     # Symbols for every Real parameter first: rumoca lists an extended base class before the
     # components of the derived model, so a binding may name a parameter declared further down
     # (``extends Base(p = effect.shape)``).
@@ -384,14 +390,14 @@ def build_ode(flat: FlatModel) -> OdeModel:
             bflat = _flatten(bval) if dims else [bval]
             if len(bflat) != len(names):
                 raise BuildError(f"parameter {d.name}: binding has {len(bflat)} elements, expected {len(names)}")
-            for n, s, b in zip(names, syms, bflat):
+            for n, s, b, lim in zip(names, syms, bflat, bounds(d, names)):
                 if _is_sym(b) and ca.symvar(b):
-                    calc.append(Variable(n, "calculated", attr_str(d, "unit"), d.description, 0.0))
+                    calc.append(Variable(n, "calculated", attr_str(d, "unit"), d.description, 0.0, **lim))
                     q_syms.append(s)
                     q_exprs.append(b)
                 else:
                     val = float(ca.evalf(b)) if _is_sym(b) else float(b)
-                    params.append(Variable(n, "parameter", attr_str(d, "unit"), d.description, val))
+                    params.append(Variable(n, "parameter", attr_str(d, "unit"), d.description, val, **lim))
                     p_syms.append(s)
         elif d.prefix == "input" and d.binding is None and "." not in d.name:
             syms = [ca.SX.sym(n) for n in names]
@@ -399,9 +405,9 @@ def build_ode(flat: FlatModel) -> OdeModel:
             start = d.attrs.get("start")
             sval = evaluate(start, env) if start is not None else 0.0
             sflat = _flatten(sval) if isinstance(sval, list) else [sval] * len(names)
-            for n, s, sv in zip(names, syms, sflat):
+            for n, s, sv, lim in zip(names, syms, sflat, bounds(d, names)):
                 sv = _const_value(sv, f"start of input {n}")
-                inputs.append(Variable(n, "input", attr_str(d, "unit"), d.description, float(sv)))
+                inputs.append(Variable(n, "input", attr_str(d, "unit"), d.description, float(sv), **lim))
                 u_syms.append(s)
         else:
             unknown_decls.append((d, dims))
@@ -474,13 +480,13 @@ def build_ode(flat: FlatModel) -> OdeModel:
             raise BuildError(f"der({n}): {n} is not a declared Real variable")
     der_sym = {}
     for d, dims in unknown_decls:
-        for n in _scalar_names(d, dims):
+        names = _scalar_names(d, dims)
+        for n, lim in zip(names, bounds(d, names)):
             if n in state_names:
                 x_syms.append(sym_of[n])
                 dsym = ca.SX.sym(f"der({n})")
                 der_sym[n] = dsym
-                start = d.attrs.get("start")
-                states.append(Variable(n, "state", attr_str(d, "unit"), d.description))
+                states.append(Variable(n, "state", attr_str(d, "unit"), d.description, **lim))
             else:
                 alg_syms.append(sym_of[n])
                 alg_names.append(n)
@@ -541,8 +547,8 @@ def build_ode(flat: FlatModel) -> OdeModel:
     alg_index = {n: i for i, n in enumerate(alg_names)}
     state_index = {v.name: i for i, v in enumerate(states)}
     for d, names in outputs_decl:
-        for n in names:
-            outputs.append(Variable(n, "output", attr_str(d, "unit"), d.description))
+        for n, lim in zip(names, bounds(d, names)):
+            outputs.append(Variable(n, "output", attr_str(d, "unit"), d.description, **lim))
             if n in alg_index:
                 y_exprs.append(final[len(dx_list) + alg_index[n]])
             else:
@@ -606,8 +612,44 @@ def build_ode(flat: FlatModel) -> OdeModel:
         v.start = float(val)
     for v, val in zip(states, np.array(init(p0, qv)).ravel()):
         v.start = float(val)
+    for v in [*params, *calc, *inputs, *states]:
+        _check_in_bounds(v)
     return OdeModel(flat.name, flat.description, states, inputs, outputs, params, calc, constants,
                     rhs, outf, init, derived, notes, n_hidden=len(h_syms))
+
+
+def _bounds(d: Decl, names: list[str], env: _Env) -> list[dict]:
+    """``min``/``max``/``nominal`` of each scalar of a declaration, as floats (absent: not set).
+
+    The attribute may be a scalar (``each min = 0``, or a plain scalar on a scalar) or an array
+    with one value per element, and must evaluate to constants at build time."""
+    out: list[dict] = [{} for _ in names]
+    for key in ("min", "max", "nominal"):
+        e = d.attrs.get(key)
+        if e is None:
+            continue
+        v = evaluate(e, env)
+        vals = _flatten(v) if isinstance(v, list) else [v] * len(names)
+        if len(vals) != len(names):
+            raise BuildError(f"{d.name}: attribute {key} has {len(vals)} elements, expected {len(names)}")
+        for o, x, n in zip(out, vals, names):
+            x = float(_const_value(x, f"attribute {key} of {n}"))
+            if not math.isfinite(x):
+                raise BuildError(f"attribute {key} of {n} must be finite, got {x}")
+            if key == "nominal" and not x > 0:
+                raise BuildError(f"attribute nominal of {n} must be > 0, got {x}")
+            o[key] = x
+    for o, n in zip(out, names):
+        if "min" in o and "max" in o and o["min"] > o["max"]:
+            raise BuildError(f"{n}: min = {o['min']} is above max = {o['max']}")
+    return out
+
+
+def _check_in_bounds(v: Variable) -> None:
+    if v.min is not None and v.start < v.min:
+        raise BuildError(f"{v.name}: default value {v.start} is below its min = {v.min}")
+    if v.max is not None and v.start > v.max:
+        raise BuildError(f"{v.name}: default value {v.start} is above its max = {v.max}")
 
 
 def hoist_static(exprs: list, dynamic: set[int]) -> tuple[list, list, list]:

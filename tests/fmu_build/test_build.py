@@ -126,9 +126,9 @@ TWO_MASS_VARIABLES = {
     "x2": ("local", "continuous", "m", None, "Position of mass 2"),
     "v2": ("local", "continuous", "m/s", None, "Velocity of mass 2"),
     "der(x1)": ("local", "continuous", "m/s", None, "Time derivative of x1"),
-    "der(v1)": ("local", "continuous", "m/s/s", None, "Time derivative of v1"),
+    "der(v1)": ("local", "continuous", "m/s2", None, "Time derivative of v1"),
     "der(x2)": ("local", "continuous", "m/s", None, "Time derivative of x2"),
-    "der(v2)": ("local", "continuous", "m/s/s", None, "Time derivative of v2"),
+    "der(v2)": ("local", "continuous", "m/s2", None, "Time derivative of v2"),
     "solver.step_size": ("parameter", "tunable", "s", fmu_build.DEFAULT_STEP_SIZE,
                          "Largest internal Runge-Kutta 4 step of the co-simulation"),
     "solver.output_interval": ("parameter", "tunable", "s", 0.0,
@@ -286,15 +286,25 @@ def test_cache_skips_rebuild_until_the_source_changes(tmp_path, write_package, m
     mtime = fmu.stat().st_mtime_ns
     fmu_build.build_fmu("Lab.Cascade", tmp_path / "lib", out, step_size=1e-5)
     assert fmu.stat().st_mtime_ns != mtime
-    assert _xml(fmu).find("DefaultExperiment").get("stepSize") == "1e-05"
+    step = next(sv for sv in _xml(fmu).iter("ScalarVariable") if sv.get("name") == "solver.step_size")
+    assert step.find("Real").get("start") == "1e-05"
 
 
 @pytest.mark.needs_gcc
-def test_forced_builds_into_different_directories_are_byte_identical(tmp_path):
+def test_forced_builds_into_different_directories_are_byte_identical(tmp_path, monkeypatch):
+    """With SOURCE_DATE_EPOCH set (reproducible-builds.org), generationDateAndTime is that date
+    and two builds are byte-identical; without it, it is the time of the build."""
     model = "GearTwin.Examples.TwoMassOscillator"
+    monkeypatch.setenv("SOURCE_DATE_EPOCH", "1764028800")
     a = fmu_build.build_fmu(model, MODELICA, tmp_path / "a", force=True)
+    time.sleep(1.1)
     b = fmu_build.build_fmu(model, MODELICA, tmp_path / "b", force=True)
     assert a.read_bytes() == b.read_bytes()
+    assert _xml(a).get("generationDateAndTime") == "2025-11-25T00:00:00Z"
+    monkeypatch.delenv("SOURCE_DATE_EPOCH")
+    before = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime(time.time() - 1))
+    c = fmu_build.build_fmu(model, MODELICA, tmp_path / "c", force=True)
+    assert before <= _xml(c).get("generationDateAndTime") <= time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())
     with zipfile.ZipFile(a) as zf:
         infos = zf.infolist()
     assert [i.filename for i in infos] == sorted(i.filename for i in infos)
