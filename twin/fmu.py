@@ -181,6 +181,19 @@ class FMU:
         return self._by("output")
 
     @property
+    def unit_definitions(self) -> dict:
+        """The FMU's ``UnitDefinitions`` with a ``BaseUnit``, as :class:`twin.units.Unit` by name."""
+        from twin.units import BASE, Unit
+        out = {}
+        for u in self.model_description.unitDefinitions or ():
+            b = getattr(u, "baseUnit", None)
+            if b is not None:
+                out[u.name] = Unit(u.name, tuple(int(getattr(b, k, 0) or 0) for k in BASE),
+                                   float(b.factor if b.factor is not None else 1.0),
+                                   float(b.offset if b.offset is not None else 0.0))
+        return out
+
+    @property
     def supports_output_buffer(self) -> bool:
         return OUTPUT_INTERVAL in self.variables
 

@@ -89,7 +89,8 @@ SCHEMA: dict[str, Any] = {
         "name": {"type": "string", "minLength": 1},
         "description": {"type": "string"},
         "fmu": {"type": "string", "minLength": 1,
-                "description": "Path of an .fmu (relative to the scenario file) or a Modelica model name built from modelica/."},
+                "description": "Path of an .fmu or of an .ssp with one FMU component and its parameter bindings "
+                               "(relative to the scenario file), or a Modelica model name built from modelica/."},
         "start_time": {**_NONNEG, "description": "s"},
         "stop_time": {**_POS, "description": "s"},
         "communication_step": {**_POS, "description": "s, default 0.01"},
@@ -101,7 +102,9 @@ SCHEMA: dict[str, Any] = {
         },
         "parameters": {**_NAME_MAP, "description": "Parameter values by FMU variable name."},
         "parameter_files": {"type": "array", "items": {"type": "string"},
-                            "description": "JSON ({name: value}) or SSP .ssv parameter sets, applied in order before 'parameters'."},
+                            "description": "JSON ({name: value}) or SSP .ssv parameter sets, applied in order before "
+                                           "'parameters' (and after the bindings of an .ssp fmu); .ssv values are "
+                                           "converted into the FMU's units."},
         "operating": {
             "type": "object", "additionalProperties": False,
             "properties": {"speed": {**_PROFILE, "description": "Shaft speed, Hz"},
@@ -224,21 +227,46 @@ class Scenario:
         return 1.0 / self.sample_rate
 
     def fmu_path(self, modelica_dir: Path | None = None, build_dir: Path | None = None) -> Path:
-        """The FMU file: a path as given, or the model built from ``modelica/`` on demand."""
-        candidate = Path(self.fmu)
-        if not candidate.is_absolute() and self.source is not None:
-            candidate = self.source.parent / candidate
-        if self.fmu.endswith(".fmu"):
+        """The FMU file: a path as given, the FMU inside an ``.ssp``, or the model built from
+        ``modelica/`` on demand."""
+        candidate = self._given_path()
+        if self.fmu.endswith((".fmu", ".ssp")):
             if not candidate.exists():
-                raise ScenarioError([(str(self.source), "fmu", f"FMU file {candidate} does not exist")])
+                kind = "FMU" if self.fmu.endswith(".fmu") else "SSP"
+                raise ScenarioError([(str(self.source), "fmu", f"{kind} file {candidate} does not exist")])
+            if self.fmu.endswith(".ssp"):
+                return _ssp_system(candidate, self.source).fmu
             return candidate
         from fmu_build import build_fmu
         repo = Path(__file__).resolve().parents[1]
         return build_fmu(self.fmu, modelica_dir or repo / "modelica", build_dir or repo / "build")
 
+    def _given_path(self) -> Path:
+        candidate = Path(self.fmu)
+        if not candidate.is_absolute() and self.source is not None:
+            candidate = self.source.parent / candidate
+        return candidate
+
     def with_overrides(self, **changes) -> "Scenario":
         from dataclasses import replace
         return replace(self, **changes)
+
+
+_SSP_CACHE: dict = {}
+
+
+def _ssp_system(path: Path, source: Path | None):
+    """The SSP package at ``path``, read once per process (keyed by path and modification time)."""
+    from twin.errors import SSPError
+    from twin.ssp import read_ssp
+
+    key = (str(path.resolve()), path.stat().st_mtime_ns)
+    if key not in _SSP_CACHE:
+        try:
+            _SSP_CACHE[key] = read_ssp(path)
+        except SSPError as exc:
+            raise ScenarioError([(str(source), "fmu", str(exc))]) from None
+    return _SSP_CACHE[key]
 
 
 def schema_json() -> str:
@@ -303,12 +331,19 @@ def scenario_from_dict(data: Any, source: Path | None = None) -> Scenario:
                          f"{comm} s must be a whole number of output samples (1/{rate:g} Hz)"))
 
     params: dict[str, float] = {}
+    locator = Scenario(name=str(data["name"]), fmu=str(data["fmu"]), stop_time=1.0, source=source)
+    if str(data["fmu"]).endswith(".ssp"):
+        try:
+            locator.fmu_path()
+            params.update(_ssp_system(locator._given_path(), source).parameters)
+        except ScenarioError as exc:
+            problems += [(where, "fmu", r) for _, _, r in exc.problems]
     for i, f in enumerate(data.get("parameter_files", [])):
         p = Path(f)
         if not p.is_absolute() and source is not None:
             p = source.parent / p
         try:
-            params.update(read_parameter_file(p))
+            params.update(read_parameter_file(p, fmu=locator.fmu_path))
         except ScenarioError as exc:
             problems += [(where, f"parameter_files[{i}]", r) for _, _, r in exc.problems]
     params.update({k: float(v) for k, v in data.get("parameters", {}).items()})
@@ -415,24 +450,38 @@ def _profile(spec, key, source, problems, where) -> Profile | None:
     return Profile(tuple(t), tuple(v))
 
 
-def read_parameter_file(path: str | Path) -> dict[str, float]:
-    """Parameter set from JSON (``{name: value}`` or ``{"parameters": {...}}``) or SSP ``.ssv``."""
+def read_parameter_file(path: str | Path, *, fmu=None) -> dict[str, float]:
+    """Parameter set from JSON (``{name: value}`` or ``{"parameters": {...}}``) or SSP ``.ssv``.
+
+    An ``.ssv`` entry with a unit is converted into the unit of the FMU variable; ``fmu`` is the
+    FMU's path, or a function returning it (called only when some entry has a unit). Without an
+    FMU, only values in a coherent SI unit (factor 1, no offset: ``N.m/rad``, not ``kN.m/rad``) are
+    accepted, as they are. Integer and Boolean entries keep their type.
+    """
     path = Path(path)
     if not path.exists():
         raise ScenarioError([(str(path), "", "parameter file does not exist")])
     if path.suffix == ".ssv":
-        import xml.etree.ElementTree as ET
+        from twin.errors import SSPError
+        from twin.ssv import read_ssv, resolve
         try:
-            root = ET.parse(path).getroot()
-        except ET.ParseError as exc:
-            raise ScenarioError([(str(path), "", f"not valid XML: {exc}")]) from None
-        out = {}
-        for p in root.iter():
-            if p.tag.endswith("Parameter") and "name" in p.attrib:
-                for child in p:
-                    if child.tag.endswith("Real") and "value" in child.attrib:
-                        out[p.attrib["name"]] = float(child.attrib["value"])
-        return out
+            pset = read_ssv(path)
+            if not any(v.unit for v in pset.values):
+                return pset.as_dict()
+            if fmu is not None:
+                from twin.ssp import _fmu_interface
+                variables, units = _fmu_interface(Path(fmu() if callable(fmu) else fmu))
+                return resolve(pset, variables, units)
+            out = {}
+            for v in pset.values:
+                unit = pset.units.get(v.unit) if v.unit else None
+                if v.unit and (unit is None or unit.factor != 1.0 or unit.offset != 0.0):
+                    raise SSPError(f"{path}: parameter {v.name!r} is given in {v.unit!r}, which needs the FMU "
+                                   "to be converted (or is not defined in the file's Units)")
+                out[v.name] = v.value
+            return out
+        except SSPError as exc:
+            raise ScenarioError([(str(path), "", str(exc))]) from None
     try:
         data = json.loads(path.read_text())
     except json.JSONDecodeError as exc:

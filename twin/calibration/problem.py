@@ -303,21 +303,26 @@ def refine_modes(fmu_path: Path, space: ParameterSpace, target: CalibrationTarge
     return space.lower + sol.x * span
 
 
-def write_parameter_set(parameters: Mapping[str, float], path: str | Path, *, name: str = "calibrated") -> Path:
-    """Write a parameter set as JSON (``.json``) or an SSP parameter-value file (``.ssv``), atomically."""
-    from xml.sax.saxutils import quoteattr
+def write_parameter_set(parameters: Mapping[str, float], path: str | Path, *, name: str = "calibrated",
+                        fmu: str | Path | None = None) -> Path:
+    """Write a parameter set as JSON (``.json``) or an SSP parameter-value file (``.ssv``), atomically.
 
+    With ``fmu`` given, the ``.ssv`` gives each Real in the unit of the FMU variable and defines
+    that unit (its BaseUnit) in the file, so that another SSP tool reads the values correctly.
+    """
     from twin._atomic import atomic_path
     path = Path(path)
     if path.suffix == ".json":
         text = json.dumps({"parameters": {k: float(v) for k, v in parameters.items()}}, indent=2)
     elif path.suffix == ".ssv":
-        rows = "\n".join(f'    <ssv:Parameter name={quoteattr(k)}><ssv:Real value="{float(v)!r}"/></ssv:Parameter>'
-                         for k, v in parameters.items())
-        text = ('<?xml version="1.0" encoding="UTF-8"?>\n'
-                '<ssv:ParameterSet xmlns:ssv="http://ssp-standard.org/SSP1/SystemStructureParameterValues" '
-                f'version="1.0" name={quoteattr(name)}>\n  <ssv:Parameters>\n{rows}\n  </ssv:Parameters>\n'
-                '</ssv:ParameterSet>\n')
+        from twin.ssv import write_ssv
+        units, fmu_units = {}, {}
+        if fmu is not None:
+            from twin.fmu import FMU
+            with FMU(fmu) as f:
+                units = {k: f.variables[k].unit for k in parameters if k in f.variables and f.variables[k].unit}
+                fmu_units = f.unit_definitions
+        return write_ssv(parameters, path, name=name, units=units, fmu_units=fmu_units)
     else:
         from twin.errors import OutputPathError
         raise OutputPathError(f"parameter set path must end in .json or .ssv, got {path.suffix!r}")

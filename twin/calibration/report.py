@@ -96,7 +96,8 @@ td,th{{border:1px solid #ccc;padding:.25em .6em;text-align:right}}</style></head
 <h2>Calibrated parameters</h2>
 <table><tr><th>parameter</th><th>calibrated</th><th>knee point</th></tr>{params}</table>
 {sens}
-<p>Files: calibrated.yaml (the calibrated scenario), calibrated.json, calibrated.ssv (SSP parameter values), knee.json,
+<p>Files: calibrated.yaml (the calibrated scenario), calibrated.json, calibrated.ssv (SSP parameter values),
+calibrated.ssp (SSP package: the FMU bound to the calibrated values), knee.json,
 pareto.csv, checkpoint.json.</p>
 <h2>PSD before and after</h2><img src="report_psd.png" style="max-width:100%">
 </body></html>"""

@@ -26,7 +26,9 @@ physics (:mod:`twin.calibration.sensitivity`). The default objectives are the pa
 Outputs in ``out_dir``:
 - ``calibrated.yaml``: the calibrated scenario, which ``twin compare``, ``diagnose``,
   ``archive`` (and every command taking a scenario) accept, valid wherever it is moved with
-  its directory; ``calibrated.json`` and ``calibrated.ssv``: the parameter set;
+  its directory; ``calibrated.json`` and ``calibrated.ssv``: the parameter set (the ``.ssv`` in the FMU's
+  units, with their definitions); ``calibrated.ssp``: a standard SSP package of the FMU bound to
+  those values, which other SSP tools (OSP libcosim, ...) run as calibrated;
 - ``knee.json``, ``pareto.csv``, ``checkpoint.json``;
 - ``modes.json`` (modes read from a record), ``sensitivity.json`` (with ``parameters: auto``);
 - ``report.html`` with the paper's Table 2 for this run, warnings (parameters ending on a bound)
@@ -228,7 +230,10 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
         print(f"warning: {w}")
     full = {**fixed, **chosen}
     write_parameter_set(full, out_dir / "calibrated.json")
-    write_parameter_set(full, out_dir / "calibrated.ssv", name=f"{scenario.name}-calibrated")
+    write_parameter_set(full, out_dir / "calibrated.ssv", name=f"{scenario.name}-calibrated", fmu=fmu)
+    from twin.ssp import write_ssp
+    write_ssp(fmu, full, out_dir / "calibrated.ssp", name=f"{scenario.name}-calibrated",
+              description=f"{scenario.name}: parameters calibrated to {Path(measurements).name}")
     write_parameter_set({**fixed, **result.knee}, out_dir / "knee.json")
     write_pareto(result, objectives, out_dir / "pareto.csv")
     scenario_file = write_calibrated_scenario(scenario, out_dir / "calibrated.yaml", "calibrated.json",

@@ -36,15 +36,45 @@ def rig(gearbox_fmu, tmp_path_factory):
 
 def test_outputs_and_table(gearbox_fmu, rig, tmp_path):
     rep = run_calibration(_scenario(gearbox_fmu, pop_size=6, n_gen=3), rig, tmp_path / "out", progress=False)
-    for name in ("calibrated.json", "calibrated.ssv", "knee.json", "pareto.csv", "checkpoint.json",
-                 "report.html", "report_psd.png"):
+    for name in ("calibrated.json", "calibrated.ssv", "calibrated.ssp", "knee.json", "pareto.csv",
+                 "checkpoint.json", "report.html", "report_psd.png"):
         assert (tmp_path / "out" / name).exists(), name
-    assert set(read_parameter_file(tmp_path / "out" / "calibrated.ssv")) == {"kt12", "I1"}
+    chosen = read_parameter_file(tmp_path / "out" / "calibrated.json")
+    assert read_parameter_file(tmp_path / "out" / "calibrated.ssv", fmu=gearbox_fmu) == chosen
+    assert set(chosen) == {"kt12", "I1"}
     assert rep.measured_modes.size == 3 and rep.after_modes.size == 3
     assert "measured [Hz]" in rep.table()
     assert np.all(np.isfinite(rep.objectives_after))
     assert rep.result.F[:, 2].min() < rep.objectives_before[2]     # the front improves on the defaults
     assert "Table 2" in (tmp_path / "out" / "report.html").read_text()
+
+
+def test_calibrated_ssp_runs_in_libcosim_with_the_calibrated_values(gearbox_fmu, rig, tmp_path):
+    """The .ssp that twin calibrate writes, run by another SSP importer (OSP libcosim)."""
+    from libcosimpy.CosimEnums import CosimVariableType
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+    from libcosimpy.CosimObserver import CosimObserver
+
+    log_output_level(CosimLogLevel.ERROR)
+    run_calibration(_scenario(gearbox_fmu, pop_size=4, n_gen=1, refine=False), rig, tmp_path / "out", progress=False)
+    chosen = read_parameter_file(tmp_path / "out" / "calibrated.json")
+    step, steps = 1e-4, 200
+    execution = CosimExecution.from_ssp_file(str(tmp_path / "out" / "calibrated.ssp"))
+    observer = CosimObserver.create_last_value()
+    execution.add_observer(observer)
+    reals = {v.name.decode(): v.reference for v in execution.slave_variables(0)
+             if v.type == CosimVariableType.REAL.value}
+    theirs = []
+    for _ in range(steps):
+        assert execution.step(1)
+        theirs.append(observer.last_real_values(0, [reals["accel_pinion_casing"], reals["mesh_force"]]))
+    assert observer.last_real_values(0, [reals[k] for k in chosen]) == list(chosen.values())
+    with FMU(gearbox_fmu) as f:
+        f.setup(0.0, parameters=chosen)
+        ours = f.run(steps * step, step, outputs=["accel_pinion_casing", "mesh_force"])
+    ours = np.column_stack([ours["accel_pinion_casing"], ours["mesh_force"]])[1:]
+    assert (np.abs(np.array(theirs) - ours).max(axis=0) / np.abs(ours).max(axis=0)).max() <= 1e-8
 
 
 def test_bad_calibration_block_lists_problems(gearbox_fmu, rig, tmp_path):
