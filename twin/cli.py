@@ -80,6 +80,14 @@ def _cmd_info(args: argparse.Namespace) -> int:
     return 0
 
 
+def _ssp_or_fmu(path: str, parameters: dict) -> tuple[Path, dict]:
+    """An .ssp gives its FMU and its bound parameter values, which the command line's override."""
+    if path.endswith(".ssp"):
+        system = _lib("twin.ssp").read_ssp(Path(path))
+        return system.fmu, {**system.parameters, **parameters}
+    return Path(path), parameters
+
+
 def _cmd_simulate(args: argparse.Namespace) -> int:
     parameters = parse_assignments(args.param, "--param")
     inputs = parse_assignments(args.input, "--input")
@@ -87,8 +95,9 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     results = _lib("twin.results")
     # Reject a bad output path before a possibly long simulation, not after it.
     target = results.check_output_path(args.output)
+    fmu, parameters = _ssp_or_fmu(args.fmu, parameters)
     result = _lib("twin.fmu").simulate_fmu(
-        Path(args.fmu), stop_time=args.stop_time, start_time=args.start_time,
+        fmu, stop_time=args.stop_time, start_time=args.start_time,
         output_interval=args.output_interval, outputs=outputs, parameters=parameters,
         inputs=inputs, progress=not args.no_progress,
     )
@@ -168,7 +177,8 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     print(report.table())
     for w in report.warnings:
         print(f"warning: {w}")
-    print(f"calibrated scenario -> {report.scenario_file} (parameters in calibrated.json and calibrated.ssv); "
+    print(f"calibrated scenario -> {report.scenario_file} (parameters in calibrated.json and calibrated.ssv; "
+          f"SSP package calibrated.ssp); "
           f"report -> {Path(args.out) / 'report.html'}")
     return 0
 
@@ -310,6 +320,30 @@ def _add_modes_parser(sub) -> None:
     p.set_defaults(handler=_cmd_modes)
 
 
+def _cmd_export_ssp(args: argparse.Namespace) -> int:
+    fmu = Path(args.fmu)
+    values: dict = {}
+    for f in args.parameters or ():
+        values.update(_lib("twin.scenario").read_parameter_file(Path(f), fmu=fmu))
+    values.update(parse_assignments(args.param, "--param"))
+    out = _lib("twin.ssp").write_ssp(fmu, values, Path(args.out), name=args.name,
+                                     description=args.description or "")
+    print(f"wrote {out}: {fmu.name} bound to {len(values)} parameter value(s)")
+    return 0
+
+
+def _add_ssp_commands(sub) -> None:
+    p = sub.add_parser("export-ssp", help="pack an FMU and a parameter set into a standard SSP package (.ssp)")
+    p.add_argument("fmu", metavar="FMU", help="path to the .fmu file")
+    p.add_argument("--parameters", action="append", metavar="P.json|P.ssv",
+                   help="parameter set (JSON or SSP .ssv, converted to the FMU's units); repeatable, later win")
+    p.add_argument("--param", action="append", metavar="NAME=VALUE", help="set a parameter (repeatable; wins)")
+    p.add_argument("--out", required=True, help="the .ssp file to write")
+    p.add_argument("--name", help="name of the system and parameter set (default: the file name)")
+    p.add_argument("--description", help="description written to the .ssd and .ssv")
+    p.set_defaults(handler=_cmd_export_ssp)
+
+
 def _loop_arguments(p: argparse.ArgumentParser, *, out: bool) -> None:
     p.add_argument("scenario", help="scenario file (its model and calibrated parameters)")
     p.add_argument("--measurements", required=True, help="measurement file (HDF5 or CSV + sidecar)")
@@ -343,8 +377,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="skip the linearisation / natural-frequency table")
     p.set_defaults(handler=_cmd_info)
 
-    p = sub.add_parser("simulate", help="run an FMU and write its outputs")
-    p.add_argument("fmu", metavar="FMU", help="path to the .fmu file")
+    p = sub.add_parser("simulate", help="run an FMU (or an .ssp with one FMU) and write its outputs")
+    p.add_argument("fmu", metavar="FMU", help="path to the .fmu file, or an .ssp with one FMU component and "
+                                              "its parameter bindings")
     p.add_argument("--stop-time", type=float, required=True, help="stop time [s]")
     p.add_argument("--start-time", type=float, default=0.0, help="start time [s] (default: 0)")
     p.add_argument("--output-interval", type=float, default=1e-5,
@@ -428,6 +463,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="regenerate GearTwin.Variants.Gearbox21Candidates from the catalogue")
     p.add_argument("--modelica-dir", type=Path, default=None)
     p.set_defaults(handler=_cmd_effects)
+
+    _add_ssp_commands(sub)
 
     from twin.transfer.cli import add_subcommands as add_transfer
     add_transfer(sub)

@@ -1,0 +1,56 @@
+"""The FMI/SSP side of the CLI, on real FMUs: twin export-ssp, twin simulate on an .ssp."""
+from __future__ import annotations
+
+import json
+import zipfile
+
+import pytest
+
+from twin.cli import main
+from twin.results import read_csv
+from twin.ssp import read_ssp
+
+pytestmark = pytest.mark.needs_gcc
+SSV = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
+SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
+
+
+def test_export_ssp_from_json_and_foreign_ssv(two_mass_fmu, tmp_path, capsys):
+    (tmp_path / "p.json").write_text(json.dumps({"parameters": {"k12": 60.0, "m2": 0.4}}))
+    (tmp_path / "q.ssv").write_text(
+        f'<ssv:ParameterSet xmlns:ssv="{SSV}" xmlns:ssc="{SSC}" version="1.0" name="q"><ssv:Parameters>'
+        '<ssv:Parameter name="k1"><ssv:Real value="0.12" unit="kN/m"/></ssv:Parameter></ssv:Parameters>'
+        '<ssv:Units><ssc:Unit name="kN/m"><ssc:BaseUnit kg="1" s="-2" factor="1000"/></ssc:Unit></ssv:Units>'
+        "</ssv:ParameterSet>")
+    out = tmp_path / "tm.ssp"
+    assert main(["export-ssp", str(two_mass_fmu), "--parameters", str(tmp_path / "p.json"),
+                 "--parameters", str(tmp_path / "q.ssv"), "--param", "m2=0.45", "--out", str(out)]) == 0
+    assert "bound to 3 parameter value(s)" in capsys.readouterr().out
+    assert read_ssp(out).parameters == {"k12": 60.0, "m2": 0.45, "k1": 120.0}
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--param", "m2=-1"], "parameter 'm2' = -1.0 is outside its range"),
+    (["--param", "nope=1"], "match no variable of the FMU: 'nope'"),
+    (["--param", "k12=inf"], "value must be finite"),
+])
+def test_export_ssp_refuses_bad_values_and_writes_nothing(two_mass_fmu, tmp_path, capsys, args, message):
+    out = tmp_path / "tm.ssp"
+    assert main(["export-ssp", str(two_mass_fmu), *args, "--out", str(out)]) == 2
+    assert message in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_simulate_an_ssp_applies_its_bindings(two_mass_fmu, tmp_path, capsys):
+    ssp = tmp_path / "tm.ssp"
+    assert main(["export-ssp", str(two_mass_fmu), "--param", "k12=60", "--param", "m2=0.4", "--out", str(ssp)]) == 0
+    assert main(["simulate", str(ssp), "--stop-time", "0.1", "--output-interval", "0.01", "--param", "m2=0.42",
+                 "--output", str(tmp_path / "r.csv"), "--no-progress"]) == 0
+    result = read_csv(tmp_path / "r.csv")
+    assert result.parameters["k12"] == 60.0 and result.parameters["m2"] == 0.42
+    with zipfile.ZipFile(ssp) as zf:
+        zf.testzip()
+    (tmp_path / "bad.ssp").write_text("not a zip")
+    assert main(["simulate", str(tmp_path / "bad.ssp"), "--stop-time", "0.1", "--output",
+                 str(tmp_path / "r2.csv")]) == 2
+    assert "not an SSP package" in capsys.readouterr().err
