@@ -1,9 +1,9 @@
-"""Modelica -> FMI 2.0 FMU (Co-Simulation + Model Exchange, linux64), compiled here.
+"""Modelica -> FMI 2.0 or FMI 3.0 FMU (Co-Simulation + Model Exchange, Linux x86-64), compiled here.
 
 Pipeline: subset check -> rumoca flattening -> :mod:`fmu_build.flat` parser ->
 :mod:`fmu_build.symbolic` (states-only ODE as CasADi functions) -> CasADi C code
 generation with common-subexpression elimination -> generic FMI wrapper
-(``templates/fmi2_wrapper.c``) -> gcc -> zip.  Builds are cached by a hash of every input
+(``templates/fmi2_wrapper.c`` or ``templates/fmi3_wrapper.c`` around ``model_core.h``) -> gcc -> zip.  Builds are cached by a hash of every input
 (sources, builder code, options), and the archive is byte-for-byte reproducible.
 """
 from __future__ import annotations
@@ -23,16 +23,19 @@ from twin.errors import BuildError
 BUILDER_VERSION = "5"
 DEFAULT_STEP_SIZE = 5e-6
 _HERE = Path(__file__).resolve().parent
-_TEMPLATE = _HERE / "templates" / "fmi2_wrapper.c"
+#: per FMI version: wrapper template, FMI headers, binary directory
+_FMI = {2: ("fmi2_wrapper.c", ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"), "linux64"),
+        3: ("fmi3_wrapper.c", ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h"), "x86_64-linux")}
 CFLAGS = ["-O2", "-fPIC", "-shared", "-fvisibility=hidden", "-std=c99", "-Wall", "-Wno-unused-variable",
           "-Wno-unused-but-set-variable", "-ffp-contract=off"]
 
 
-def _fmi_headers() -> Path:
+def _fmi_headers(fmi_version: int = 2) -> Path:
     import fmpy
     d = Path(fmpy.__file__).parent / "c-code"
-    if not (d / "fmi2Functions.h").exists():
-        raise BuildError(f"FMI 2.0 headers not found in {d}; reinstall fmpy")
+    for name in _FMI[fmi_version][1]:
+        if not (d / name).exists():
+            raise BuildError(f"FMI {fmi_version}.0 header {name} not found in {d}; reinstall fmpy")
     return d
 
 
@@ -50,9 +53,11 @@ def model_file(modelica_dir: Path, model: str) -> Path:
                      f"(looked for {'/'.join(parts)}.mo and package.mo files)")
 
 
-def _sources_hash(modelica_dir: Path, model: str, step_size: float) -> str:
+def _sources_hash(modelica_dir: Path, model: str, step_size: float, fmi_version: int = 2) -> str:
     h = hashlib.sha256()
     h.update(f"{BUILDER_VERSION}|{model}|{step_size!r}|{' '.join(CFLAGS)}".encode())
+    if fmi_version != 2:
+        h.update(f"|fmi{fmi_version}".encode())
     for f in sorted(modelica_dir.rglob("*")):
         if f.is_file() and f.suffix in (".mo", ".order", ".md"):
             h.update(str(f.relative_to(modelica_dir)).encode())
@@ -90,7 +95,7 @@ def flatten(modelica_dir: Path, model: str) -> str:
 
 def build_fmu(model: str = "GearTwin.Gearbox21", modelica_dir: Path | str = "modelica",
               out_dir: Path | str = "build", *, step_size: float = DEFAULT_STEP_SIZE,
-              force: bool = False) -> Path:
+              force: bool = False, fmi_version: int = 2) -> Path:
     """Build ``<out_dir>/<model>.fmu`` from ``<modelica_dir>`` and return its path.
 
     Parameters
@@ -98,9 +103,12 @@ def build_fmu(model: str = "GearTwin.Gearbox21", modelica_dir: Path | str = "mod
     model : full Modelica name, e.g. ``"GearTwin.Gearbox21"``.
     step_size : default internal RK4 step [s] (the FMU parameter ``solver.step_size``).
     force : rebuild even when the cache says the FMU is current.
+    fmi_version : 2 (FMI 2.0) or 3 (FMI 3.0); both run the same generated code and solver.
     """
     if not (step_size > 0):
         raise BuildError(f"step_size must be > 0 s, got {step_size!r}")
+    if fmi_version not in _FMI:
+        raise BuildError(f"fmi_version must be 2 or 3, got {fmi_version!r}")
     modelica_dir = Path(modelica_dir).resolve()
     out_dir = Path(out_dir)
     if not modelica_dir.is_dir():
@@ -108,7 +116,7 @@ def build_fmu(model: str = "GearTwin.Gearbox21", modelica_dir: Path | str = "mod
     if not out_dir.parent.exists():
         raise BuildError(f"output directory's parent {out_dir.parent} does not exist")
     out_dir.mkdir(exist_ok=True)
-    digest = _sources_hash(modelica_dir, model, step_size)
+    digest = _sources_hash(modelica_dir, model, step_size, fmi_version)
     fmu_path = out_dir / f"{model}.fmu"
     stamp = out_dir / f".{model}.fmu.hash"
     if not force and fmu_path.exists() and stamp.exists() and stamp.read_text().strip() == digest:
@@ -133,27 +141,32 @@ def build_fmu(model: str = "GearTwin.Gearbox21", modelica_dir: Path | str = "mod
     structure = model_structure(ode)
     readme = src_file.with_name(f"{model.split('.')[-1]}.readme.md")
 
+    wrapper, headers, platform = _FMI[fmi_version]
     with tempfile.TemporaryDirectory(prefix="fmu_build_") as tmp:
         tmp = Path(tmp)
         root = tmp / "fmu"
         (root / "sources").mkdir(parents=True)
-        (root / "binaries" / "linux64").mkdir(parents=True)
+        (root / "binaries" / platform).mkdir(parents=True)
         (root / "documentation").mkdir()
         prefix = "m" + digest[:10]
         _generate_c(ode, root / "sources", prefix, guid, step_size)
-        shutil.copy(_TEMPLATE, root / "sources" / "fmi2_wrapper.c")
+        shutil.copy(_HERE / "templates" / wrapper, root / "sources" / wrapper)
         for header in ("twin_math.h", "model_core.h"):
             shutil.copy(_HERE / "templates" / header, root / "sources" / header)
-        hdr = _fmi_headers()
-        for name in ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"):
+        hdr = _fmi_headers(fmi_version)
+        for name in headers:
             shutil.copy(hdr / name, root / "sources" / name)
         (root / "sources" / "model_flat.mo").write_text(flat_text)
-        (root / "modelDescription.xml").write_text(description.fmi2(ode, info, structure), encoding="utf-8")
+        md = description.fmi2(ode, info, structure) if fmi_version == 2 else description.fmi3(ode, info, structure)
+        (root / "modelDescription.xml").write_text(md, encoding="utf-8")
+        if fmi_version == 3:
+            (root / "sources" / "buildDescription.xml").write_text(description.build_description_fmi3(info),
+                                                                   encoding="utf-8")
         (root / "documentation" / "index.html").write_text(description.documentation_html(ode, info, readme),
                                                            encoding="utf-8")
-        so = root / "binaries" / "linux64" / f"{identifier}.so"
+        so = root / "binaries" / platform / f"{identifier}.so"
         cmd = ["gcc", *CFLAGS, "-I", str(root / "sources"), "-o", str(so),
-               str(root / "sources" / "fmi2_wrapper.c"), str(root / "sources" / "model_functions.c"), "-lm"]
+               str(root / "sources" / wrapper), str(root / "sources" / "model_functions.c"), "-lm"]
         try:
             proc = subprocess.run(cmd, capture_output=True, text=True)
         except FileNotFoundError as exc:
@@ -265,17 +278,19 @@ static const char *STATE_NAMES[{max(nx, 1)}] = {_c_names(ode.states)};
 
 def main(argv=None) -> int:
     import argparse
-    ap = argparse.ArgumentParser(prog="python -m fmu_build", description="Build FMI 2.0 FMUs from Modelica models.")
+    ap = argparse.ArgumentParser(prog="python -m fmu_build", description="Build FMI 2.0 or 3.0 FMUs from Modelica models.")
     ap.add_argument("models", nargs="*", default=["GearTwin.Gearbox21"])
     ap.add_argument("--modelica-dir", default="modelica")
     ap.add_argument("--out", default="build")
     ap.add_argument("--step-size", type=float, default=DEFAULT_STEP_SIZE)
     ap.add_argument("--force", action="store_true")
+    ap.add_argument("--fmi", type=int, choices=(2, 3), default=2, help="FMI version (default: 2)")
     args = ap.parse_args(argv)
     from twin.errors import TwinError
     try:
         for m in args.models:
-            print(build_fmu(m, args.modelica_dir, args.out, step_size=args.step_size, force=args.force))
+            print(build_fmu(m, args.modelica_dir, args.out, step_size=args.step_size, force=args.force,
+                            fmi_version=args.fmi))
     except TwinError as exc:
         print(f"fmu_build: error: {exc}", file=sys.stderr)
         return 2

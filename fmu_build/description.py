@@ -286,3 +286,84 @@ def documentation_html(ode, info: BuildInfo, readme: Path | None) -> str:
     parts.append("</body>\n</html>\n")
     return "\n".join(parts)
 
+
+
+# ---- FMI 3.0 ------------------------------------------------------------------------------------------
+def fmi3_value_references(ode) -> dict:
+    """FMI 3.0 layout: the Float64 blocks as in FMI 2.0, then ``time``, then the Int32 constants."""
+    lay = layout(ode)
+    return {**lay, "time": lay["end"], "c0": lay["end"] + 1}
+
+
+def fmi3(ode, info: BuildInfo, structure: ModelStructure) -> str:
+    """The FMI 3.0 modelDescription.xml (Co-Simulation and Model Exchange)."""
+    all_rows = rows(ode, info.step_size)
+    lay = fmi3_value_references(ode)
+    xml_rows = [f'    <Float64 name="time" valueReference="{lay["time"]}" causality="independent" '
+                'variability="continuous" unit="s" description="Simulation time"/>']
+    for r in all_rows:
+        v = r.var
+        vr = r.vr if r.type == "Real" else lay["c0"] + r.vr
+        attrs = [f"name={quoteattr(v.name)}", f'valueReference="{vr}"']
+        if v.description:
+            attrs.append(f"description={quoteattr(v.description)}")
+        attrs += [f'causality="{r.causality}"', f'variability="{r.variability}"']
+        if r.initial:
+            attrs.append(f'initial="{r.initial}"')
+        if r.type == "Real":
+            attrs += _real_attrs(r, fmi3=True)
+            if r.derivative_of is not None:
+                attrs.append(f'derivative="{r.derivative_of}"')
+            xml_rows.append(f'    <Float64 {" ".join(attrs)}/>')
+        else:
+            attrs.append(f'start="{int(r.start)}"')
+            xml_rows.append(f'    <Int32 {" ".join(attrs)}/>')
+
+    def vr_of(block: str, i: int) -> int:
+        return lay[block] + i
+
+    def unknown(tag: str, vr: int, deps, with_kind: bool) -> str:
+        refs = [vr_of(b, i) for b, i, _ in deps]
+        order = sorted(range(len(refs)), key=refs.__getitem__)
+        out = f'    <{tag} valueReference="{vr}" dependencies="{" ".join(str(refs[k]) for k in order)}"'
+        if with_kind and deps:
+            out += f' dependenciesKind="{" ".join(deps[k][2] for k in order)}"'
+        return out + "/>"
+
+    structure_xml = [unknown("Output", vr_of("y", i), d, True) for i, d in enumerate(structure.outputs)]
+    structure_xml += [unknown("ContinuousStateDerivative", vr_of("dx", i), d, True)
+                      for i, d in enumerate(structure.derivatives)]
+    initial = []
+    for block, deps in (("y", structure.initial_outputs), ("q", structure.initial_calculated),
+                        ("x", structure.initial_states), ("dx", structure.initial_derivatives)):
+        for i, d in enumerate(deps):
+            initial.append((vr_of(block, i), d))
+    structure_xml += [unknown("InitialUnknown", vr, d, False) for vr, d in sorted(initial)]
+    desc = ode.description or info.model
+    return "\n".join([f"""<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="3.0" modelName={quoteattr(info.model)} instantiationToken="{info.guid}"
+  description={quoteattr(desc)}
+  {_meta_attrs(info)}
+  variableNamingConvention="structured">
+  <ModelExchange modelIdentifier="{info.identifier}" canGetAndSetFMUState="true" canSerializeFMUState="true"/>
+  <CoSimulation modelIdentifier="{info.identifier}" canHandleVariableCommunicationStepSize="true"
+    canGetAndSetFMUState="true" canSerializeFMUState="true" hasEventMode="false"/>""",
+                      unit_definitions(all_rows), _experiment_xml(info),
+                      "  <ModelVariables>\n" + "\n".join(xml_rows) + "\n  </ModelVariables>",
+                      "  <ModelStructure>\n" + "\n".join(structure_xml) + "\n  </ModelStructure>",
+                      "</fmiModelDescription>\n"])
+
+
+def build_description_fmi3(info: BuildInfo) -> str:
+    """sources/buildDescription.xml of an FMI 3.0 FMU: how to compile its sources (fmpy compile)."""
+    return f"""<?xml version="1.0" encoding="UTF-8"?>
+<fmiBuildDescription fmiVersion="3.0">
+  <BuildConfiguration modelIdentifier="{info.identifier}">
+    <SourceFileSet language="C99">
+      <SourceFile name="fmi3_wrapper.c"/>
+      <SourceFile name="model_functions.c"/>
+    </SourceFileSet>
+    <Library name="m"/>
+  </BuildConfiguration>
+</fmiBuildDescription>
+"""

@@ -33,3 +33,17 @@ def two_mass_fmu(fmu_dir) -> Path:
     """A second, small model built by the same pipeline (GearTwin.Examples.TwoMassOscillator)."""
     from fmu_build import build_fmu
     return build_fmu("GearTwin.Examples.TwoMassOscillator", MODELICA, fmu_dir)
+
+
+@pytest.fixture(scope="session")
+def gearbox_fmu3(fmu_dir) -> Path:
+    """GearTwin.Gearbox21 built as an FMI 3.0 FMU (same code and solver as gearbox_fmu)."""
+    from fmu_build import build_fmu
+    return build_fmu("GearTwin.Gearbox21", MODELICA, fmu_dir / "fmi3", fmi_version=3)
+
+
+@pytest.fixture(scope="session")
+def two_mass_fmu3(fmu_dir) -> Path:
+    """GearTwin.Examples.TwoMassOscillator built as an FMI 3.0 FMU."""
+    from fmu_build import build_fmu
+    return build_fmu("GearTwin.Examples.TwoMassOscillator", MODELICA, fmu_dir / "fmi3", fmi_version=3)
