@@ -55,9 +55,14 @@ def parse_assignments(tokens: Sequence[str] | None, option: str) -> dict[str, fl
 
 def _cmd_build(args: argparse.Namespace) -> int:
     fmu_build = _lib("fmu_build")
+    # FMI 3.0 builds go to their own directory by default, so that they never replace the FMI 2.0 ones
+    out = Path(args.out) if args.out else Path("build") / ("fmi3" if args.fmi == 3 else "")
+    if args.fmi == 3 and not args.out:
+        out.parent.mkdir(exist_ok=True)
     for model in args.models or [DEFAULT_MODEL]:
-        path = fmu_build.build_fmu(model, Path(args.modelica_dir), Path(args.out),
-                                   step_size=args.step_size, force=args.force)
+        options = {"fmi_version": 3} if args.fmi == 3 else {}
+        path = fmu_build.build_fmu(model, Path(args.modelica_dir), out, step_size=args.step_size,
+                                   force=args.force, **options)
         print(path)
     return 0
 
@@ -365,10 +370,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("models", nargs="*", metavar="MODEL",
                    help=f"fully qualified model name(s) (default: {DEFAULT_MODEL})")
     p.add_argument("--modelica-dir", default="modelica", help="Modelica source directory")
-    p.add_argument("--out", default="build", help="output directory for the .fmu files")
+    p.add_argument("--out", help="output directory for the .fmu files (default: build, or build/fmi3 with --fmi 3)")
     p.add_argument("--step-size", type=float, default=5e-6,
                    help="fixed solver step size [s] (default: 5e-6)")
     p.add_argument("--force", action="store_true", help="rebuild even if up to date")
+    p.add_argument("--fmi", type=int, choices=(2, 3), default=2,
+                   help="FMI version of the FMU: 2 (FMI 2.0, default) or 3 (FMI 3.0 Co-Simulation and Model Exchange)")
     p.set_defaults(handler=_cmd_build)
 
     p = sub.add_parser("info", help="describe an FMU and compare its modes with measurements")

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 import zipfile
 
 import pytest
@@ -54,3 +55,23 @@ def test_simulate_an_ssp_applies_its_bindings(two_mass_fmu, tmp_path, capsys):
     assert main(["simulate", str(tmp_path / "bad.ssp"), "--stop-time", "0.1", "--output",
                  str(tmp_path / "r2.csv")]) == 2
     assert "not an SSP package" in capsys.readouterr().err
+
+
+def test_build_fmi3(tmp_path, capsys, monkeypatch):
+    from fmpy import read_model_description
+
+    out = tmp_path / "fmus"
+    out.mkdir()
+    assert main(["build", "GearTwin.Examples.TwoMassOscillator", "--fmi", "3", "--out", str(out)]) == 0
+    path = capsys.readouterr().out.strip()
+    assert path == str(out / "GearTwin.Examples.TwoMassOscillator.fmu")
+    assert read_model_description(path).fmiVersion == "3.0"
+    # without --out, FMI 3.0 builds go to build/fmi3 and never replace the FMI 2.0 ones in build/
+    calls = []
+    import fmu_build
+
+    monkeypatch.setattr(fmu_build, "build_fmu", lambda model, mdir, out_dir, **kw: calls.append((out_dir, kw))
+                        or out_dir / f"{model}.fmu")
+    monkeypatch.chdir(tmp_path)
+    assert main(["build", "--fmi", "3"]) == 0
+    assert calls == [(Path("build") / "fmi3", {"step_size": 5e-6, "force": False, "fmi_version": 3})]
