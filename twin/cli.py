@@ -337,7 +337,25 @@ def _cmd_export_ssp(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_validate(args: argparse.Namespace) -> int:
+    path = Path(args.file)
+    problems = (_lib("twin.ssp").validate_ssp(path) if path.suffix == ".ssp"
+                else _lib("twin.fmu").validate(path))
+    if not problems:
+        print("No problems found.")
+        return 0
+    print(f"{len(problems)} problem{'s were' if len(problems) != 1 else ' was'} found:")
+    for message in problems:
+        print()
+        print(message)
+    return 1
+
+
 def _add_ssp_commands(sub) -> None:
+    p = sub.add_parser("validate", help="validate an FMU (like fmpy validate) or an .ssp (SSP 1.0 schemas, its FMU)")
+    p.add_argument("file", metavar="FMU|SSP", help="path to the .fmu or .ssp file")
+    p.set_defaults(handler=_cmd_validate)
+
     p = sub.add_parser("export-ssp", help="pack an FMU and a parameter set into a standard SSP package (.ssp)")
     p.add_argument("fmu", metavar="FMU", help="path to the .fmu file")
     p.add_argument("--parameters", action="append", metavar="P.json|P.ssv",

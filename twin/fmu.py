@@ -563,6 +563,30 @@ def simulate_fmu(path: str | Path, *, stop_time: float, start_time: float = 0.0,
         return fmu.run(stop_time, output_interval, outputs=outputs, progress=progress)
 
 
+def validate(path: str | Path) -> list[str]:
+    """Problems fmpy's validator finds in an FMU (``fmpy validate``): schema, names, model
+    structure, start values, causality/variability, units. ``[]`` when there are none."""
+    from fmpy.validation import validate_fmu
+
+    path = Path(path)
+    if not path.exists():
+        raise FMUError(f"FMU file {path} does not exist")
+    if not zipfile.is_zipfile(path) and not path.is_dir():
+        raise FMUError(f"{path} is not an FMU (not a zip archive)")
+    return [str(p) for p in validate_fmu(str(path))]
+
+
+def xml_schema(kind: str, name: str) -> Path:
+    """A schema file that fmpy ships: ``kind`` is ``"ssp"`` (SSP 1.0), ``"fmi2"`` or ``"fmi3"``."""
+    import fmpy
+
+    base = Path(fmpy.__file__).parent
+    path = base / "ssp" / "schema" / name if kind == "ssp" else base / "schema" / kind / name
+    if not path.is_file():
+        raise FMUError(f"schema {name} not found in {path.parent}; reinstall fmpy")
+    return path
+
+
 def describe(path: str | Path) -> str:
     """Human-readable summary of an FMU: identity, interfaces and variables with units."""
     with FMU(path) as fmu:

@@ -86,6 +86,11 @@ class _Archive:
         except (KeyError, FileNotFoundError):
             raise SSPError(f"{self.path}: {what} {name!r} is not in the package") from None
 
+    def names(self) -> list[str]:
+        if self.zip is not None:
+            return [n for n in self.zip.namelist() if not n.endswith("/")]
+        return sorted(str(p.relative_to(self.path).as_posix()) for p in self.path.rglob("*") if p.is_file())
+
     def close(self) -> None:
         if self.zip is not None:
             self.zip.close()
@@ -283,6 +288,48 @@ def _apply(pset: ParameterSet, prefix: str, mapping: dict, scope: str, variables
                        f"name the component ({scope[:-1]}.<variable>)")
     sub = ParameterSet(pset.name, tuple(entries), pset.units, pset.source)
     return resolve(sub, variables, fmu_units, extra_units=ssd_units, names=names)
+
+
+_SCHEMAS = {".ssd": "SystemStructureDescription.xsd", ".ssv": "SystemStructureParameterValues.xsd",
+            ".ssm": "SystemStructureParameterMapping.xsd"}
+
+
+def validate_ssp(path: str | os.PathLike[str]) -> list[str]:
+    """Problems of an ``.ssp`` package (or an unpacked one), ``[]`` when there are none.
+
+    Every ``.ssd``, ``.ssv`` and ``.ssm`` file is checked against the SSP 1.0 XML schemas, then
+    the package is read as :func:`read_ssp` reads it (one FMU component, parameters that apply),
+    and its FMU is validated like ``fmpy validate``.
+    """
+    from lxml import etree
+
+    from twin.fmu import validate, xml_schema
+
+    path = Path(path)
+    problems: list[str] = []
+    archive = _Archive(path)
+    try:
+        schemas = {}
+        for name in archive.names():
+            suffix = PurePosixPath(name).suffix
+            if suffix not in _SCHEMAS:
+                continue
+            if suffix not in schemas:
+                schemas[suffix] = etree.XMLSchema(etree.parse(str(xml_schema("ssp", _SCHEMAS[suffix]))))
+            try:
+                doc = etree.fromstring(archive.read(name, "file"))
+            except etree.XMLSyntaxError as exc:
+                problems.append(f"{name}: not valid XML: {exc}")
+                continue
+            if not schemas[suffix].validate(doc):
+                problems += [f"{name}:{e.line}: {e.message}" for e in schemas[suffix].error_log]
+    finally:
+        archive.close()
+    try:
+        system = read_ssp(path)
+    except SSPError as exc:
+        return problems + [str(exc)]
+    return problems + [f"{system.fmu.name}: {p}" for p in validate(system.fmu)]
 
 
 # ---- writing -------------------------------------------------------------------------------------

@@ -75,3 +75,36 @@ def test_build_fmi3(tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(tmp_path)
     assert main(["build", "--fmi", "3"]) == 0
     assert calls == [(Path("build") / "fmi3", {"step_size": 5e-6, "force": False, "fmi_version": 3})]
+
+
+def test_validate_fmu_and_ssp(two_mass_fmu, two_mass_fmu3, tmp_path, capsys):
+    for fmu in (two_mass_fmu, two_mass_fmu3):
+        assert main(["validate", str(fmu)]) == 0
+        assert capsys.readouterr().out.strip() == "No problems found."
+    # an FMU whose model description uses a unit it does not define
+    broken = tmp_path / "broken.fmu"
+    with zipfile.ZipFile(two_mass_fmu) as src, zipfile.ZipFile(broken, "w") as dst:
+        for item in src.infolist():
+            data = src.read(item)
+            if item.filename == "modelDescription.xml":
+                data = data.replace(b'<Real unit="N/m"', b'<Real unit="N/mm"', 1)
+            dst.writestr(item, data)
+    assert main(["validate", str(broken)]) == 1
+    out = capsys.readouterr().out
+    assert out.startswith("1 problem was found:") and 'The unit "N/mm" of variable "k1"' in out
+    # an .ssp: schema problems of its files, then what reading it finds
+    ssp = tmp_path / "tm.ssp"
+    assert main(["export-ssp", str(two_mass_fmu), "--param", "k12=60", "--out", str(ssp)]) == 0
+    capsys.readouterr()
+    assert main(["validate", str(ssp)]) == 0
+    bad = tmp_path / "bad.ssp"
+    with zipfile.ZipFile(ssp) as src, zipfile.ZipFile(bad, "w") as dst:
+        for item in src.infolist():
+            data = src.read(item)
+            if item.filename.endswith(".ssv"):
+                data = data.replace(b'<ssv:Real value="60.0"', b'<ssv:Real value="sixty"')
+            dst.writestr(item, data)
+    assert main(["validate", str(bad)]) == 1
+    out = capsys.readouterr().out
+    assert "resources/tm.ssv:" in out and "'sixty' is not a valid value of the atomic type 'xs:double'" in out
+    assert "parameter 'k12': 'sixty' is not a valid Real" in out
