@@ -20,9 +20,9 @@ HDF5 layout (``format="gear-twin-result"``, ``format_version=1``)
 CSV layout
 ----------
 ``<path>``
-    Header ``time,<channel>[<unit>],...`` (``[]`` when a channel has no unit),
-    then one row per sample, values printed with 17 significant digits so a
-    round trip is exact.
+    Header ``time,<channel>,...`` (plain names, as fmpy writes and reads them;
+    units are in the sidecar), then one row per sample, values printed with 17
+    significant digits so a round trip is exact.
 ``<path>.json``
     Sidecar with ``format``, ``format_version``, ``model_name``, ``guid``,
     ``fmu_sha256``, ``sample_rate`` (Hz), ``channels`` (ordered names),
@@ -296,10 +296,9 @@ def write_csv(result: SimulationResult, path: str | os.PathLike[str]) -> Path:
     target = Path(path)
     names = list(result.signals)
     header = io.StringIO()
-    # csv.writer quotes channel names containing commas or quotes.
-    csv.writer(header, lineterminator="").writerow(
-        ["time", *(f"{n}[{result.units.get(n, '')}]" for n in names)]
-    )
+    # Plain names, as fmpy writes and reads them (units are in the sidecar); csv.writer quotes
+    # channel names containing commas or quotes.
+    csv.writer(header, lineterminator="").writerow(["time", *names])
     table = np.column_stack([result.time, *(result.signals[n] for n in names)])
     with atomic_path(target) as tmp:
         with open(tmp, "w", encoding="utf-8", newline="") as fh:
