@@ -93,20 +93,60 @@ def _ssp_or_fmu(path: str, parameters: dict) -> tuple[Path, dict]:
     return Path(path), parameters
 
 
+def _add_fmpy_simulate_options(p: argparse.ArgumentParser) -> None:
+    """The options of ``fmpy simulate``, spelled as fmpy spells them."""
+    g = p.add_argument_group("fmpy's options", "accepted as `fmpy simulate` spells them (--output-file is --output)")
+    g.add_argument("--start-values", nargs="+", metavar="NAME VALUE",
+                   help="name-value pairs of start values of parameters and inputs")
+    g.add_argument("--input-file", help="CSV of inputs over time, fmpy's format: time first, one column per input "
+                                        "(continuous inputs interpolated linearly, others held)")
+    g.add_argument("--output-variables", nargs="+", metavar="NAME", help="variables to record (default: every output)")
+    g.add_argument("--show-plot", action="store_true",
+                   help="plot the recorded variables (at most 12) to <output>.png")
+    g.add_argument("--validate", action="store_true", help="validate the FMU before simulating it")
+
+
+def _fmpy_simulate_values(args: argparse.Namespace, parameters: dict, outputs: list | None) -> tuple[dict, list | None]:
+    """Merge fmpy's --start-values and --output-variables into the twin's own options."""
+    values = args.start_values or []
+    if len(values) % 2:
+        raise ParameterError(f"--start-values takes NAME VALUE pairs, got {len(values)} words: {' '.join(values)}")
+    pairs = parse_assignments([f"{n}={v}" for n, v in zip(values[::2], values[1::2])], "--start-values")
+    twice = sorted(set(pairs) & set(parameters))
+    if twice:
+        raise ParameterError(f"{', '.join(map(repr, twice))} given both by --param and --start-values")
+    if args.output_variables:
+        outputs = [*(outputs or []), *(n for n in args.output_variables if n not in (outputs or []))]
+    return {**parameters, **pairs}, outputs
+
+
 def _cmd_simulate(args: argparse.Namespace) -> int:
     parameters = parse_assignments(args.param, "--param")
     inputs = parse_assignments(args.input, "--input")
     outputs = [s.strip() for s in args.outputs.split(",") if s.strip()] if args.outputs else None
+    parameters, outputs = _fmpy_simulate_values(args, parameters, outputs)
     results = _lib("twin.results")
     # Reject a bad output path before a possibly long simulation, not after it.
     target = results.check_output_path(args.output)
     fmu, parameters = _ssp_or_fmu(args.fmu, parameters)
-    result = _lib("twin.fmu").simulate_fmu(
-        fmu, stop_time=args.stop_time, start_time=args.start_time,
-        output_interval=args.output_interval, outputs=outputs, parameters=parameters,
-        inputs=inputs, progress=not args.no_progress,
-    )
+    if args.validate:
+        problems = _lib("twin.fmu").validate(fmu)
+        if problems:
+            raise _lib("twin.errors").FMUError(f"{fmu} is not valid ({len(problems)} problem(s)):\n  "
+                                                + "\n  ".join(problems))
+    options = dict(stop_time=args.stop_time, start_time=args.start_time, output_interval=args.output_interval,
+                   outputs=outputs, parameters=parameters, inputs=inputs, progress=not args.no_progress)
+    if args.input_file:
+        inputs_lib = _lib("twin.inputs")
+        result = inputs_lib.simulate_with_inputs(fmu, inputs_lib.InputTable.read(args.input_file), **options)
+    else:
+        result = _lib("twin.fmu").simulate_fmu(fmu, **options)
     written = results.write_result(result, target)
+    if args.show_plot:
+        channels = list(result.signals)[:12]
+        png = _lib("twin.plotting").plot_time(result, channels, Path(written).with_suffix(".png"),
+                                              float(result.time[0]), float(result.time[-1]), title=result.model_name)
+        print(f"plot of {len(channels)} channel(s) -> {png}")
     n = len(result.time)
     span = f"t=[{result.time[0]:.6g}, {result.time[-1]:.6g}] s" if n else "no samples"
     print(f"wrote {written}: {n} samples x {len(result.signals)} channels, "
@@ -165,10 +205,21 @@ def _cmd_archive(args: argparse.Namespace) -> int:
 
 def _cmd_import(args: argparse.Namespace) -> int:
     out = _lib("twin.measurements").import_csv(Path(args.csv), Path(args.out),
-                                               sidecar=Path(args.sidecar) if args.sidecar else None)
+                                               sidecar=Path(args.sidecar) if args.sidecar else None,
+                                               **_import_fmu_options(args))
     mset = _lib("twin.measurements").load_measurements(out)
     print(f"{args.csv} -> {out}: {len(mset)} record(s), channels {', '.join(mset[0].channel_names)}")
     return 0
+
+
+def _import_fmu_options(args: argparse.Namespace) -> dict:
+    """``twin import --fmu/--channels``: units of a result CSV (fmpy's or the twin's) from its FMU."""
+    options = {}
+    if args.fmu:
+        options["fmu"] = Path(args.fmu)
+    if args.channels:
+        options["channels"] = [c.strip() for c in args.channels.split(",") if c.strip()]
+    return options
 
 
 def _cmd_calibrate(args: argparse.Namespace) -> int:
@@ -409,13 +460,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--start-time", type=float, default=0.0, help="start time [s] (default: 0)")
     p.add_argument("--output-interval", type=float, default=1e-5,
                    help="output sample interval [s] (default: 1e-5)")
-    p.add_argument("--output", default="out.h5", help="result file, .h5/.hdf5 or .csv")
+    p.add_argument("--output", "--output-file", default="out.h5", help="result file, .h5/.hdf5 or .csv")
     p.add_argument("--outputs", help="comma-separated output variables (default: all)")
     p.add_argument("--param", action="append", metavar="NAME=VALUE",
                    help="set a parameter (repeatable)")
     p.add_argument("--input", action="append", metavar="NAME=VALUE",
                    help="hold an input at a constant value (repeatable)")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    _add_fmpy_simulate_options(p)
     p.set_defaults(handler=_cmd_simulate)
 
     p = sub.add_parser("run", help="run a scenario file through the co-simulation orchestrator")
@@ -440,6 +492,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("csv", metavar="CSV", help="CSV file with a time column and channels")
     p.add_argument("--out", required=True, help="HDF5 file to write")
     p.add_argument("--sidecar", help="sidecar with the record attributes (default: next to the CSV)")
+    p.add_argument("--fmu", help="the FMU that wrote the CSV (e.g. an fmpy result): units of the columns the "
+                                 "sidecar does not give; no sidecar needed")
+    p.add_argument("--channels", help="comma-separated channels to keep (default: every column)")
     p.set_defaults(handler=_cmd_import)
 
     p = sub.add_parser("calibrate", help="calibrate a scenario's FMU to measurements (NSGA-II or MOGOA)")
