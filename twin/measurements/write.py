@@ -110,7 +110,8 @@ def _attrs(attrs, metadata, file: str, record: str | None, *, reserved: tuple[st
 
 
 def import_csv(csv_path: str | os.PathLike[str], out_h5: str | os.PathLike[str], *,
-               sidecar: str | os.PathLike[str] | None = None) -> Path:
+               sidecar: str | os.PathLike[str] | None = None, fmu: str | os.PathLike[str] | None = None,
+               channels: Iterable[str] | None = None) -> Path:
     """Validate a CSV measurement (+ sidecar) and write it as an HDF5 measurement file.
 
     Parameters
@@ -121,6 +122,13 @@ def import_csv(csv_path: str | os.PathLike[str], out_h5: str | os.PathLike[str],
         Target ``.h5``/``.hdf5`` file (written atomically).
     sidecar : path, optional
         YAML/JSON sidecar; by default ``<file>.yaml``/``.yml``/``.json`` next to the CSV.
+    fmu : path, optional
+        The FMU that produced the CSV (e.g. ``fmpy simulate ... --output-file``): the unit of each
+        column the sidecar does not give is that of the FMU variable of its name, and no sidecar is
+        needed (the sample rate comes from the time column). A column that names no variable of the
+        FMU is an error naming it.
+    channels : names, optional
+        Keep only these channels (default: every column but ``time``).
 
     Returns
     -------
@@ -138,4 +146,41 @@ def import_csv(csv_path: str | os.PathLike[str], out_h5: str | os.PathLike[str],
     src = Path(csv_path)
     if src.suffix.lower() not in CSV_SUFFIXES:
         raise MeasurementError(str(src), None, f"not a CSV file (suffix must be {', '.join(CSV_SUFFIXES)})")
-    return write_measurements(load_measurements(src, sidecar=sidecar), target)
+    keep = list(channels) if channels is not None else None
+    if fmu is None:
+        return write_measurements(load_measurements(src, sidecar=sidecar, channels=keep), target)
+    import json
+    import tempfile
+
+    with tempfile.TemporaryDirectory(prefix="twin_import_") as tmp:
+        merged = Path(tmp) / f"{src.name}.json"
+        merged.write_text(json.dumps(_sidecar_with_fmu_units(src, sidecar, Path(fmu), keep)), encoding="utf-8")
+        return write_measurements(load_measurements(src, sidecar=merged, channels=keep), target)
+
+
+def _sidecar_with_fmu_units(src: Path, sidecar, fmu: Path, keep: list[str] | None) -> dict:
+    """The sidecar (given, found next to the CSV, or empty) with the FMU's unit for every other column."""
+    import csv
+
+    from twin.measurements.format import sidecar_candidates
+    from twin.measurements.load import read_sidecar
+
+    found = [Path(sidecar)] if sidecar is not None else [c for c in sidecar_candidates(src) if c.is_file()][:1]
+    try:
+        side = dict(read_sidecar(found[0])) if found else {}
+    except ValueError as exc:
+        raise MeasurementError(str(src), None, str(exc)) from None
+    with src.open(newline="", encoding="utf-8-sig") as fh:
+        header = [h.strip() for h in next(csv.reader(fh), [])]
+    from twin.fmu import FMU
+    with FMU(fmu) as f:
+        variables = f.variables
+    units = dict(side.get("units") or {})
+    wanted = [c for c in header if c != "time" and (keep is None or c in keep) and c not in units]
+    unknown = [c for c in wanted if c not in variables]
+    if unknown:
+        raise MeasurementError(str(src), None, f"column(s) {', '.join(map(repr, unknown))} name no variable of "
+                                               f"{fmu.name}, so their units are unknown")
+    units.update({c: variables[c].unit or "1" for c in wanted})
+    side["units"] = units
+    return side
