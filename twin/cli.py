@@ -69,8 +69,10 @@ def _cmd_build(args: argparse.Namespace) -> int:
 
 def _cmd_info(args: argparse.Namespace) -> int:
     print(_lib("twin.fmu").describe(Path(args.fmu)))
-    if args.no_modes:
-        return 0
+    if args.measurements:
+        return _info_against_measurements(args)
+    if not args.modes:
+        return 0                       # fast by default: no linearisation
     freqs = _lib("twin.linearize").natural_frequencies(Path(args.fmu), n=len(MEASURED_MODES_HZ))
     print()
     print("natural frequencies (linearised model vs. measured, paper Table 2)")
@@ -82,6 +84,42 @@ def _cmd_info(args: argparse.Namespace) -> int:
                   f"{100.0 * (model - measured) / measured:>+8.1f}")
         else:
             print(f"{i + 1:>4}  {'-':>11}  {measured:>13.0f}  {'-':>8}")
+    return 0
+
+
+def _info_against_measurements(args: argparse.Namespace) -> int:
+    """``twin info FMU --measurements M``: the linearised model's modes against a record's."""
+    import numpy as np
+
+    survey = _lib("twin.modes").survey_file(Path(args.measurements), args.record)
+    measured = survey.frequencies(min_confidence=args.min_confidence)
+    if measured.size == 0:
+        raise _lib("twin.errors").MeasurementError(
+            str(args.measurements), args.record, f"no mode with confidence >= {args.min_confidence} to compare with")
+    from scipy.optimize import linear_sum_assignment
+
+    freqs = np.asarray(_lib("twin.linearize").natural_frequencies(Path(args.fmu), n=measured.size + 4), float)
+    partner: dict[int, int] = {}
+    if freqs.size:
+        # one-to-one, least total |ln(f_model / f_measured)|; a model with fewer modes leaves some unmatched
+        rows, cols = linear_sum_assignment(np.abs(np.log(freqs[None, :] / measured[:, None])))
+        partner = dict(zip(rows.tolist(), cols.tolist()))
+    confidence = {m.frequency: m.confidence for m in survey.modes}
+    print()
+    print(f"natural frequencies: linearised model vs. {args.measurements} ({survey.method}, "
+          f"{len(measured)} mode(s) with confidence >= {args.min_confidence:g})")
+    print(f"{'mode':>4}  {'measured [Hz]':>13}  {'confidence':>10}  {'model [Hz]':>11}  {'diff [%]':>8}")
+    diffs = []
+    for i, m in enumerate(measured):
+        conf = confidence.get(float(m), float("nan"))
+        if i not in partner:
+            print(f"{i + 1:>4}  {m:>13.1f}  {conf:>10.2f}  {'-':>11}  {'-':>8}")
+            continue
+        model = float(freqs[partner[i]])
+        diffs.append(abs(model - m) / m)
+        print(f"{i + 1:>4}  {m:>13.1f}  {conf:>10.2f}  {model:>11.1f}  {100.0 * (model - m) / m:>+8.1f}")
+    if diffs:
+        print(f"mean |diff| over {len(diffs)} matched mode(s): {100 * float(np.mean(diffs)):.1f} %")
     return 0
 
 
@@ -447,10 +485,16 @@ def build_parser() -> argparse.ArgumentParser:
                    help="FMI version of the FMU: 2 (FMI 2.0, default) or 3 (FMI 3.0 Co-Simulation and Model Exchange)")
     p.set_defaults(handler=_cmd_build)
 
-    p = sub.add_parser("info", help="describe an FMU and compare its modes with measurements")
+    p = sub.add_parser("info", help="describe an FMU (fast); --modes or --measurements add its natural frequencies")
     p.add_argument("fmu", metavar="FMU", help="path to the .fmu file")
-    p.add_argument("--no-modes", action="store_true",
-                   help="skip the linearisation / natural-frequency table")
+    p.add_argument("--modes", action="store_true",
+                   help="linearise and compare the natural frequencies with the paper's Table 2")
+    p.add_argument("--measurements", metavar="MEAS",
+                   help="linearise and compare with the modes of a record (run-up or hammer test, see twin modes)")
+    p.add_argument("--record", help="record of --measurements (default: the first)")
+    p.add_argument("--min-confidence", type=float, default=0.3,
+                   help="confidence a measured mode needs to be compared (default: 0.3)")
+    p.add_argument("--no-modes", action="store_true", help=argparse.SUPPRESS)   # the default now; kept for scripts
     p.set_defaults(handler=_cmd_info)
 
     p = sub.add_parser("simulate", help="run an FMU (or an .ssp with one FMU) and write its outputs")

@@ -108,7 +108,7 @@ def test_info_prints_mode_table(monkeypatch, capsys, fake_fmu):
     module = types.ModuleType("twin.linearize")
     module.natural_frequencies = lambda path, n: np.array([22.0, 88.74])
     monkeypatch.setitem(sys.modules, "twin.linearize", module)
-    assert main(["info", "m.fmu"]) == 0
+    assert main(["info", "m.fmu", "--modes"]) == 0
     out = capsys.readouterr().out
     assert "FMU m.fmu: fake" in out
     assert "+2.0" in out and "1927" in out  # 88.74 vs 87 Hz; mode 8 listed without model value
@@ -118,6 +118,29 @@ def test_info_no_modes_skips_linearize(monkeypatch, capsys, fake_fmu):
     monkeypatch.setitem(sys.modules, "twin.linearize", None)  # importing it would fail
     assert main(["info", "m.fmu", "--no-modes"]) == 0
     assert capsys.readouterr().out.strip() == "FMU m.fmu: fake"
+    assert main(["info", "m.fmu"]) == 0                       # fast by default: no linearisation
+    assert capsys.readouterr().out.strip() == "FMU m.fmu: fake"
+
+
+def test_info_compares_with_a_records_modes(monkeypatch, capsys, fake_fmu):
+    from twin.signals.survey import Mode
+
+    module = types.ModuleType("twin.linearize")
+    module.natural_frequencies = lambda path, n: np.array([21.0, 90.0, 300.0, 440.0])[:n]
+    monkeypatch.setitem(sys.modules, "twin.linearize", module)
+    survey = types.SimpleNamespace(method="runup", modes=[Mode(88.0, 0.02, 0.9, 10.0), Mode(430.0, 0.02, 0.6, 8.0),
+                                                          Mode(600.0, 0.02, 0.1, 2.0)])
+    survey.frequencies = lambda min_confidence=0.0: np.array(sorted(m.frequency for m in survey.modes
+                                                                    if m.confidence >= min_confidence))
+    modes = types.ModuleType("twin.modes")
+    modes.survey_file = lambda path, record: survey
+    monkeypatch.setitem(sys.modules, "twin.modes", modes)
+    assert main(["info", "m.fmu", "--measurements", "rec.h5"]) == 0
+    out = capsys.readouterr().out
+    assert "rec.h5 (runup, 2 mode(s) with confidence >= 0.3)" in out
+    assert "   1           88.0        0.90         90.0      +2.3" in out
+    assert "   2          430.0        0.60        440.0      +2.3" in out
+    assert "600" not in out and "mean |diff| over 2 matched mode(s): 2.3 %" in out
 
 
 def test_build_defaults(monkeypatch, capsys, tmp_path):
