@@ -203,7 +203,11 @@ def _cmd_schema(args: argparse.Namespace) -> int:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    scenario = _lib("twin.scenario").load_scenario(Path(args.scenario))
+    scenarios = _lib("twin.scenario")
+    if args.scenario.endswith(".ssp"):       # an SSP runs as it is, over its default experiment
+        scenario = scenarios.scenario_from_ssp(Path(args.scenario), args.stop_time)
+    else:
+        scenario = scenarios.load_scenario(Path(args.scenario))
     if args.stop_time is not None:
         scenario = scenario.with_overrides(stop_time=args.stop_time)
     orch = _lib("twin.orchestrator")
@@ -515,7 +519,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(handler=_cmd_simulate)
 
     p = sub.add_parser("run", help="run a scenario file through the co-simulation orchestrator")
-    p.add_argument("scenario", metavar="SCENARIO", help="scenario .yaml file")
+    p.add_argument("scenario", metavar="SCENARIO", help="scenario .yaml file, or an .ssp (its FMU, bindings and "
+                                                        "default experiment)")
     p.add_argument("--output", help="result HDF5 file (default: <scenario name>.h5)")
     p.add_argument("--stop-time", type=float, help="override the scenario's stop time [s]")
     p.add_argument("--resume", action="store_true", help="degradation runs: continue from the last completed stage")

@@ -269,6 +269,20 @@ def _ssp_system(path: Path, source: Path | None):
     return _SSP_CACHE[key]
 
 
+def scenario_from_ssp(path: str | Path, stop_time: float | None = None) -> Scenario:
+    """A scenario that runs an ``.ssp`` as it is: its FMU with its parameter bindings, every output,
+    over the SSD's DefaultExperiment (``stop_time`` [s] overrides its stop time)."""
+    path = Path(path)
+    if not path.exists():
+        raise ScenarioError([(str(path), "", "SSP file does not exist")])
+    exp = _ssp_system(path, path).default_experiment
+    stop = stop_time if stop_time is not None else exp.get("stopTime")
+    if stop is None:
+        raise ScenarioError([(str(path), "DefaultExperiment", "the SSP gives no stopTime; pass a stop time")])
+    return scenario_from_dict({"version": FORMAT_VERSION, "name": path.stem, "fmu": str(path.resolve()),
+                               "start_time": exp.get("startTime", 0.0), "stop_time": stop}, source=path)
+
+
 def schema_json() -> str:
     return json.dumps(SCHEMA, indent=2)
 

@@ -108,3 +108,14 @@ def test_validate_fmu_and_ssp(two_mass_fmu, two_mass_fmu3, tmp_path, capsys):
     out = capsys.readouterr().out
     assert "resources/tm.ssv:" in out and "'sixty' is not a valid value of the atomic type 'xs:double'" in out
     assert "parameter 'k12': 'sixty' is not a valid Real" in out
+
+
+def test_run_an_ssp_as_it_is(two_mass_fmu, tmp_path, capsys):
+    from twin.results import read_hdf5
+
+    ssp = tmp_path / "tm.ssp"
+    assert main(["export-ssp", str(two_mass_fmu), "--param", "k12=60", "--out", str(ssp)]) == 0
+    assert main(["run", str(ssp), "--stop-time", "0.05", "--output", str(tmp_path / "r.h5"), "--no-progress"]) == 0
+    result = read_hdf5(tmp_path / "r.h5")
+    assert result.parameters["k12"] == 60.0 and result.time[-1] == pytest.approx(0.05)
+    assert "tm: 5001 samples" in capsys.readouterr().out
