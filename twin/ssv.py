@@ -218,7 +218,7 @@ def _value_for(entry: ParameterValue, target: str, var, fmu_units, scope, where:
         if not entry.unit:
             return value
         target_unit = var.unit or ""
-        if entry.unit == target_unit:
+        if entry.unit == target_unit or (entry.unit == "1" and not target_unit):
             return value
         source = scope.get(entry.unit)
         if source is None:
