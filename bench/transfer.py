@@ -5,7 +5,9 @@
 
 Builds (or reuses, in OUT/data) the source archives of scenarios/lubricated.yaml (6 pitting
 stages) and scenarios/dry.yaml (4 wear stages) and their "measured" target domains
-(twin.transfer.domain.make_target_domain), then trains every method with the paper's settings
+(twin.transfer.domain.make_target_domain for the emulated rigs 'rig' and 'blind', variants of the
+twin that prove plumbing only; rigs.lumped / rigs.ltca for the independent simulators, whose records
+are written here and handed to the twin as files), then trains every method with the paper's settings
 (alpha = beta = 0.1, lr 0.01, batch 20, 80 epochs) for each seed and scores the last epoch on the
 held-out second halves of the target records.  Prints the machine and a Markdown table for
 BENCHMARKS.md; figures and report.html go to OUT.
@@ -17,10 +19,12 @@ first halves (target labels, so never a method; it bounds what the rig's records
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import platform
 import sys
 import time
+from dataclasses import asdict
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
@@ -39,8 +43,9 @@ def main() -> None:
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--out", default=str(REPO / "bench_out" / "transfer"))
     ap.add_argument("--data-dir", default=None)
-    ap.add_argument("--rig", choices=tuple(RIGS), default="rig",
-                    help="the emulated rig of the target data (blind: fixed after every choice, only scored)")
+    ap.add_argument("--rig", choices=tuple(RIGS) + tuple(INDEPENDENT_RIGS), default="rig",
+                    help="the rig of the target data: an emulated one (rig; blind: fixed after every choice, only "
+                         "scored) or an independent simulator of rigs/ (lumped, ltca)")
     ref = ap.add_mutually_exclusive_group()
     ref.add_argument("--source-ceiling", action="store_true",
                     help="instead: the source-only CNN on held-out *source* records (no domain shift), per seed")
@@ -65,8 +70,15 @@ def main() -> None:
         _ceiling(args, tasks)
         return
     t = time.perf_counter()
+    settings = targets = None
+    if args.rig in INDEPENDENT_RIGS:
+        out.mkdir(exist_ok=True)
+        data_dir = Path(args.data_dir) if args.data_dir else out / "data"
+        data_dir.mkdir(exist_ok=True)
+        settings, targets = independent_targets(args.rig, tasks, data_dir)
     summary = run_benchmark(out, tasks=tasks, seeds=args.seeds, epochs=args.epochs, jobs=args.jobs,
-                            data_dir=args.data_dir, rig=args.rig, first_seed=args.first_seed)
+                            data_dir=args.data_dir, rig=args.rig, first_seed=args.first_seed,
+                            settings=settings, targets=targets)
     wall = time.perf_counter() - t
     cpu = next((ln.split(":", 1)[1].strip() for ln in open("/proc/cpuinfo") if ln.startswith("model name")), "?")
     print(f"Machine: {cpu}, {len(os.sched_getaffinity(0))} cores, Python {platform.python_version()}, "
@@ -75,6 +87,30 @@ def main() -> None:
           f"{args.epochs} epochs, rig '{args.rig}'; total wall time {wall:.0f} s\n")
     print(markdown_table(summary))
     print(f"\nfigures and report.html -> {out}")
+
+
+# The independent simulators of rigs/ and the data seeds of their benchmark records.
+INDEPENDENT_RIGS = {"lumped": 3, "ltca": 4}
+
+
+def independent_targets(rig: str, tasks, data_dir: Path, progress: bool = True) -> tuple[dict, dict]:
+    """(settings, target files) per task for an independent simulator of ``rigs/``: its records of the
+    task's stages, written into ``data_dir`` (``target_<task>_<rig>.h5``) unless the ones there were
+    made with the same settings (the key ``<task>_<rig>.json`` that prepare_task writes beside them)."""
+    from rigs import ltca, lumped
+    from twin.transfer.benchmark import ARCHIVE_RULES, rig_settings, task_scenario
+
+    make = {"lumped": lumped.make_lumped_target, "ltca": ltca.make_ltca_target}[rig]
+    settings, targets = {}, {}
+    for t in tasks:
+        s = rig_settings(t, rig, target_seed=INDEPENDENT_RIGS[rig])
+        tgt, key = data_dir / f"target_{t}_{rig}.h5", data_dir / f"{t}_{rig}.json"
+        wanted = json.dumps({**asdict(s), "archive_rules": ARCHIVE_RULES}, sort_keys=True)
+        if not (tgt.exists() and key.exists() and key.read_text() == wanted):
+            make(task_scenario(t, s), tgt, records_per_stage=s.target_records_per_stage,
+                 record_duration=s.target_record_duration, seed=s.target_seed, progress=progress)
+        settings[t], targets[t] = s, tgt
+    return settings, targets
 
 
 def _ceiling(args, tasks) -> None:
@@ -98,7 +134,9 @@ def _ceiling(args, tasks) -> None:
         what, fn, pick = f"CNN trained on rig '{args.rig}' labels, target test halves", target_ceiling, 1
     else:
         what, fn, pick = "source-only CNN on held-out source records", source_ceiling, 0
-    jobs = [(fn, t, str(prepare_task(t, data_dir, rig_settings(t, args.rig))[pick]), s, args.epochs)
+    settings, targets = ({t: rig_settings(t, args.rig) for t in tasks}, {}) if args.rig not in INDEPENDENT_RIGS \
+        else independent_targets(args.rig, tasks, data_dir)
+    jobs = [(fn, t, str(prepare_task(t, data_dir, settings[t], target=targets.get(t))[pick]), s, args.epochs)
             for t in tasks for s in args.seed_range]
     with ProcessPoolExecutor(max_workers=args.jobs, mp_context=mp.get_context("spawn")) as pool:
         acc = list(pool.map(_star, jobs))

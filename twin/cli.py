@@ -193,7 +193,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
 
 
 def _cmd_demo(args: argparse.Namespace) -> int:
-    _lib("twin.demo").run_demo(Path(args.out), stop_time=args.stop_time)
+    _lib("twin.demo").run_demo(Path(args.out), stop_time=args.stop_time, rig_records=args.rig_records)
     return 0
 
 
@@ -608,6 +608,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", default="demo_out", help="output directory (default: demo_out)")
     p.add_argument("--stop-time", type=float, default=10.0,
                    help="simulated time [s] (default: 10)")
+    p.add_argument("--rig-records", nargs="+", default=(), metavar="FILE",
+                   help="pitting records of independent simulators (python -m rigs.lumped target ...) for step 9")
     p.set_defaults(handler=_cmd_demo)
     return parser
 

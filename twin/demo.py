@@ -28,8 +28,14 @@ LOAD_NM = 20.0
 
 
 def run_demo(out_dir: Path | str = "demo_out", *, stop_time: float = 10.0,
-             modelica_dir: Path | str | None = None) -> dict:
-    """Run the demo and return a dict of the produced paths and headline numbers."""
+             modelica_dir: Path | str | None = None, rig_records=()) -> dict:
+    """Run the demo and return a dict of the produced paths and headline numbers.
+
+    ``rig_records``: measurement files of the pitting stages written by the independent simulators
+    of ``rigs/`` (``make demo`` writes them with ``python -m rigs.lumped target`` and ``python -m
+    rigs.ltca target``); step 9 scores the transfer on each, named after its file.
+    """
+    from twin.errors import ParameterError
     from fmu_build import build_fmu
     from twin.errors import OutputPathError
     from twin.fmu import simulate_fmu
@@ -38,6 +44,10 @@ def run_demo(out_dir: Path | str = "demo_out", *, stop_time: float = 10.0,
     from twin.results import write_result
 
     out_dir = Path(out_dir)
+    rig_records = [Path(f) for f in rig_records]
+    missing = [f for f in rig_records if not f.is_file()]
+    if missing:
+        raise ParameterError(f"rig records '{missing[0]}' do not exist")
     if not out_dir.parent.exists():
         raise OutputPathError(f"parent directory {out_dir.parent} of the demo output does not exist")
     out_dir.mkdir(exist_ok=True)
@@ -80,7 +90,7 @@ def run_demo(out_dir: Path | str = "demo_out", *, stop_time: float = 10.0,
     report = _calibration_demo(fmu, out_dir)
     _compare_demo(out_dir)
     history = _loop_demo(out_dir)
-    transfer = _transfer_demo(out_dir)
+    transfer = _transfer_demo(out_dir, rig_records)
     return {"loop": history, "transfer": transfer, "fmu": fmu, "hdf5": Path(h5), "png": Path(png), "natural_frequencies": freqs,
             "simulation_wall_time": wall, "stages_png": stages_png, "stages": stage_rows,
             "calibration": report}
@@ -259,7 +269,7 @@ def _loop_demo(out_dir: Path):
     return history
 
 
-def _transfer_demo(out_dir: Path, epochs: int = 15):
+def _transfer_demo(out_dir: Path, rig_records=(), epochs: int = 15):
     """Wear-stage assessment of built-in rig records: CNN, MMD and the proposed method side by side.
 
     A short version of ``twin benchmark-transfer`` (one seed, ``epochs`` epochs, fewer records), so
@@ -303,9 +313,9 @@ def _transfer_demo(out_dir: Path, epochs: int = 15):
             f"retraining by twin rematch: {100 * accuracy['proposed, offsets']:.0f} %)")
     print("      ordinal class-prior match (proposed): the rig's stage boundaries along the expected stage, "
           + " ".join(f"{v:.2f}" for v in boundaries) + ", split its windows in the archive's proportions; "
-          f"{100 * moved:.1f} % of its adaptation windows changed stage (twin.transfer.prior, stop 25). "
+          f"{100 * moved:.1f} % of its adaptation windows changed stage (twin.transfer.prior). "
           "It needs a well-trained network and many rig windows: here (15 epochs, 108 windows) it can "
-          "lose to the offsets; at 80 epochs and 270 windows it does not (BENCHMARKS.md, stop 25)")
+          "lose to the offsets; at 80 epochs and 270 windows it does not (BENCHMARKS.md)")
     print(f"      without labels: a second seed of the proposed method gives {100 * agreed.window_agreement:.0f} % of "
           f"the rig's test windows the same stage, so the two read at most {100 * agreed.accuracy_bound:.0f} % "
           "of them right (twin agreement; low agreement proves a transfer unreliable, high agreement does not "
@@ -313,7 +323,7 @@ def _transfer_demo(out_dir: Path, epochs: int = 15):
     print(f"      each archive record has a pinion of its own: run-out up to {1e6 * settings.source_runout:.0f} um, "
           f"pitting spread over the teeth with a relative sd up to {settings.source_tooth_damage_scatter:.1f}, "
           + (f"pitch errors up to {1e6 * settings.source_pitch_error:.0f} um" if settings.source_pitch_error > 0
-             else "no pitch errors (they hide pitting at this load: BENCHMARKS.md, stop 16)")
+             else "no pitch errors (they hide pitting at this load: docs/experiments.md)")
           + " (twin.archive.tooth_errors)")
     for note in notes:
         print(f"      warning: {note}")
@@ -325,8 +335,11 @@ def _transfer_demo(out_dir: Path, epochs: int = 15):
     page = write_assessment_report(asm, out_dir / "assessment", "Demo: the proposed method on the rig's test records")
     print(f"      assessor saved to {out_dir / 'assessor'} (twin assess {out_dir / 'assessor'} <measurements.h5> "
           f"--report DIR); this table as a figure: {page}")
-    for rig in ("lumped", "ltca"):
-        accuracy[rig] = _independent_rig_demo(data, settings, pre, epochs, rig)
+    for path in rig_records:
+        accuracy[path.stem] = _independent_rig_demo(src, path, pre, epochs)
+    if not rig_records:
+        print("      independent simulators: no records given (make demo writes them with "
+              "'python -m rigs.lumped target' and 'python -m rigs.ltca target'; twin demo --rig-records FILE ...)")
     return accuracy
 
 
@@ -349,28 +362,19 @@ def _offsets_accuracy(fitted, adapt, test) -> float:
     return fitted.rematch(adapt, "source").score(test)
 
 
-# what each simulator that is not the twin is, for the demo's line
-_INDEPENDENT_RIGS = {
-    "lumped": ("twin.transfer.lumped: one-DOF contact dynamics, no code shared with the twin", "stops 15, 21 and 25"),
-    "ltca": ("twin.transfer.ltca: loaded tooth contact analysis + linear dynamics, discrete pits", "stops 23 and 25")}
-
-
-def _independent_rig_demo(data: Path, settings, pre, epochs: int, rig: str) -> float:
-    """The proposed method on records of a simulator of the gearbox that is not the twin
-    (:data:`_INDEPENDENT_RIGS`): what the emulated rigs cannot show."""
-    from dataclasses import replace
-
+def _independent_rig_demo(src: Path, rig_file: Path, pre, epochs: int) -> float:
+    """The proposed method, trained on the demo's pitting archive ``src``, on the records of a
+    simulator of the gearbox that is not the twin (``rig_file``, written by ``rigs/``): what the
+    emulated rigs cannot show."""
+    from twin.measurements import load_measurements
     from twin.transfer.assessor import Assessor
-    from twin.transfer.benchmark import (RIG_SEEDS, TASK_CLASS_PRIOR, load_task_data, prepare_task,
-                                         stage_order_scores)
+    from twin.transfer.benchmark import TASK_CLASS_PRIOR, load_task_data, stage_order_scores
     from twin.transfer.errors import class_prior_notes
     from twin.transfer.report import confusion_matrix
 
     t = time.perf_counter()
-    other = replace(settings, rig=rig, target_seed=RIG_SEEDS[rig], target_records_per_stage=3,
-                    target_record_duration=0.3)
-    src, tgt = prepare_task("pitting", data, other, progress=False)
-    source, adapt, test = load_task_data("pitting", str(src), str(tgt), pre.sample_rate)
+    what = str(load_measurements(rig_file).metadata.get("note", "")).split(";")[0] or rig_file.name
+    source, adapt, test = load_task_data("pitting", str(src), str(rig_file), pre.sample_rate)
     a = Assessor("proposed", epochs=epochs, seed=0, preprocessing=pre, progress=False,
                  class_prior=TASK_CLASS_PRIOR["pitting"])
     with class_prior_notes() as caught:
@@ -380,10 +384,9 @@ def _independent_rig_demo(data: Path, settings, pre, epochs: int, rig: str) -> f
     with class_prior_notes():       # the same warning again, already caught above
         offsets = _offsets_accuracy(a, adapt, test)
     agreed = _seed_agreement(a, source, adapt, test)
-    what, where = _INDEPENDENT_RIGS[rig]
-    print(f"      another simulator of the gearbox ({what}; {time.perf_counter() - t:.0f} s): "
+    print(f"      {rig_file.stem}: another simulator of the gearbox ({what}; {time.perf_counter() - t:.0f} s): "
           f"proposed {100 * asm.window_accuracy:.0f} % exact, {100 * within:.0f} % within one stage; "
-          f"{100 * offsets:.0f} % with the per-stage offsets (5 seeds and why: BENCHMARKS.md, {where}); "
+          f"{100 * offsets:.0f} % with the per-stage offsets (5 seeds: BENCHMARKS.md); "
           f"two seeds agree on {100 * agreed.window_agreement:.0f} % of windows (accuracy at most "
           f"{100 * agreed.accuracy_bound:.0f} %)")
     for note in caught:

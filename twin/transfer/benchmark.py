@@ -56,8 +56,6 @@ import numpy as np
 
 from twin.errors import ParameterError
 from twin.transfer.domain import TargetShift
-from twin.transfer.ltca import LtcaRig
-from twin.transfer.lumped import LumpedRig
 
 REPO = Path(__file__).resolve().parents[2]
 TASKS = {"pitting": "scenarios/lubricated.yaml", "wear": "scenarios/dry.yaml"}
@@ -90,36 +88,36 @@ class DataSettings:
     # (twin.archive.draw_wheel); 0 = a perfect gear
     source_wheel_pitch_error: float = 0.0
     source_wheel_runout: float = 0.0
-    # which emulated rig measures the target (RIGS)
+    # which rig measures the target: an emulated rig (RIGS), simulated here, or the name of a rig
+    # whose records are given as a file
     rig: str = "rig"
 
     def __post_init__(self) -> None:
         _check_rig(self.rig)
 
 
-# The emulated rigs (twin.transfer.domain.TargetShift).  "rig" is the benchmark's: every setting of
-# the assessor and of the benchmark data was chosen while looking at its results.  "blind" is a
-# second rig, fixed after all those choices (stop 11) and only ever scored: a stiffer pedestal
-# instead of a softer one, the sensor tilted by half the angle, a lower and sharper mount resonance,
-# less run-out and noise, its own data seed (2).  A result on it is a blind test of the settings.
-# "lumped" is not the twin at all: an independent one-DOF simulator of the same gearbox with its
-# own stiffness, wear, pitting and casing models (twin.transfer.lumped, stop 15), also only scored.
-# "ltca" is a third simulator of another model family: a loaded tooth contact analysis whose static
-# transmission error excites linear dynamics, with Archard wear integrated on both flanks and
-# discrete pits (twin.transfer.ltca, stop 23), fixed before it was first scored.
-RIGS: dict[str, TargetShift | LumpedRig | LtcaRig] = {
+# The emulated rigs (twin.transfer.domain.TargetShift): variants of the twin's own FMU, so a figure
+# on them proves plumbing only.  "rig" is the benchmark's: every setting of the assessor and of the
+# benchmark data was chosen while looking at its results.  "blind" is a second emulated rig, fixed
+# after all those choices and only ever scored: a stiffer pedestal instead of a softer one, the
+# sensor tilted by half the angle, a lower and sharper mount resonance, less run-out and noise, its
+# own data seed (2).
+# Records of any other rig (the independent simulators of rigs/, or a real gearbox) are made
+# outside the twin and handed to prepare_task / run_benchmark as files (``target=``, ``targets=``);
+# DataSettings.rig then only names them.
+RIGS: dict[str, TargetShift] = {
     "rig": TargetShift(),
     "blind": TargetShift(runout=3e-6, sensor_angle=0.1, pedestal_stiffness_factor=1.15,
                          resonance_hz=3300.0, resonance_q=6.0, gain_error=0.10, noise=0.06,
-                         speed_scatter=0.02, load_scatter=0.10),
-    "lumped": LumpedRig(),
-    "ltca": LtcaRig()}
-RIG_SEEDS = {"rig": 1, "blind": 2, "lumped": 3, "ltca": 4}
+                         speed_scatter=0.02, load_scatter=0.10)}
+RIG_SEEDS = {"rig": 1, "blind": 2}
 
 
 def _check_rig(rig: str) -> None:
-    if rig not in RIGS:
-        raise ParameterError(f"unknown rig {rig!r}; use one of {', '.join(RIGS)}")
+    # any name is a rig's name (it goes into file names); only RIGS are simulated here
+    if not (isinstance(rig, str) and rig and all(c.isalnum() or c in "_-" for c in rig)):
+        raise ParameterError(f"a rig name must be letters, digits, '_' or '-', got {rig!r}; "
+                             f"the emulated rigs are {', '.join(RIGS)}")
 
 
 # Record lengths in the same number of pinion revolutions for both tests: the dry test runs at
@@ -154,14 +152,36 @@ TASK_CLASS_PRIOR = {"pitting": "ordinal", "wear": "source"}
 ARCHIVE_RULES = 2
 
 
-def rig_settings(task: str, rig: str = "rig") -> DataSettings:
-    """The data settings of ``task`` with its target measured on ``rig`` (:data:`RIGS`)."""
+def rig_settings(task: str, rig: str = "rig", *, target_seed: int | None = None) -> DataSettings:
+    """The data settings of ``task`` with its target measured on ``rig``: an emulated rig
+    (:data:`RIGS`, with its data seed) or the name of a rig whose records are given as a file
+    (``target_seed`` then records the seed they were made with; default the task's)."""
     from dataclasses import replace
 
     if task not in TASKS:
         raise ParameterError(f"unknown task {task!r}; use one of {', '.join(TASKS)}")
     _check_rig(rig)
-    return replace(TASK_SETTINGS[task], rig=rig, target_seed=RIG_SEEDS[rig])
+    seed = RIG_SEEDS.get(rig, TASK_SETTINGS[task].target_seed) if target_seed is None else target_seed
+    return replace(TASK_SETTINGS[task], rig=rig, target_seed=seed)
+
+
+def task_scenario(task: str, settings: DataSettings | None = None):
+    """The scenario of ``task`` with the archive block of ``settings`` (default ``TASK_SETTINGS[task]``):
+    what the source archive is built from, and what a simulator of another rig reads its stages,
+    damage sampling and operating point from."""
+    from twin.scenario import load_scenario
+
+    if task not in TASKS:
+        raise ParameterError(f"unknown task {task!r}; use one of {', '.join(TASKS)}")
+    settings = TASK_SETTINGS[task] if settings is None else settings
+    sc = load_scenario(REPO / TASKS[task])
+    arc = {**sc.archive, "records_per_stage": settings.source_records_per_stage,
+           "record_duration": settings.source_record_duration, "damage_sampling": settings.damage_sampling,
+           "damage_scatter": settings.damage_scatter, "speed_scatter": settings.source_speed_scatter,
+           "load_scatter": settings.source_load_scatter, "pitch_error": settings.source_pitch_error,
+           "runout": settings.source_runout, "tooth_damage_scatter": settings.source_tooth_damage_scatter,
+           "wheel_pitch_error": settings.source_wheel_pitch_error, "wheel_runout": settings.source_wheel_runout}
+    return sc.with_overrides(archive=arc)
 
 
 def task_preprocessing(task: str) -> "Preprocessing":
@@ -179,19 +199,28 @@ def task_preprocessing(task: str) -> "Preprocessing":
 
 
 def prepare_task(task: str, data_dir: str | Path, settings: DataSettings | None = None, *,
-                 progress: bool = True) -> tuple[Path, Path]:
+                 progress: bool = True, target: str | Path | None = None) -> tuple[Path, Path]:
     """Build (or reuse) the source archive and target measurements of ``task``; return their paths.
 
-    ``settings`` None means ``TASK_SETTINGS[task]``.
+    ``settings`` None means ``TASK_SETTINGS[task]``.  When ``settings.rig`` is an emulated rig
+    (:data:`RIGS`) its target records are simulated here; for any other rig, ``target`` is the
+    measurement file of its records (labelled with the task's stages), used as it is.
     """
     from twin.archive import build_archive
     from twin.degradation_run import run_degradation
-    from twin.scenario import load_scenario
     from twin.transfer.domain import make_target_domain
 
     if task not in TASKS:
         raise ParameterError(f"unknown task {task!r}; use one of {', '.join(TASKS)}")
     settings = TASK_SETTINGS[task] if settings is None else settings
+    emulated = settings.rig in RIGS
+    if emulated and target is not None:
+        raise ParameterError(f"rig {settings.rig!r} is emulated here; a target file is for another rig's records")
+    if not emulated and target is None:
+        raise ParameterError(f"rig {settings.rig!r} is not an emulated rig ({', '.join(RIGS)}); "
+                             "give the file of its records (target=)")
+    if target is not None and not Path(target).is_file():
+        raise ParameterError(f"target records '{target}' do not exist")
     data_dir = Path(data_dir)
     if not data_dir.is_dir():
         from twin.errors import OutputPathError
@@ -200,36 +229,22 @@ def prepare_task(task: str, data_dir: str | Path, settings: DataSettings | None 
     # own copy of the source archive, so one key always describes the pair it sits next to.
     tag = task if settings.rig == "rig" else f"{task}_{settings.rig}"
     src, tgt, key = data_dir / f"source_{tag}.h5", data_dir / f"target_{tag}.h5", data_dir / f"{tag}.json"
+    tgt = tgt if target is None else Path(target)
     wanted = json.dumps({**asdict(settings), "archive_rules": ARCHIVE_RULES}, sort_keys=True)
     if src.exists() and tgt.exists() and key.exists() and key.read_text() == wanted:
         return src, tgt
-    sc = load_scenario(REPO / TASKS[task])
-    arc = {**sc.archive, "records_per_stage": settings.source_records_per_stage,
-           "record_duration": settings.source_record_duration, "damage_sampling": settings.damage_sampling,
-           "damage_scatter": settings.damage_scatter, "speed_scatter": settings.source_speed_scatter,
-           "load_scatter": settings.source_load_scatter, "pitch_error": settings.source_pitch_error,
-           "runout": settings.source_runout, "tooth_damage_scatter": settings.source_tooth_damage_scatter,
-           "wheel_pitch_error": settings.source_wheel_pitch_error, "wheel_runout": settings.source_wheel_runout}
-    sc = sc.with_overrides(archive=arc)
+    sc = task_scenario(task, settings)
     # gears of their own need the model variant that has per-gear-tooth parameters; the targets
     # below keep the scenario's model
     src_sc = sc.with_overrides(fmu=WHEEL_MODEL) if settings.source_wheel_pitch_error or settings.source_wheel_runout \
         else sc
     build_archive(src_sc, src, progress=progress, fmu_path=src_sc.fmu_path())
-    rig = RIGS[settings.rig]
-    if isinstance(rig, (LumpedRig, LtcaRig)):
-        # the simulators that are not the twin write their own target files, from the scenario alone
-        from twin.transfer import ltca, lumped
-        make = lumped.make_lumped_target if isinstance(rig, LumpedRig) else ltca.make_ltca_target
-        make(sc, tgt, records_per_stage=settings.target_records_per_stage,
-             record_duration=settings.target_record_duration, seed=settings.target_seed,
-             rig=rig, progress=progress)
-    else:
+    if emulated:
         fmu = sc.fmu_path()
         run = run_degradation(sc, None, fmu_path=fmu, progress=progress, channels=(CHANNEL,))
         make_target_domain(sc, tgt, records_per_stage=settings.target_records_per_stage,
                            record_duration=settings.target_record_duration, seed=settings.target_seed,
-                           shift=rig, run=run, fmu_path=fmu, progress=progress)
+                           shift=RIGS[settings.rig], run=run, fmu_path=fmu, progress=progress)
     from twin._atomic import atomic_path
     with atomic_path(key) as tmp:       # a torn key would only force a rebuild, but never leave one
         Path(tmp).write_text(wanted)
@@ -480,7 +495,8 @@ def training_jobs(tasks: tuple[str, ...], methods: tuple[str, ...], seeds: range
 def run_benchmark(out: str | Path, *, tasks: tuple[str, ...] = ("pitting", "wear"), seeds: int = 5,
                   methods: tuple[str, ...] = METHODS, epochs: int = 80, jobs: int = 2,
                   data_dir: str | Path | None = None, settings: dict[str, DataSettings] | None = None,
-                  rig: str = "rig", progress: bool = True, first_seed: int = 0) -> dict:
+                  rig: str = "rig", progress: bool = True, first_seed: int = 0,
+                  targets: dict[str, str | Path] | None = None) -> dict:
     """Run every (task, method, seed), write ``results.json``, ``summary.md``, figures and
     ``report.html`` into ``out``; return the summary (see :func:`summarise`).
 
@@ -489,8 +505,10 @@ def run_benchmark(out: str | Path, *, tasks: tuple[str, ...] = ("pitting", "wear
     machine, so the two ``results.json`` can be pooled).
 
     ``jobs`` training runs go in parallel, each in its own process on one torch thread (so the
-    fit times are single-core times).  ``rig`` picks the emulated rig (:data:`RIGS`) for the tasks
-    whose ``settings`` are not given.
+    fit times are single-core times).  ``rig`` picks the rig for the tasks whose ``settings`` are
+    not given: an emulated rig (:data:`RIGS`), simulated here, or the name of another rig, whose
+    records ``targets`` gives per task (a measurement file each, e.g. written by a simulator of
+    ``rigs/``).
     """
     import multiprocessing as mp
     from concurrent.futures import ProcessPoolExecutor
@@ -507,11 +525,18 @@ def run_benchmark(out: str | Path, *, tasks: tuple[str, ...] = ("pitting", "wear
         raise ParameterError(f"unknown task or method {bad[0]!r}; tasks: {', '.join(TASKS)}; "
                              f"methods: cnn, mmd, proposed, coral")
     run_seeds = seed_range(seeds, first_seed)
+    settings = {t: (settings or {}).get(t) or rig_settings(t, rig) for t in tasks}
+    targets = dict(targets or {})
+    for t in tasks:
+        if (settings[t].rig in RIGS) == (t in targets):
+            raise ParameterError(f"task {t!r} on rig {settings[t].rig!r}: give a target file exactly when the rig "
+                                 f"is not emulated here ({', '.join(RIGS)})")
+        if t in targets and not Path(targets[t]).is_file():
+            raise ParameterError(f"target records '{targets[t]}' of task {t!r} do not exist")
     out.mkdir(exist_ok=True)        # only once every argument is known good: a typo leaves no trace
     data_dir = Path(data_dir) if data_dir is not None else out / "data"
     data_dir.mkdir(exist_ok=True)
-    settings = {t: (settings or {}).get(t) or rig_settings(t, rig) for t in tasks}
-    paths = {t: prepare_task(t, data_dir, settings[t], progress=progress) for t in tasks}
+    paths = {t: prepare_task(t, data_dir, settings[t], progress=progress, target=targets.get(t)) for t in tasks}
     jobs_list = training_jobs(tasks, methods, run_seeds, paths, epochs)
     bar = progress_bar(len(jobs_list), progress, "transfer benchmark", "run")
     results: list[RunResult] = []

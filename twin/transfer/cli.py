@@ -143,9 +143,19 @@ def _cmd_agreement(args: argparse.Namespace) -> int:
 def _cmd_benchmark_transfer(args: argparse.Namespace) -> int:
     bench = _lib("twin.transfer.benchmark")
     tasks = ("pitting", "wear") if args.task == "both" else (args.task,)
+    rig, targets = args.rig, None
+    if args.target:
+        from twin.errors import ParameterError
+        if len(tasks) != 1:
+            raise ParameterError("--target holds the records of one task: give --task pitting or --task wear")
+        # the rig is named after its file (the name tags the cached source archive beside it)
+        rig = "".join(c if c.isalnum() or c in "_-" else "_" for c in Path(args.target).stem) or "target"
+        rig = rig + "_file" if rig in bench.RIGS else rig
+        targets = {tasks[0]: Path(args.target)}
     summary = bench.run_benchmark(Path(args.out), tasks=tasks, seeds=args.seeds, epochs=args.epochs,
                                   jobs=args.jobs, data_dir=Path(args.data_dir) if args.data_dir else None,
-                                  rig=args.rig, progress=not args.no_progress, first_seed=args.first_seed)
+                                  rig=rig, progress=not args.no_progress, first_seed=args.first_seed,
+                                  targets=targets)
     print(bench.markdown_table(summary))
     print(f"report -> {Path(args.out) / 'report.html'}")
     return 0
@@ -231,10 +241,11 @@ def add_subcommands(sub) -> None:
     p.add_argument("--data-dir", help="where the simulated source/target data are cached (default: OUT/data)")
     # The names of benchmark.RIGS, spelt out: importing it would pull numpy into ``twin --help``
     # (tests/twin/transfer/test_cli_transfer.py checks that the two agree).
-    p.add_argument("--rig", choices=("rig", "blind", "lumped", "ltca"), default="rig",
-                   help="emulated rig of the target data: the benchmark's (default), the blind one fixed "
-                        "after every setting was chosen, or a simulator of the gearbox that is not the twin: "
-                        "'lumped' (twin.transfer.lumped, one-DOF contact dynamics) or 'ltca' "
-                        "(twin.transfer.ltca, loaded tooth contact analysis + linear dynamics)")
+    p.add_argument("--rig", choices=("rig", "blind"), default="rig",
+                   help="emulated rig of the target data (a variant of the twin: plumbing only): the benchmark's "
+                        "(default) or the blind one fixed after every setting was chosen")
+    p.add_argument("--target", metavar="FILE",
+                   help="instead of an emulated rig: the labelled records of another rig for the one --task (for "
+                        "example written by 'python -m rigs.lumped target' or 'python -m rigs.ltca target')")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bars")
     p.set_defaults(handler=_cmd_benchmark_transfer)

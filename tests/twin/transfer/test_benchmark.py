@@ -36,14 +36,22 @@ def test_blind_rig_changes_only_the_target_rig_and_its_data_seed():
     assert other.resonance_hz != rig.resonance_hz and other.pedestal_stiffness_factor != rig.pedestal_stiffness_factor
 
 
-def test_unknown_rig_is_refused_before_any_data_are_built(tmp_path):
-    with pytest.raises(ParameterError, match="'garage'"):
-        DataSettings(rig="garage")
-    with pytest.raises(ParameterError, match="'garage'"):
-        rig_settings("wear", "garage")
+def test_a_rig_without_records_or_a_bad_rig_name_is_refused_before_any_data_are_built(tmp_path):
+    for bad in ("", "../garage", "gar age"):
+        with pytest.raises(ParameterError, match="rig name"):
+            DataSettings(rig=bad)
+        with pytest.raises(ParameterError, match="rig name"):
+            rig_settings("wear", bad)
+    # a rig that is not emulated here needs the file of its records, and only it
     with pytest.raises(ParameterError, match="'garage'"):
         run_benchmark(tmp_path / "out", rig="garage", progress=False)
-    assert not (tmp_path / "out" / "data").exists()
+    with pytest.raises(ParameterError, match="'blind'"):
+        run_benchmark(tmp_path / "out", tasks=("wear",), rig="blind", targets={"wear": tmp_path / "t.h5"},
+                      progress=False)
+    with pytest.raises(ParameterError, match="t.h5"):
+        run_benchmark(tmp_path / "out", tasks=("wear",), rig="garage", targets={"wear": tmp_path / "t.h5"},
+                      progress=False)
+    assert not (tmp_path / "out").exists()
 
 
 def test_first_seed_adds_later_seeds_and_is_checked_before_any_data_are_built(tmp_path):
@@ -235,33 +243,32 @@ def test_prepare_task_keeps_each_rigs_data_apart_and_reuses_it(tmp_path, monkeyp
     assert calls[n:] == [("source", "source_wear_blind.h5"), ("target", "target_wear_blind.h5")]
 
 
-def test_the_lumped_rig_is_simulated_by_the_independent_model_not_the_fmu(tmp_path, monkeypatch):
+def test_another_rigs_records_are_the_file_given_never_simulated_by_the_twin(tmp_path, monkeypatch):
     import twin.archive
     import twin.degradation_run
     import twin.scenario
     import twin.transfer.domain
-    import twin.transfer.lumped
     from twin.transfer.benchmark import prepare_task
 
-    calls = []
-
     def refuse(*a, **kw):
-        raise AssertionError("the lumped rig must not run the twin's degradation or target domain")
-
-    def make_lumped_target(sc, path, *, rig, seed, records_per_stage, record_duration, **kw):
-        calls.append((path.name, rig, seed, records_per_stage, record_duration))
-        path.write_text("lumped")
+        raise AssertionError("another rig's records must not come from the twin's degradation or target domain")
 
     monkeypatch.setattr(twin.scenario.Scenario, "fmu_path", lambda self: tmp_path / "model.fmu")
     monkeypatch.setattr(twin.archive, "build_archive", lambda sc, path, **kw: path.write_text("source"))
     monkeypatch.setattr(twin.degradation_run, "run_degradation", refuse)
     monkeypatch.setattr(twin.transfer.domain, "make_target_domain", refuse)
-    monkeypatch.setattr(twin.transfer.lumped, "make_lumped_target", make_lumped_target)
-    src, tgt = prepare_task("pitting", tmp_path, rig_settings("pitting", "lumped"), progress=False)
-    assert (src.name, tgt.name) == ("source_pitting_lumped.h5", "target_pitting_lumped.h5")
-    s = TASK_SETTINGS["pitting"]
-    assert calls == [("target_pitting_lumped.h5", RIGS["lumped"], 3, s.target_records_per_stage,
-                      s.target_record_duration)]
+    records = tmp_path / "lumped_records.h5"
+    records.write_text("lumped")
+    settings = rig_settings("pitting", "lumped", target_seed=3)
+    assert settings.target_seed == 3 and settings.rig == "lumped"
+    src, tgt = prepare_task("pitting", tmp_path, settings, progress=False, target=records)
+    assert (src.name, tgt) == ("source_pitting_lumped.h5", records) and records.read_text() == "lumped"
+    with pytest.raises(ParameterError, match="'lumped'"):          # no file for a rig simulated elsewhere
+        prepare_task("pitting", tmp_path, settings, progress=False)
+    with pytest.raises(ParameterError, match="'blind'"):           # an emulated rig is simulated here
+        prepare_task("pitting", tmp_path, rig_settings("pitting", "blind"), progress=False, target=records)
+    with pytest.raises(ParameterError, match="missing.h5"):
+        prepare_task("pitting", tmp_path, settings, progress=False, target=tmp_path / "missing.h5")
 
 
 def _rig_file(tmp_path, name, shuffle_labels=False):

@@ -1,13 +1,13 @@
 """A third simulator of the test gearbox, of another model family: loaded tooth contact + linear dynamics.
 
-The twin (21 DOF) and the lumped rig (:mod:`twin.transfer.lumped`) both integrate a time-varying,
+The twin (21 DOF) and the lumped rig (:mod:`rigs.lumped`) both integrate a time-varying,
 nonlinear mesh contact in the time domain.  This module follows the other classic line of gear
 noise modelling: a quasi-static *loaded tooth contact analysis* (LTCA) gives the static
 transmission error, and that error excites a linear mesh mode (Ozguven & Houser, J. Sound Vib. 121,
-1988), whose force reaches the sensor through a bearing and the casing.  It was written after stop
-22 and fixed before it was first scored, so it is a blind test of the archive and assessor choices
-of stops 1-22.  It shares the datasheet geometry (:func:`twin.transfer.lumped.mesh_geometry`) and
-the record drawing (:func:`twin.transfer.lumped.write_simulated_target`) with the lumped rig, no
+1988), whose force reaches the sensor through a bearing and the casing.  It was written (2026-11-24)
+after the archive and assessor settings had been chosen, and fixed before it was first scored, so it
+is a blind test of those choices.  It shares the datasheet geometry (:func:`rigs.lumped.mesh_geometry`) and
+the record drawing (:func:`rigs.lumped.write_simulated_target`) with the lumped rig, no
 physics.
 
 =============================  =====================================================================
@@ -58,9 +58,9 @@ from pathlib import Path
 
 import numpy as np
 
+from rigs.lumped import (ISO_SINGLE_PAIR_STIFFNESS, check_records, field_problems, mesh_geometry, mode_problems,
+                         write_simulated_target)
 from twin.errors import ParameterError, SimulationError
-from twin.transfer.lumped import (ISO_SINGLE_PAIR_STIFFNESS, check_records, field_problems, mesh_geometry,
-                                  mode_problems, write_simulated_target)
 
 __all__ = ["LtcaRig", "lost_width", "make_ltca_target", "pair_stiffness", "pit_fields", "simulate_ltca",
            "static_approach", "wear_profiles"]
@@ -463,7 +463,7 @@ def make_ltca_target(source_scenario, output: str | Path, *, records_per_stage: 
                      progress: bool = True) -> Path:
     """Simulate the target domain of ``source_scenario``'s stages on the LTCA model; write it.
 
-    Same file layout as :func:`twin.transfer.lumped.make_lumped_target`, with the metadata entry
+    Same file layout as :func:`rigs.lumped.make_lumped_target`, with the metadata entry
     ``ltca_rig`` (JSON).  Only the scenario's stages, damage kind and nominal operating point are
     read; its FMU is not used.
     """
@@ -471,5 +471,12 @@ def make_ltca_target(source_scenario, output: str | Path, *, records_per_stage: 
     return write_simulated_target(
         source_scenario, output, rig, lambda *a, **k: simulate_ltca(rig, *a, **k), name="ltca",
         records_per_stage=records_per_stage, record_duration=record_duration, seed=seed, progress=progress,
-        note="independent LTCA simulator (twin.transfer.ltca); labels and damage are for evaluation only")
+        note="independent LTCA simulator (rigs.ltca); labels and damage are for evaluation only")
 
+
+if __name__ == "__main__":
+    import sys
+
+    from rigs.lumped import main
+
+    sys.exit(main(make=make_ltca_target, prog="python -m rigs.ltca"))

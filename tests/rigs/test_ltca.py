@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 
 from twin.errors import ParameterError, ScenarioError
-from twin.transfer.ltca import (LtcaRig, lost_width, make_ltca_target, pair_stiffness, pit_fields, simulate_ltca,
+from rigs.ltca import (LtcaRig, lost_width, make_ltca_target, pair_stiffness, pit_fields, simulate_ltca,
                                 static_approach, wear_profiles)
-from twin.transfer.lumped import mesh_geometry, LumpedRig
+from rigs.lumped import mesh_geometry, LumpedRig
 
-SCENARIOS = Path(__file__).resolve().parents[3] / "scenarios"
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 U = np.linspace(0.0, 1.0, 401)
 
 

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from twin.errors import ParameterError, ScenarioError
-from twin.transfer.lumped import LumpedRig, _profile_shapes, make_lumped_target, mesh_geometry, simulate_lumped
+from rigs.lumped import LumpedRig, _profile_shapes, make_lumped_target, mesh_geometry, simulate_lumped
 
-SCENARIOS = Path(__file__).resolve().parents[3] / "scenarios"
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 
 
 def test_geometry_agrees_with_the_twins_independent_geometry_code():
@@ -128,3 +128,24 @@ def test_a_scenario_without_pitting_or_wear_is_a_scenario_error(tmp_path):
     assert not (tmp_path / "x.h5").exists()
     with pytest.raises(ParameterError, match="records_per_stage"):
         make_lumped_target(sc, tmp_path / "x.h5", records_per_stage=0, progress=False)
+
+
+def test_the_command_line_writes_what_the_function_writes_and_names_bad_input(tmp_path, capsys):
+    from rigs.lumped import main
+    from twin.measurements import load_measurements
+    from twin.scenario import load_scenario
+
+    args = ["--records-per-stage", "1", "--record-duration", "0.05", "--seed", "5", "--no-progress"]
+    assert main(["target", str(SCENARIOS / "dry.yaml"), "--out", str(tmp_path / "cli.h5"),
+                 "--damage-sampling", "snapshot", "--damage-scatter", "0.2", *args]) == 0
+    sc = load_scenario(SCENARIOS / "dry.yaml")
+    sc = sc.with_overrides(archive={**sc.archive, "damage_sampling": "snapshot", "damage_scatter": 0.2})
+    make_lumped_target(sc, tmp_path / "fn.h5", records_per_stage=1, record_duration=0.05, seed=5, progress=False)
+    cli, fn = (load_measurements(tmp_path / f"{n}.h5").records for n in ("cli", "fn"))
+    assert [(r.label, r.damage) for r in cli] == [(r.label, r.damage) for r in fn]
+    for r, q in zip(cli, fn):
+        np.testing.assert_array_equal(r["accel_pinion_casing"], q["accel_pinion_casing"])
+    # a scenario without stages: a one-line error naming it, exit code 2, nothing written
+    assert main(["target", str(SCENARIOS / "healthy.yaml"), "--out", str(tmp_path / "bad.h5"),
+                 "--damage-sampling", "snapshot", *args]) == 2
+    assert "healthy.yaml" in capsys.readouterr().err and not (tmp_path / "bad.h5").exists()

@@ -42,7 +42,12 @@ acquisition rate (4.9 us, below the 5 us the 21-DOF model needs), vectorised ove
 casing response is filtered at that rate and decimated with an anti-alias FIR.
 
 Nothing here was tuned to the assessor: the defaults were set from the datasheet and textbook
-values once, before the first assessment was run on it.
+values once (2026-11-23), before the first assessment was run on it.
+
+Command line (the records of a scenario's stages, e.g. for ``twin benchmark-transfer --target``)::
+
+    python -m rigs.lumped target SCENARIO --out FILE.h5 [--records-per-stage 15] [--record-duration 0.4]
+                                 [--seed 3] [--damage-sampling snapshot] [--damage-scatter 0.1] [--no-progress]
 """
 from __future__ import annotations
 
@@ -326,7 +331,7 @@ def make_lumped_target(source_scenario, output: str | Path, *, records_per_stage
     return write_simulated_target(
         source_scenario, output, rig, lambda *a, nominal_load, **k: simulate_lumped(rig, *a, **k), name="lumped",
         records_per_stage=records_per_stage, record_duration=record_duration, seed=seed, progress=progress,
-        note="independent lumped simulator (twin.transfer.lumped); labels and damage are for evaluation only")
+        note="independent lumped simulator (rigs.lumped); labels and damage are for evaluation only")
 
 
 def write_simulated_target(source_scenario, output: str | Path, rig, simulate, *, name: str,
@@ -391,3 +396,51 @@ def write_simulated_target(source_scenario, output: str | Path, rig, simulate, *
     metadata = {"stages": np.asarray(bounds), "damage_kind": kinds[model], f"{name}_rig": json.dumps(asdict(rig)),
                 "seed": int(seed), "source_scenario": source_scenario.name, "note": note}
     return write_measurements(MeasurementSet(tuple(records), None, (), metadata), target)
+
+
+def main(argv=None, *, make=None, prog: str = "python -m rigs.lumped") -> int:
+    """``target SCENARIO --out FILE.h5 ...``: write the records of the scenario's stages simulated by
+    ``make`` (default :func:`make_lumped_target`); return the exit code (0 ok, 2 bad input)."""
+    import argparse
+    import sys
+
+    from twin.errors import TwinError
+    from twin.scenario import load_scenario
+
+    make = make or make_lumped_target
+    ap = argparse.ArgumentParser(prog=prog, description="Records of an independent simulator of the gearbox.")
+    sub = ap.add_subparsers(dest="command", required=True)
+    p = sub.add_parser("target", help="labelled records of the stages of a scenario's archive block")
+    p.add_argument("scenario", metavar="SCENARIO", help="scenario YAML with degradation (pitting or wear) and "
+                                                        "archive blocks: its stages and nominal operating point")
+    p.add_argument("--out", required=True, help="measurement HDF5 to write (atomically)")
+    p.add_argument("--records-per-stage", type=int, default=15)
+    p.add_argument("--record-duration", type=float, default=0.4, help="[s]")
+    p.add_argument("--seed", type=int, help="seed of the gearbox and of every draw (default: the simulator's)")
+    p.add_argument("--damage-sampling", choices=("uniform", "snapshot"),
+                   help="overrides the archive block's: records spread over each stage or at its centre")
+    p.add_argument("--damage-scatter", type=float, help="overrides the archive block's (snapshot sampling)")
+    p.add_argument("--no-progress", action="store_true")
+    args = ap.parse_args(argv)
+    try:
+        sc = load_scenario(args.scenario)
+        overrides = {k: v for k, v in (("damage_sampling", args.damage_sampling),
+                                       ("damage_scatter", args.damage_scatter)) if v is not None}
+        if overrides:
+            if sc.archive is None:
+                raise ScenarioError([(str(sc.source), "archive", "the scenario has no archive block")])
+            sc = sc.with_overrides(archive={**sc.archive, **overrides})
+        seed = {} if args.seed is None else {"seed": args.seed}
+        out = make(sc, args.out, records_per_stage=args.records_per_stage, record_duration=args.record_duration,
+                   progress=not args.no_progress, **seed)
+    except TwinError as exc:
+        print(f"{prog}: error: {exc}", file=sys.stderr)
+        return 2
+    print(out)
+    return 0
+
+
+if __name__ == "__main__":
+    import sys
+
+    sys.exit(main())
