@@ -1,6 +1,6 @@
 """A second, independent simulator of the test gearbox: "measured" data the twin did not make.
 
-The issue asks that the assessor be judged on target data that did not come from our simulator.
+The assessor must be judged on target data that did not come from the twin.
 The emulated rigs of :mod:`twin.transfer.domain` vary the twin's own 21-DOF FMU, so they share its
 mesh-stiffness table, its wear and pitting mappings and its shaft-bearing-pedestal dynamics.  This
 module shares none of that code or those parameters: it is a different *model family* of the same

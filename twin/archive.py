@@ -251,7 +251,7 @@ def tooth_compliance_factors(k_healthy: np.ndarray, k_damaged: np.ndarray, damag
     tooth, so the number chosen keeps the tooth's *mean compliance* along the path, 1/k averaged
     over u: that is the tooth's mean quasi-static deflection under a given mesh force, whose
     differences from tooth to tooth are what puts energy at the shaft-order sidebands.  (Keeping
-    the mean stiffness instead, the rule until stop 21, underestimates how far a badly pitted
+    the mean stiffness instead, the rule before 2026-11-24, underestimates how far a badly pitted
     tooth gives way: where its local loss nears the cap, its compliance grows as 1 / (1 - loss).)
     For uniform damage (``c_i = 1``), or a loss that is the same all along the path, both rules
     agree: (1 - min(c_i L, 0.95)) / (1 - L).

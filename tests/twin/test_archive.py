@@ -133,7 +133,7 @@ def test_tooth_compliance_factors_keep_the_mean_deflection_by_hand():
     f = tooth_compliance_factors(np.ones(3), np.array([1.0, 0.5, 1.0]), np.array([0.0, 1.0, 2.0]),
                                  samples_per_segment=20000)
     np.testing.assert_allclose(f, [2 * np.log(2), 1.0, 2 * np.log(2) / (1.0 - np.log(0.05))], rtol=1e-3)
-    # the mean-stiffness rule (until stop 21) gave the doubly pitted tooth (1 - 2 L) / (1 - L) = 0.8
+    # the earlier mean-stiffness rule gave the doubly pitted tooth (1 - 2 L) / (1 - L) = 0.8
     assert f[2] < 0.4
     assert np.all(tooth_compliance_factors(np.ones(3), np.ones(3), np.array([0.5, 3.0])) == 1.0)
     # a node the uniform damage stripped bare: finite factors, the mean tooth unchanged

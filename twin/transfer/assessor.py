@@ -62,9 +62,9 @@ _READABLE_VERSIONS = (1, 2, 3, 4)
 CLASS_PRIORS = ("source", "ordinal", None)
 # How far the class-prior match may lower the adaptation windows' mean confidence before fit warns
 # (twin.transfer.prior.confidence_drop).  The middle of the gap in the runs that chose it
-# (BENCHMARKS.md, stop 20): on the balanced benchmark and blind rigs the match cost at most 0.019, on
+# (2026-11-23, docs/transfer.md): on the balanced benchmark and blind rigs the match cost at most 0.019, on
 # run-to-failure-like subsets of the benchmark rig, where it costs 7-16 points of accuracy, at least
-# 0.066.  Unseen imbalanced sets afterwards: at least 0.053.  The share of windows moved (stop 14's
+# 0.066.  Unseen imbalanced sets afterwards: at least 0.053.  The share of windows moved (the earlier
 # statistic, 8 %) overlapped: up to 14 % on balanced data, from 7.8 % on imbalanced.
 CLASS_PRIOR_WARN_DROP = 0.04
 _EVAL_BATCH = 256
@@ -175,8 +175,8 @@ class Assessor:
         How the contrastive terms of a batch add up: their mean, or Eq. 18's sum over the batch's
         gated target windows, which gives ``beta`` the paper's weight, ``batch_size`` times the
         mean's (:func:`~twin.transfer.losses.class_contrastive_loss`).  The sum locks in wrong
-        pseudo-labels on a rig whose records do not fall into the twin's stages (BENCHMARKS.md,
-        stop 22), so the mean is the default.
+        pseudo-labels on a rig whose records do not fall into the twin's stages (docs/experiments.md),
+        so the mean is the default.
     preprocessing : Preprocessing, optional
         Channel, resampling rate, window, hop, normalisation (default :class:`Preprocessing()`).
     augmentation : Augmentation or None, optional
@@ -864,7 +864,7 @@ class Assessor:
             raise AssessorError(f"'{cfg_file}': target_log_weights must be {a.n_classes_} finite numbers, "
                                 f"got {weights!r}")
         a.target_log_weights_ = w
-        # written since stop 28, for rematch; without it, rematch can only drop the match
+        # written since 2026-11-25, for rematch; without it, rematch can only drop the match
         prior, a.source_prior_ = cfg.get("source_prior"), None
         if prior is not None:
             arr = _finite_numbers(prior, a.n_classes_)
@@ -872,7 +872,7 @@ class Assessor:
                 raise AssessorError(f"'{cfg_file}': source_prior must be {a.n_classes_} numbers > 0 that sum to 1, "
                                     f"got {prior!r}")
             a.source_prior_ = arr
-        # written since stop 25; an adapting ordinal assessor cannot assess without them
+        # written since 2026-11-24; an adapting ordinal assessor cannot assess without them
         anchors, a.ordinal_anchors_ = cfg.get("ordinal_anchors"), None
         if a.class_prior == "ordinal" and a.method != "cnn":
             arr = _finite_numbers(anchors, 2 * a.n_classes_ - 1)
@@ -884,7 +884,7 @@ class Assessor:
             raise AssessorError(f"'{cfg_file}': ordinal_anchors are only read with class_prior 'ordinal' and a "
                                 f"method that adapts; this file has class_prior {a.class_prior!r} and method "
                                 f"{a.method!r}")
-        # diagnostics of the match, written since stop 14; an older version-4 file has none
+        # diagnostics of the match, written since 2026-11-23; an older version-4 file has none
         if cfg.get("class_prior_moved") is not None:
             try:
                 a.class_prior_moved_ = float(cfg["class_prior_moved"])
@@ -895,7 +895,7 @@ class Assessor:
                 raise AssessorError(f"'{cfg_file}': adaptation_stage_counts must be 2 x {a.n_classes_} and "
                                     f"class_prior_moved in [0, 1], got {cfg['adaptation_stage_counts']!r} and "
                                     f"{cfg['class_prior_moved']!r}")
-        # written since stop 20
+        # written since the confidence-drop warning (2026-11-23)
         if cfg.get("class_prior_confidence_drop") is not None:
             drop = cfg["class_prior_confidence_drop"]
             if isinstance(drop, bool) or not isinstance(drop, (int, float)) or not -1 < drop < 1:

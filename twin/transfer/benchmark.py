@@ -15,7 +15,7 @@ Data (built once per task and cached in ``data_dir``, keyed by the settings belo
   fixed casing resonances, which no augmentation of recorded signals reproduces; so the archive
   is simulated over a range that covers the rig's (the emulated rig scatters by 2 % and 10 %).
   With the scenario's 1 % the rig's fastest records were the ones misassessed.
-  Each record also has a pinion of its own (:func:`twin.archive.tooth_errors`, stop 16): run-out
+  Each record also has a pinion of its own (:func:`twin.archive.tooth_errors`): run-out
   up to 10 um peak to peak, per-tooth damage factors with a relative sd up to 0.5 (pitting) / 0.1
   (wear, which the hunting tooth ratio 19:52 evens out), and, in the wear archive only, pitch
   errors with an sd up to 2 um (ISO 1328 class 5 for m = 3 mm, d = 57 mm allows a single pitch
@@ -24,7 +24,7 @@ Data (built once per task and cached in ``data_dir``, keyed by the settings belo
   otherwise identical, and with identical teeth its shaft-order sidebands sat 21-23 dB below the
   mesh harmonics, against -7 to -17 dB on the emulated rig (bench/transfer_diagnostics.py).
   A tooth's pitting factor keeps its mean compliance along the path
-  (:func:`twin.archive.tooth_compliance_factors`, stop 21).
+  (:func:`twin.archive.tooth_compliance_factors`).
   Many short records rather than a few long ones: what the network must learn to ignore is the
   spread *between* records (operating point, sensor gain, the damage within its stage), and a
   record's later windows add little of it.  At the same number of windows, hence the same
@@ -122,9 +122,9 @@ def _check_rig(rig: str) -> None:
 
 # Record lengths in the same number of pinion revolutions for both tests: the dry test runs at
 # half the speed of the lubricated one, so its records last twice as long.
-# The pitting archive has no pitch errors (stop 16, benchmark rig, 5 seeds): at 20 N.m the static
-# mesh deflection is about 0.7 um, so pitch errors of 2 um rewrite the spectral shape that the
-# stages' few per cent of stiffness loss show in; with them pitting fell to 79.6 +- 9.2 %, without
+# The pitting archive has no pitch errors (2026-11-23, benchmark rig, 5 seeds; docs/experiments.md):
+# at 20 N.m the static mesh deflection is about 0.7 um, so pitch errors of 2 um rewrite the spectral
+# shape that the stages' few per cent of stiffness loss show in; with them pitting fell to 79.6 +- 9.2 %, without
 # them (run-out and per-tooth damage kept) it is 98.5 +- 1.4 %.  Wear depths are 60 um per stage.
 TASK_SETTINGS = {"pitting": DataSettings(source_pitch_error=0.0),
                  "wear": DataSettings(source_record_duration=0.3, target_record_duration=0.8,
@@ -142,13 +142,13 @@ TASK_REMOVE_LEVEL = {"pitting": True, "wear": False}
 # The class-prior rule of the adapting methods (Assessor.class_prior), by task.  Pitting uses the
 # ordinal match: its stages are ordered, and a gearbox that is not the twin may turn the same
 # pitting into a larger or smaller change of the spectrum.  Adopted under a rule written down before
-# it was scored (BENCHMARKS.md, stop 25).  Wear keeps the per-stage offsets (not tested there).
+# it was scored (2026-11-24; docs/transfer.md).  Wear keeps the per-stage offsets (not tested there).
 TASK_CLASS_PRIOR = {"pitting": "ordinal", "wear": "source"}
 
 
 # Changes of how the archive is simulated that the settings above do not show.  Data cached under
 # another value are rebuilt.  2: per-tooth pitting factors keep each tooth's mean compliance
-# (twin.archive.tooth_compliance_factors, stop 21) instead of its mean stiffness.
+# (twin.archive.tooth_compliance_factors, 2026-11-24) instead of its mean stiffness.
 ARCHIVE_RULES = 2
 
 
@@ -455,9 +455,9 @@ def markdown_table(summary: dict) -> str:
         for m, r in s["methods"].items():
             # summaries written before the stage-order columns lack them
             within, rho = r.get("within_one_mean", float("nan")), r.get("spearman_mean", float("nan"))
-            warned = r.get("class_prior_warnings")      # absent before stop 20, None without a match
+            warned = r.get("class_prior_warnings")      # absent in older results, None without a match
             warned = "n/a" if warned is None else f"{warned}/{len(r['seeds'])}"
-            agree = r.get("seed_agreement")     # absent before stop 26, None with one seed
+            agree = r.get("seed_agreement")     # absent in older results, None with one seed
             agree = "n/a" if agree is None else f"{100 * agree:.1f} ({100 * (1 + agree) / 2:.1f})"
             lines.append(f"| {task} | {m} | {100 * r['mean']:.1f} +- {100 * r['std']:.1f} | "
                          f"{100 * r['record_mean']:.1f} +- {100 * r['record_std']:.1f} | "

@@ -175,7 +175,7 @@ def add_subcommands(sub) -> None:
                         "the paper's i-th with i-th")
     p.add_argument("--contrastive-reduction", choices=("mean", "sum"), default="mean",
                    help="mean over the pairs (default) or the paper's sum over the batch (Eq. 18), 20 times the "
-                        "weight at batch 20; measured in BENCHMARKS.md (stop 22) and not the default")
+                        "weight at batch 20; measured in docs/experiments.md and not the default")
     p.add_argument("--seed", type=int, default=0, help="seed of initialisation, batches, augmentation")
     p.add_argument("--epochs", type=int, default=80, help="passes over the source windows (default: 80)")
     p.add_argument("--shaft-speed", type=float, metavar="HZ",
@@ -194,7 +194,7 @@ def add_subcommands(sub) -> None:
     match.add_argument("--class-prior", choices=("source", "ordinal"), default="source",
                    help="how the rig's stage proportions are matched to the archive's: per-stage logit offsets "
                         "(source, default) or boundaries along the expected stage, which keep only the order of "
-                        "the windows (ordinal; the benchmark's pitting rule, BENCHMARKS.md stop 25)")
+                        "the windows (ordinal; the benchmark's pitting rule, docs/transfer.md)")
     match.add_argument("--no-class-prior", action="store_true",
                    help="do not match the rig's stage proportions to the archive's after training (use it when the "
                         "rig data are mostly one stage, e.g. a run-to-failure history; default: match them)")

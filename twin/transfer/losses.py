@@ -17,7 +17,7 @@
   the mean of its terms with the source windows), so with batch 20 the paper's ``beta = 0.1``
   weighs the loss 20 times more than the mean over pairs (``reduction="mean"``) does.  The
   assessor keeps the mean by default: with the sum, wrong pseudo-labels lock in on a rig whose
-  records do not fall into the twin's stages (``BENCHMARKS.md``, stop 22).
+  records do not fall into the twin's stages (``docs/experiments.md``).
 * :func:`pseudo_label_gate` -- the target pseudo-labels ``y~_t`` that may enter Eq. 19: the
   classifier's arg-max, kept only where its probability is at least ``threshold`` and only from
   epoch ``warmup_epochs`` on, so that the early, mostly wrong labels cannot lock in.

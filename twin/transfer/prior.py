@@ -22,8 +22,9 @@ leaves windows near it that the classifier is unsure of, and the match moves tho
 confidence barely changes.  Rig data whose stage mix differs from the prior (or that do not fall
 into the twin's stages at all) hold stages the classifier reads confidently in the "wrong"
 proportions, and the match can only meet the prior by pushing confident windows over a boundary:
-the mean confidence falls.  On the benchmark's rigs (BENCHMARKS.md, stop 20; 54 runs) the first
-case cost at most 1.9 points of mean confidence and the second at least 5.3.
+the mean confidence falls.  On the benchmark's rigs (the runs that chose the warning threshold,
+2026-11-23; 54 runs) the first case cost at most 1.9 points of mean confidence and the second at
+least 5.3.
 
 **The ordinal match** (:func:`ordinal_anchors`, :func:`ordinal_probabilities`; ``class_prior="ordinal"``)
 uses the same assumption and one more fact: the stages are ordered.  Each window is reduced to its
@@ -32,13 +33,13 @@ boundaries are the quantiles of ``s`` over the adaptation windows at the twin's 
 proportions.  Only the order of the windows along ``s`` matters, not where the twin's boundaries
 lie, so a rig whose damage moves the vibration features the same way as the twin's but by a
 different amount is read right.  The per-stage offsets above can move each boundary on its own
-but keep the twin's scale.  Measured (BENCHMARKS.md, stop 25; pitting, proposed method, seeds 0-4):
+but keep the twin's scale.  Measured (2026-11-24; pitting, proposed method, seeds 0-4; docs/transfer.md):
 the lumped rig, whose stages keep their order (rank correlation 0.8-0.9), goes from 23 % to 59 %; the
 LTCA rig, which reads its last stage below its fifth, falls from 26 % to 20 %; the benchmark rigs
 stay within their scatter.  The quantiles put exactly the prior's share into each stage, so they
 need the adaptation windows balanced more strictly than the offsets do: with the stages off by the
 sampling scatter of 180 windows (about +-17 % each) the emulated rigs read 87 % instead of 97 %,
-where the offsets lose 2-4 points (BENCHMARKS.md, stop 26).
+where the offsets lose 2-4 points (docs/experiments.md).
 """
 from __future__ import annotations
 

@@ -2,7 +2,7 @@
 
 A rig's stages are unknown; that is why the assessor exists.  So on a rig whose physics the twin
 does not share, nothing in one assessor's output says whether its stages are right: on the LTCA
-simulator (BENCHMARKS.md, stop 23) the assessors read pitting at chance with a mean confidence of
+simulator (BENCHMARKS.md) the assessors read pitting at chance with a mean confidence of
 0.77, and the class-prior warning fired on one run in five.
 
 What can be measured without labels is whether assessors that differ only in their seed (their
@@ -15,11 +15,11 @@ window accuracies ``a1`` and ``a2`` on the same windows and agreement ``g``,
 Averaged over every pair of ``m`` assessors (each one is in ``m - 1`` pairs), the members' mean
 window accuracy is at most ``(1 + mean pairwise agreement) / 2``.  The bound is tight when every
 disagreement has exactly one member right; it says nothing when the members agree and are all wrong
-in the same way, which a rig can also do (stop 26: on the LTCA rig five seeds agreed on 71 % of the
+in the same way, which a rig can also do (on the LTCA rig five seeds agreed on 71 % of the
 pitting windows and were right on 20 %).  Low agreement is therefore a proof of unreliability, high
 agreement is not a proof of the opposite.
 
-Measured on the benchmark's rigs (BENCHMARKS.md, stop 26; the proposed method with each task's
+Measured on the benchmark's rigs (2026-11-24, docs/transfer.md; the proposed method with each task's
 class-prior rule, 5 seeds for pitting and 3 for wear, target test windows): on the emulated rigs,
 where the members read 93-98 % of the windows right, they agreed on 94-97 % of them; on the two
 simulators that are not the twin, where they read 20-79 %, on 65-84 %.

@@ -270,7 +270,7 @@ def test_contrastive_reduction_is_saved_and_older_assessors_load_with_the_mean(f
     d = paper.save(tmp_path / "red")
     assert Assessor.load(d).contrastive_reduction == "sum"
     cfg = json.loads((d / "config.json").read_text())
-    del cfg["params"]["contrastive_reduction"]              # as saved before stop 22
+    del cfg["params"]["contrastive_reduction"]              # as saved before the option existed
     (d / "config.json").write_text(json.dumps(cfg))
     assert Assessor.load(d).contrastive_reduction == "mean"
 
@@ -383,8 +383,8 @@ def _checked(p: np.ndarray) -> Assessor:
 
 def test_a_shifted_boundary_moves_unsure_windows_without_a_warning():
     """Balanced rig data (50 windows per stage) whose boundary the rig has shifted: 30 stage-1
-    windows read as stage 0, unsure.  The match moves them back (30 %, far more than stop 14's 8 %
-    rule allowed) but costs little confidence, so fit stays quiet."""
+    windows read as stage 0, unsure.  The match moves them back (30 %, far more than the old 8 %
+    share-moved rule allowed) but costs little confidence, so fit stays quiet."""
     import warnings
 
     from twin.transfer import ClassPriorWarning
@@ -401,7 +401,7 @@ def test_a_shifted_boundary_moves_unsure_windows_without_a_warning():
 def test_an_imbalanced_rig_set_costs_confidence_and_warns():
     """Run-to-failure-like rig data, 70 windows of stage 0 and 30 of stage 1, all read with
     confidence.  A balanced prior is met by making every stage-0 window less sure; no window changes
-    stage, so stop 14's rule (share moved) saw nothing."""
+    stage, so the old share-moved rule saw nothing."""
     from twin.transfer import ClassPriorWarning
     from twin.transfer.assessor import CLASS_PRIOR_WARN_DROP
     p0 = np.concatenate([np.linspace(0.9, 0.99, 70), np.linspace(0.01, 0.1, 30)])
@@ -418,7 +418,7 @@ def test_class_prior_diagnostics_survive_save_and_load(fitted, tmp_path):
     assert back.class_prior_confidence_drop_ == fitted.class_prior_confidence_drop_
     np.testing.assert_array_equal(back.adaptation_stage_counts_, fitted.adaptation_stage_counts_)
     cfg = json.loads((d / "config.json").read_text())
-    del cfg["class_prior_confidence_drop"]                             # written before stop 20
+    del cfg["class_prior_confidence_drop"]                             # written before the confidence drop was saved
     (d / "config.json").write_text(json.dumps(cfg))
     back = Assessor.load(d)
     assert back.class_prior_moved_ == fitted.class_prior_moved_ and not hasattr(back, "class_prior_confidence_drop_")
@@ -426,7 +426,7 @@ def test_class_prior_diagnostics_survive_save_and_load(fitted, tmp_path):
     (d / "config.json").write_text(json.dumps(cfg))
     with pytest.raises(AssessorError, match=r"class_prior_confidence_drop must be a number in \(-1, 1\), got 'high'"):
         Assessor.load(d)
-    del cfg["class_prior_confidence_drop"], cfg["class_prior_moved"], cfg["adaptation_stage_counts"]  # before stop 14
+    del cfg["class_prior_confidence_drop"], cfg["class_prior_moved"], cfg["adaptation_stage_counts"]  # older file
     (d / "config.json").write_text(json.dumps(cfg))
     assert not hasattr(Assessor.load(d), "class_prior_moved_")
     cfg["class_prior_moved"], cfg["adaptation_stage_counts"] = 1.5, [[1, 2, 3]]
@@ -510,7 +510,7 @@ def test_rematch_after_save_and_load_and_its_typed_errors(tiny_pre, tiny_data, f
         (d / "config.json").write_text(json.dumps(cfg))
         with pytest.raises(AssessorError, match=r"source_prior must be 3 numbers > 0 that sum to 1, got \["):
             Assessor.load(d)
-    del cfg["source_prior"]                                  # saved before stop 28
+    del cfg["source_prior"]                                  # saved before rematch existed
     (d / "config.json").write_text(json.dumps(cfg))
     old = Assessor.load(d)
     assert old.source_prior_ is None

@@ -160,7 +160,7 @@ def test_summary_reads_the_seeds_agreement_on_the_rig_windows():
     s = summarise(runs)["wear"]["methods"]["mmd"]
     assert s["seed_agreement"] == pytest.approx(2 / 3)
     assert markdown_table(summarise(runs)).splitlines()[2].endswith("| 66.7 (83.3) |")
-    # one seed, or runs without stages (results written before stop 26): no figure
+    # one seed, or runs without stages (older results): no figure
     assert summarise(runs[:1])["wear"]["methods"]["mmd"]["seed_agreement"] is None
     assert summarise([_run("mmd", s, 0.5) for s in range(2)])["wear"]["methods"]["mmd"]["seed_agreement"] is None
     assert markdown_table(summarise(runs[:1])).splitlines()[2].endswith("| n/a |")
@@ -315,7 +315,7 @@ def test_target_ceiling_trains_on_the_rigs_first_halves_and_scores_the_second(tm
 # two epochs leave the tiny rig's windows in one stage, so the match warns; the warning is not tested here
 @pytest.mark.filterwarnings("ignore::twin.transfer.errors.ClassPriorWarning")
 def test_train_one_uses_each_tasks_class_prior_rule(monkeypatch, tiny_pre, tiny_data):
-    """Pitting is staged by the ordinal match (stop 25), wear by the per-stage offsets."""
+    """Pitting is staged by the ordinal match, wear by the per-stage offsets."""
     from twin.transfer import benchmark
     from twin.transfer.assessor import Assessor
 
