@@ -1,6 +1,6 @@
 """Why the wear stages are hard to transfer: level and spectral-shape statistics of the benchmark data.
 
-    python bench/transfer_diagnostics.py --data-dir DIR [--rig rig|blind] [--task wear]
+    python bench/transfer_diagnostics.py --data-dir DIR [--rig rig|blind|lumped|ltca] [--task wear]
 
 Reads the source archive and the target records that ``bench/transfer.py`` built in DIR
 (``twin.transfer.benchmark.prepare_task``; nothing is simulated or trained here) and prints, per
@@ -106,14 +106,19 @@ def main() -> None:
     from twin.measurements import load_measurements
     from twin.transfer.benchmark import RIGS, prepare_task, rig_settings, task_preprocessing
     from twin.transfer.preprocess import split_records
+    from transfer import INDEPENDENT_RIGS, independent_targets      # bench/transfer.py, beside this script
 
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--data-dir", required=True, help="the data directory of bench/transfer.py (its --data-dir)")
     ap.add_argument("--task", choices=("pitting", "wear"), default="wear")
-    ap.add_argument("--rig", choices=tuple(RIGS), default="rig")
+    ap.add_argument("--rig", choices=tuple(RIGS) + tuple(INDEPENDENT_RIGS), default="rig")
     args = ap.parse_args()
 
-    src_path, tgt_path = prepare_task(args.task, args.data_dir, rig_settings(args.task, args.rig))
+    if args.rig in INDEPENDENT_RIGS:        # the independent simulators' records are written by rigs/
+        settings, targets = independent_targets(args.rig, (args.task,), Path(args.data_dir))
+        src_path, tgt_path = prepare_task(args.task, args.data_dir, settings[args.task], target=targets[args.task])
+    else:
+        src_path, tgt_path = prepare_task(args.task, args.data_dir, rig_settings(args.task, args.rig))
     pre = replace(task_preprocessing(args.task), remove_level=False)
     ch = pre.channel
     src = load_measurements(src_path, channels=[ch], resample_to=pre.sample_rate).records
