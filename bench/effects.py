@@ -5,7 +5,7 @@ catalogue, and for each seed: simulate a truth record with the effect hidden
 (:func:`twin.effects.synthetic.make_case`: base parameters off, speed off, gain error, noise),
 calibrate the twin's base parameters to the truth's modes, then diagnose with the base model.
 
-    python bench/effects.py --seeds 3 --out bench/effects_RESULTS.md
+    python bench/effects.py --seeds 3 --out bench_out/effects_RESULTS.md
 """
 from __future__ import annotations
 
@@ -26,7 +26,7 @@ def main() -> None:
     ap.add_argument("--seeds", type=int, default=3)
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--effects", nargs="*", default=None)
-    ap.add_argument("--out", type=Path, default=REPO / "bench" / "effects_RESULTS.md")
+    ap.add_argument("--out", type=Path, default=REPO / "bench_out" / "effects_RESULTS.md")
     args = ap.parse_args()
 
     from fmu_build import build_fmu
@@ -54,6 +54,7 @@ def main() -> None:
                              "score_top": top.score, "unexplained": list(d.unexplained), "wall_s": wall,
                              "load_nm": case.load, "record_s": case.duration})
                 print(json.dumps(rows[-1]), flush=True)
+    args.out.parent.mkdir(parents=True, exist_ok=True)
     (args.out.with_suffix(".json")).write_text(json.dumps(rows, indent=1))
     lines = [f"Machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
              f"{args.workers} workers; {args.seeds} seeds per case; records at 20 kHz.", "",

@@ -1,6 +1,6 @@
 """Benchmark: RUL error against life fraction on simulated run-to-failure histories (twin rul).
 
-    python bench/rul.py [--seeds 10] [--out bench/rul_RESULTS.md]
+    python bench/rul.py [--seeds 10] [--out bench_out/rul_RESULTS.md]
 
 For the lubricated (pitting) and the dry (wear) scenario:
 
@@ -100,7 +100,7 @@ def summarise(rows, kind: str) -> list[str]:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--seeds", type=int, default=10, help="histories per true rate factor")
-    ap.add_argument("--out", default=str(REPO / "bench" / "rul_RESULTS.md"))
+    ap.add_argument("--out", default=str(REPO / "bench_out" / "rul_RESULTS.md"))
     args = ap.parse_args()
     from twin.rul import trajectory_from_scenario
     from twin.scenario import load_scenario
@@ -149,6 +149,7 @@ def main() -> None:
               "- The quasi-static block measures a model-form error: the truth follows the co-simulated "
               "shape, the estimator a slightly different one, and the band does not account for that.", ""]
     text = "\n".join(lines)
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     Path(args.out).write_text(text)
     print(text)
 

@@ -62,7 +62,7 @@ _READABLE_VERSIONS = (1, 2, 3, 4)
 CLASS_PRIORS = ("source", "ordinal", None)
 # How far the class-prior match may lower the adaptation windows' mean confidence before fit warns
 # (twin.transfer.prior.confidence_drop).  The middle of the gap in the runs that chose it
-# (2026-11-23, docs/transfer.md): on the balanced benchmark and blind rigs the match cost at most 0.019, on
+# (2026-11-23, docs/experiments.md): on the balanced benchmark and blind rigs the match cost at most 0.019, on
 # run-to-failure-like subsets of the benchmark rig, where it costs 7-16 points of accuracy, at least
 # 0.066.  Unseen imbalanced sets afterwards: at least 0.053.  The share of windows moved (the earlier
 # statistic, 8 %) overlapped: up to 14 % on balanced data, from 7.8 % on imbalanced.

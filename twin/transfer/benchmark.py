@@ -30,7 +30,7 @@ Data (built once per task and cached in ``data_dir``, keyed by the settings belo
   record's later windows add little of it.  At the same number of windows, hence the same
   training time, 32 records of three revolutions sample that spread twice as densely as the 16
   records of five revolutions used before, and the assessment depended less on which archive was
-  drawn (``bench/transfer_RESULTS.md``).
+  drawn (trials of 2026-11-22).
   At the task's preprocessing (:func:`task_preprocessing`: windows of two pinion revolutions,
   hop 1024) each record gives two windows: 384 (pitting) / 256 (wear) source windows, about
   the paper's 400 source samples, which keeps a training run under 2 minutes.

@@ -32,7 +32,7 @@ A first, harsher default (10 um run-out, 3 kHz / Q 8 mount, 0.3 rad, 0.8 stiffne
 buried the pitting stages: a linear classifier of normalised log spectra trained and tested
 *within* that target reached 31 % (chance 17 %, 63 % within the source), and in a 20-epoch trial
 the source-only CNN stayed at chance (17 %) and the proposed method reached 52 %.  The defaults
-were moderated once to the values above (within-target 53 %); see ``bench/transfer_RESULTS.md``.
+were moderated once to the values above (within-target 53 %), on 2026-11-22.
 No method hyperparameter was changed for it.
 
 The records keep their stage ``label`` and ``damage`` **for evaluation only**: the assessor's

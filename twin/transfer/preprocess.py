@@ -14,7 +14,7 @@ model, so ``assess`` windows new data exactly as training did):
    train-assessor --shaft-speed``): 20.48 kHz for the lubricated test at 20 Hz, 10.24 kHz for the
    dry test at 10 Hz.  Every tooth is then in every window twice, and the spectrum holds the
    same ~26 mesh harmonics at either speed.  At 20 kHz the dry test's window would hold one
-   revolution, and its wear stages were told apart 4 points worse (``bench/transfer_RESULTS.md``).
+   revolution, and its wear stages were told apart 4 points worse (trials of 2026-11-22).
 3. **windowing** -- windows of ``window`` samples (2048, the paper's segment length) every ``hop``
    samples from the start of the record; the tail shorter than a window is dropped.
 4. **normalisation** (``normalise``), two documented choices:
