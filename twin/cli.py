@@ -273,6 +273,8 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
                                                           resume=args.resume, modes_from=args.modes_from)
     print(f"modes: {report.modes_source}")
     print(report.table())
+    for n in report.notes:
+        print(n)
     for w in report.warnings:
         print(f"warning: {w}")
     print(f"calibrated scenario -> {report.scenario_file} (parameters in calibrated.json and calibrated.ssv; "

@@ -205,6 +205,13 @@ model Gearbox21 "21-DOF lumped model of the UNSW spur-gear test rig (Feng et al.
   Real effect_gear_torque(unit = "N.m") = 0 "Extra torque on the gear, driven direction positive (tooth friction)";
   Real effect_off_line_force(unit = "N") = 0 "Force on the pinion across the line of action, along (cos alpha, -sin alpha); the gear takes the reaction (tooth friction)";
   Real effect_sensor_acceleration_pinion(unit = "m/s2") = 0 "Extra acceleration seen by the pinion-side sensor (casing panel or sensor-mount mode)";
+  // Broadband excitation and transfer paths (GearTwin.Gearbox21Measured binds them; zero here and
+  // folded away by the build).
+  Real excitation_mesh_displacement(unit = "m") = 0 "Transmission error of the flank roughness, added to the approach of the flanks";
+  Real excitation_mesh_displacement_rate(unit = "m/s") = 0 "Time derivative of excitation_mesh_displacement";
+  Real excitation_off_line_force(unit = "N") = 0 "Process force on the pinion across the line of action (like effect_off_line_force)";
+  Real sensor_path_acceleration_pinion(unit = "m/s2") = 0 "What the transfer path and sensor add to the pinion-side casing acceleration";
+  Real sensor_path_acceleration_gear(unit = "m/s2") = 0 "What the transfer path and sensor add to the gear-side casing acceleration";
 equation
   // Tooth-pair bookkeeping without events: the mesh phase is wrapped with atan2, the tooth
   // identity is read from the angle of the last entered tooth on the unit circle.
@@ -221,8 +228,8 @@ equation
   // Piecewise-linear interpolation along the profile: hat functions on n_profile nodes.
   pair_stiffness = {mesh_stiffness_scale * window[i] * pair_tooth_factor[i] * sum(k_pair[n] * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[i]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile) for i in 1:3};
   pair_deviation = {pair_tooth_offset[i] + effect_pair_deviation[i] + sum((profile_deviation[n] + effect_profile_deviation[n]) * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[i]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile) for i in 1:3};
-  mesh_deflection = rb1 * theta5 - rb2 * theta10 + (x5 - x10) * sin(alpha) + (y5 - y10) * cos(alpha) + effect_mesh_displacement;
-  mesh_deflection_rate = rb1 * omega5 - rb2 * omega10 + (vx5 - vx10) * sin(alpha) + (vy5 - vy10) * cos(alpha) + effect_mesh_displacement_rate;
+  mesh_deflection = rb1 * theta5 - rb2 * theta10 + (x5 - x10) * sin(alpha) + (y5 - y10) * cos(alpha) + effect_mesh_displacement + excitation_mesh_displacement;
+  mesh_deflection_rate = rb1 * omega5 - rb2 * omega10 + (vx5 - vx10) * sin(alpha) + (vy5 - vy10) * cos(alpha) + effect_mesh_displacement_rate + excitation_mesh_displacement_rate;
   // A pair whose flanks are apart (deviation larger than the approach) carries no load.
   pair_force = {pair_stiffness[i] * noEvent(max(0.0, mesh_deflection - pair_deviation[i])) for i in 1:3};
   // The flanks damp each other only while they touch (oil film, material damping); apart, the
@@ -268,20 +275,20 @@ equation
   der(y11) = vy11;
   m4 * der(vx4) = -kx4 * x4 - cx4 * vx4 + kx45 * (x5 - x4) + cx45 * (vx5 - vx4);
   m4 * der(vy4) = -ky4 * y4 - cy4 * vy4 + ky45 * (y5 - y4) + cy45 * (vy5 - vy4);
-  m5 * der(vx5) = -kx45 * (x5 - x4) - cx45 * (vx5 - vx4) - kx56 * (x5 - x6) - cx56 * (vx5 - vx6) - mesh_force * sin(alpha) + effect_off_line_force * cos(alpha);
-  m5 * der(vy5) = -ky45 * (y5 - y4) - cy45 * (vy5 - vy4) - ky56 * (y5 - y6) - cy56 * (vy5 - vy6) - mesh_force * cos(alpha) - effect_off_line_force * sin(alpha);
+  m5 * der(vx5) = -kx45 * (x5 - x4) - cx45 * (vx5 - vx4) - kx56 * (x5 - x6) - cx56 * (vx5 - vx6) - mesh_force * sin(alpha) + (effect_off_line_force + excitation_off_line_force) * cos(alpha);
+  m5 * der(vy5) = -ky45 * (y5 - y4) - cy45 * (vy5 - vy4) - ky56 * (y5 - y6) - cy56 * (vy5 - vy6) - mesh_force * cos(alpha) - (effect_off_line_force + excitation_off_line_force) * sin(alpha);
   m6 * der(vx6) = -kx6 * x6 - cx6 * vx6 + kx56 * (x5 - x6) + cx56 * (vx5 - vx6);
   m6 * der(vy6) = -ky6 * y6 - cy6 * vy6 + ky56 * (y5 - y6) + cy56 * (vy5 - vy6);
   m9 * der(vx9) = -kx9 * x9 - cx9 * vx9 + kx910 * (x10 - x9) + cx910 * (vx10 - vx9);
   m9 * der(vy9) = -ky9 * y9 - cy9 * vy9 + ky910 * (y10 - y9) + cy910 * (vy10 - vy9);
-  m10 * der(vx10) = -kx910 * (x10 - x9) - cx910 * (vx10 - vx9) - kx1011 * (x10 - x11) - cx1011 * (vx10 - vx11) + mesh_force * sin(alpha) - effect_off_line_force * cos(alpha);
-  m10 * der(vy10) = -ky910 * (y10 - y9) - cy910 * (vy10 - vy9) - ky1011 * (y10 - y11) - cy1011 * (vy10 - vy11) + mesh_force * cos(alpha) + effect_off_line_force * sin(alpha);
+  m10 * der(vx10) = -kx910 * (x10 - x9) - cx910 * (vx10 - vx9) - kx1011 * (x10 - x11) - cx1011 * (vx10 - vx11) + mesh_force * sin(alpha) - (effect_off_line_force + excitation_off_line_force) * cos(alpha);
+  m10 * der(vy10) = -ky910 * (y10 - y9) - cy910 * (vy10 - vy9) - ky1011 * (y10 - y11) - cy1011 * (vy10 - vy11) + mesh_force * cos(alpha) + (effect_off_line_force + excitation_off_line_force) * sin(alpha);
   m11 * der(vx11) = -kx11 * x11 - cx11 * vx11 + kx1011 * (x10 - x11) + cx1011 * (vx10 - vx11);
   m11 * der(vy11) = -ky11 * y11 - cy11 * vy11 + ky1011 * (y10 - y11) + cy1011 * (vy10 - vy11);
 
   // ---- Sensors ------------------------------------------------------------------------------
   casing_acceleration_pinion = cos(sensor_angle_pinion) * der(vy6) + sin(sensor_angle_pinion) * der(vx6);
-  accel_pinion_casing = casing_acceleration_pinion + effect_sensor_acceleration_pinion;
-  accel_gear_casing = cos(sensor_angle_gear) * der(vy9) + sin(sensor_angle_gear) * der(vx9);
+  accel_pinion_casing = casing_acceleration_pinion + effect_sensor_acceleration_pinion + sensor_path_acceleration_pinion;
+  accel_gear_casing = cos(sensor_angle_gear) * der(vy9) + sin(sensor_angle_gear) * der(vx9) + sensor_path_acceleration_gear;
   annotation(experiment(StartTime = 0, StopTime = 1, Interval = 1e-4));
 end Gearbox21;

@@ -82,13 +82,14 @@ def write_html(report, scenario, measurements, path: Path) -> None:
         sens = ("<h2>Parameters chosen for the modes (sensitivity.json)</h2><pre>"
                 + html.escape(report.sensitivity.table()) + "</pre>")
     source = html.escape(report.modes_source)
+    notes = "".join(f"<p>{html.escape(n)}</p>" for n in report.notes)
     doc = f"""<!doctype html><html><head><meta charset="utf-8"><title>Calibration: {html.escape(scenario.name)}</title>
 <style>body{{font-family:sans-serif;max-width:60em;margin:2em auto}}table{{border-collapse:collapse}}
 td,th{{border:1px solid #ccc;padding:.25em .6em;text-align:right}}</style></head><body>
 <h1>Calibration of {html.escape(scenario.fmu)} ({html.escape(scenario.name)})</h1>
 <p>Measurements: {html.escape(str(measurements))}. Modes: {source}. Algorithm: {r.algorithm}, {r.n_evals} evaluations
 ({r.failed_evals} failed and scored infeasible), then a least-squares polish on the modes.</p>
-{warn}
+{warn}{notes}
 <h2>Natural frequencies (paper Table 2 for this run)</h2>
 <table><tr><th>measured [Hz]</th><th>model before [Hz]</th><th>diff [%]</th><th>model after [Hz]</th><th>diff [%]</th></tr>{rows}</table>
 <h2>Objectives</h2>

@@ -140,6 +140,7 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
                     modes_from: str | None = None) -> CalibrationReport:
     """Calibrate the scenario's FMU to a measurement file (see the module docstring)."""
     from twin._atomic import check_output_dir
+    from twin.calibration.levels import fit_levels, has_levels
     from twin.calibration.modal_fit import mode_errors, on_bounds
     from twin.calibration.objectives import match_modes
     from twin.calibration.output import write_calibrated_scenario
@@ -217,15 +218,25 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
                            checkpoint=out_dir / "checkpoint.json", settle=settle, duration=duration, fixed=fixed,
                            verbose=progress, resume=resume, refine=bool(spec.get("refine", True)),
                            nominal=nominal or None)
-        after, _ = evaluate_candidate(EvalTask(str(fmu), {**fixed, **result.chosen}, target, settle, duration, shaft))
+        chosen = dict(result.chosen)
+        levels = None
+        if has_levels(fmu, channel):
+            # the level of the spectrum: sensor gain, roughness and process-force levels (three runs)
+            levels = fit_levels(fmu, {**fixed, **chosen}, np.asarray(rec[channel], float), rec.sample_rate,
+                                speed_hz=target.drive_hz, load_nm=target.load, channel=channel, fmin=band[0],
+                                fmax=min(band[1], 0.45 * rec.sample_rate), settle=settle)
+            chosen.update(levels.parameters)
+            if progress:
+                print(f"levels: {levels.describe()}")
+        after, _ = evaluate_candidate(EvalTask(str(fmu), {**fixed, **chosen}, target, settle, duration, shaft))
     finally:
         if executor is None:
             ex.close()
-    chosen = result.chosen
     warnings = [f"{n} = {chosen[n]:.6g} ended on a bound of [{lo:.6g}, {hi:.6g}]: the measured modes pull it "
                 "beyond what physics allows, so the model's structure may lack something the rig has"
                 for n, lo, hi in zip(space.names, space.lower, space.upper)
                 if n in on_bounds(space.names, [chosen[k] for k in space.names], space.lower, space.upper)]
+    notes = (f"levels: {levels.describe()}",) if levels is not None else ()
     for w in warnings:
         print(f"warning: {w}")
     full = {**fixed, **chosen}
@@ -247,7 +258,7 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
         a = natural_frequencies(fmu, n=freqs.size + 4, parameters={**full, **_start(target)})
         mb, ma = b[match_modes(b, freqs)], a[match_modes(a, freqs)]
     report = CalibrationReport(result, freqs, mb, ma, before, after, out_dir, objectives, tuple(warnings),
-                               sensitivity, modes_what, scenario_file)
+                               sensitivity, modes_what, scenario_file, notes)
     psd_overlay(fmu, target, {**fixed, **nominal}, chosen, settle, duration, out_dir / "report_psd.png")
     write_html(report, scenario, measurements, out_dir / "report.html")
     return report

@@ -148,12 +148,24 @@ def _running_median(v: np.ndarray, width: int) -> np.ndarray:
     return np.median(np.lib.stride_tricks.sliding_window_view(padded, width), axis=1)
 
 
+#: An order's track is masked in the slices where it sweeps over at most this many bins: there it
+#: is a narrow peak the median could keep; a faster sweep spreads it thinly over many bins (and
+#: a dense comb of such tracks, e.g. from flank roughness, would otherwise mask everything).
+MASK_MAX_SWEEP_BINS = 8
+#: Orders masked: at most this many, the strongest, each at least MASK_MIN_DB above the floor.
+MASK_MAX_ORDERS = 24
+MASK_MIN_DB = 10.0
+
+
 def _mask_orders(shape, f: np.ndarray, speed: np.ndarray, spread: np.ndarray, orders) -> np.ndarray:
     masked = np.zeros(shape, dtype=bool)
     df = f[1] - f[0]
-    for o in orders:
-        half = 0.5 * o.order * spread + 2.0 * df
-        masked |= np.abs(f[:, None] - o.order * speed[None, :]) <= half[None, :]
+    strong = sorted((o for o in orders if o.level_db >= MASK_MIN_DB), key=lambda o: -o.level_db)[:MASK_MAX_ORDERS]
+    for o in strong:
+        sweep = o.order * spread
+        half = 0.5 * sweep + 2.0 * df
+        on = (np.abs(f[:, None] - o.order * speed[None, :]) <= half[None, :]) & (sweep <= MASK_MAX_SWEEP_BINS * df)
+        masked |= on
     return masked
 
 

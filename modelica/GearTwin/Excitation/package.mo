@@ -1,0 +1,3 @@
+within GearTwin;
+package Excitation "Broadband excitation of a running gearbox: flank roughness and process forces (deterministic, seeded)"
+end Excitation;

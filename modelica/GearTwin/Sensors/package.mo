@@ -1,0 +1,3 @@
+within GearTwin;
+package Sensors "Transfer paths from the bearing pedestals to the casing accelerometers"
+end Sensors;

@@ -1,0 +1,129 @@
+"""Broadband excitation and transfer path (GearTwin.Excitation, GearTwin.Sensors, Gearbox21Measured):
+the blocks against their formulas, the switch that folds them away, and the level fit."""
+from __future__ import annotations
+
+import re
+import shutil
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from twin.calibration.levels import band_levels, fit_levels, has_levels
+from twin.fmu import simulate_fmu
+from twin.operating import simulate_operating_point
+
+REPO = Path(__file__).resolve().parents[2]
+
+CHECK = """package ExcitationCheck
+  model Blocks
+    Real a(start = 0.2);
+    GearTwin.Excitation.RoughnessTransmissionError r(angle = a, speed = 7.3, seed = 4, rms = 1e-6, slope = 0.8);
+    GearTwin.Excitation.ProcessForce p(seed = 5, rms = 2, f_high = 8000);
+    output Real te = r.displacement;
+    output Real rate = r.displacement_rate;
+    output Real force = p.force;
+  equation
+    der(a) = 7.3;
+  end Blocks;
+  model Folded
+    extends GearTwin.Gearbox21Measured(broadband = false);
+  end Folded;
+end ExcitationCheck;
+"""
+
+
+@pytest.fixture(scope="module")
+def check_dir(tmp_path_factory):
+    root = tmp_path_factory.mktemp("modelica")
+    shutil.copytree(REPO / "modelica" / "GearTwin", root / "GearTwin")
+    (root / "ExcitationCheck.mo").write_text(CHECK)
+    return root
+
+
+@pytest.fixture(scope="session")
+def measured_fmu(fmu_dir):
+    from fmu_build import build_fmu
+    return build_fmu("GearTwin.Gearbox21Measured", REPO / "modelica", fmu_dir)
+
+
+def _roughness_reference(angle, rms, slope, seed):
+    j, k = np.arange(1, 17), np.arange(1, 9)
+    p = (16.0 * j) ** (-slope)
+    phi = 43758.5453 * np.sin(12.9898 * j + 78.233 * seed)
+    psi = 43758.5453 * np.sin(39.3468 * k + 11.135 * seed)
+    norm = np.sqrt(np.sum(p ** 2) / 2 * 9 / 2)
+    P = np.sum(p[None, :] * np.cos(16 * j[None, :] * angle[:, None] + phi[None, :]), axis=1)
+    Q = 1 / np.sqrt(2) + np.sum(np.cos(k[None, :] * angle[:, None] + psi[None, :]), axis=1)
+    return rms / norm * P * Q
+
+
+def test_blocks_follow_their_formulas(check_dir, tmp_path):
+    from fmu_build import build_fmu
+    fmu = build_fmu("ExcitationCheck.Blocks", check_dir, tmp_path)
+    res = simulate_fmu(fmu, stop_time=2.0, output_interval=1 / 20000)
+    angle = 0.2 + 7.3 * res.time
+    np.testing.assert_allclose(res["te"], _roughness_reference(angle, 1e-6, 0.8, 4.0), atol=1e-12)
+    rate = np.gradient(res["te"], res.time)
+    assert np.sqrt(np.mean((rate - res["rate"])[5:-5] ** 2)) < 0.01 * np.sqrt(np.mean(res["rate"] ** 2))
+    force = res["force"]
+    assert np.sqrt(np.mean(force ** 2)) == pytest.approx(2.0, rel=0.25)
+    fc, level = band_levels(force, 20000, 100, 7000, resolution=2.0)
+    db = 10 * np.log10(level)
+    assert db.max() - db.min() < 6.0                     # flat from 100 Hz to 7 kHz, in 1/12 octaves
+
+
+def test_roughness_rms_and_orders(check_dir, tmp_path):
+    angle = np.linspace(0, 2 * np.pi, 8192, endpoint=False)
+    te = _roughness_reference(angle, 1e-6, 0.8, 4.0)
+    assert np.sqrt(np.mean(te ** 2)) == pytest.approx(1e-6, rel=0.35)     # a random sum: RMS as designed in mean
+    spectrum = np.abs(np.fft.rfft(te)) / te.size
+    assert spectrum[1:8].max() < 1e-3 * spectrum.max()                  # orders below 8 are not there
+    assert spectrum[8:265].min() > 0 and spectrum[266:].max() < 1e-9
+
+
+def test_switch_off_folds_the_excitation_away(check_dir, tmp_path, gearbox_fmu, measured_fmu):
+    from fmu_build import build_fmu
+    folded = build_fmu("ExcitationCheck.Folded", check_dir, tmp_path)
+
+    def rhs_trig_calls(fmu):
+        """sin/cos calls in the generated right-hand side (the function every solver stage runs)."""
+        with zipfile.ZipFile(fmu) as z:
+            code = z.read("sources/model_functions.c").decode()
+        name = re.search(r"_rhs\(const casadi_real\*\* arg.*?\{\s*return (casadi_f\d+)\(", code, re.S).group(1)
+        body = code.split(f"static int {name}(", 1)[1].split("\n}\n", 1)[0]
+        return body.count("sin(") + body.count("cos(")
+
+    # switched on, the broadband blocks put tens of sines in every evaluation; switched off none
+    # is left beyond the base model's own (the phases, computed once per parameter change, stay)
+    assert rhs_trig_calls(folded) == rhs_trig_calls(gearbox_fmu)
+    assert rhs_trig_calls(measured_fmu) >= rhs_trig_calls(gearbox_fmu) + 10
+
+
+def test_broadband_lifts_the_floor_and_the_sensor_reads_with_its_gain(measured_fmu, gearbox_fmu):
+    kw = dict(settle=0.1, duration=0.5, channels=["accel_pinion_casing"], output_interval=2e-5)
+    base = simulate_operating_point(gearbox_fmu, 20.0, 20.0, **kw)[:, 0]
+    meas = simulate_operating_point(measured_fmu, 20.0, 20.0, **kw)[:, 0]
+    double = simulate_operating_point(measured_fmu, 20.0, 20.0, parameters={"sensor_pinion.gain": 2.0}, **kw)[:, 0]
+    np.testing.assert_allclose(double, 2 * meas, rtol=1e-9, atol=1e-9)
+    # mesh lines alone leave the model's floor 60-100 dB down; the broadband content fills it
+    from twin.signals import welch_psd
+    f, pb = welch_psd(base, 5e4, resolution=4.0)
+    _, pm = welch_psd(meas, 5e4, resolution=4.0)
+    band = (f > 100) & (f < 5000)
+    assert np.median(10 * np.log10(pm[band] / pb[band])) > 30
+    assert has_levels(measured_fmu, "accel_pinion_casing") and not has_levels(gearbox_fmu, "accel_pinion_casing")
+
+
+def test_level_fit_recovers_gain_and_roughness(measured_fmu):
+    truth = {"sensor_pinion.gain": 0.6, "pinion_roughness.rms": 1.5e-7, "gear_roughness.rms": 1.5e-7,
+             "process.rms": 1.0}
+    x = simulate_operating_point(measured_fmu, 20.0, 20.0, parameters=truth, settle=0.1, duration=1.0,
+                                 channels=["accel_pinion_casing"], output_interval=4e-5)[:, 0]
+    x = x + 0.01 * np.std(x) * np.random.default_rng(0).standard_normal(x.size)
+    fit = fit_levels(measured_fmu, {}, x, 25000.0, speed_hz=20.0, load_nm=20.0, channel="accel_pinion_casing",
+                     fmin=20.0, fmax=5000.0)
+    assert fit.gain == pytest.approx(0.6, rel=0.1)
+    assert fit.parameters["pinion_roughness.rms"] == pytest.approx(1.5e-7, rel=0.4)
+    assert fit.distance_db < 1.5
