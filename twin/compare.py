@@ -280,58 +280,64 @@ def read_record(measurements, channel: str = "accel_pinion_casing", record: str 
 
 
 def compare(scenario, measurements, out_dir, *, record: str | None = None, duration: float | None = None,
-            settle: float = 0.1):
-    """``twin compare``: simulate under the measured conditions and write the comparison.
+            solver_step: float | None = 1e-5):
+    """``twin compare``: simulate at the record's measured operating point and write the comparison.
 
-    The record's ``nominal_speed`` [Hz] and ``load`` [N.m] set the drive and the brake, and its
-    sample rate sets the output rate; the record is resampled to the scenario's rate if they
-    differ, and the change is reported. The parameters are the scenario's.
+    The model runs where the record was taken, as ``twin diagnose`` runs it
+    (:func:`twin.operating.measured_operating`): its pinion turns at the shaft speed measured on
+    the record (the record's ``nominal_speed`` [Hz] is only where that search starts), under the
+    record's ``load`` [N.m], sampled at the record's rate, on the RK4 step ``solver_step`` [s]
+    (the model's own when None). The parameters are the scenario's.
 
-    Writes to ``out_dir``: ``compare.json`` (headline metric, f1/f2 and the findings),
-    ``simulated.h5`` (the simulated signal), ``compare.png`` (spectra and order spectra with the
-    findings marked) and ``compare.html``. Returns the :class:`Comparison`.
+    Writes to ``out_dir``: ``compare.json`` (headline metric, f1/f2, the operating point and the
+    findings), ``simulated.h5`` (the simulated signal), ``compare.png`` (spectra and order
+    spectra with the findings marked) and ``compare.html``. Returns the :class:`Comparison`.
     """
     import json
+    from dataclasses import asdict
     from pathlib import Path
 
-    from twin.calibration.objectives import estimate_shaft_hz
-    from twin.errors import OutputPathError
+    from twin.errors import OutputPathError, ParameterError
     from twin.fmu import FMU
-    from twin.operating import operating_point
+    from twin.operating import measured_operating, simulate_at
     from twin.results import SimulationResult, write_hdf5
 
     out_dir = Path(out_dir)
     if not out_dir.parent.exists():
         raise OutputPathError(f"parent directory {out_dir.parent} does not exist")
-    out_dir.mkdir(exist_ok=True)
+    if duration is not None and not (duration > 0):
+        raise ParameterError(f"duration must be > 0 s, got {duration!r}")
     channel = (scenario.outputs or ("accel_pinion_casing",))[0]
-    rec = read_record(measurements, channel, record, resample_to=scenario.sample_rate)
+    rec = read_record(measurements, channel, record)
     measured = rec.signal
     if duration is not None:
         measured = measured[-int(round(duration * rec.sample_rate)):]
-    dur = measured.size / rec.sample_rate
-    drive = float(rec.nominal_speed)
-    start, inputs = operating_point(drive, float(rec.load))
-    params = {**scenario.parameters, **start}
-    dt = 1.0 / rec.sample_rate
-    with FMU(scenario.fmu_path()) as fmu:
-        fmu.setup(0.0, parameters=params, inputs=inputs)
-        fmu.capture(settle, dt, [channel])
-        block = fmu.capture(settle + dur, dt, [channel, "motor_speed"])
-        identity = (fmu.model_name, fmu.guid, fmu.sha256, fmu.parameter_values())
+    fmu_path = scenario.fmu_path()
+    params = dict(scenario.parameters)
+    with FMU(fmu_path) as fmu:
+        current = fmu.parameter_values()
+        z1_var = fmu.variables.get("z1")
+    z1 = int(round(float(z1_var.start))) if z1_var is not None and z1_var.start is not None else 19
+    z2 = int(round(params.get("z2", current.get("z2", 52))))
+    c_motor = params.get("c_motor", current.get("c_motor"))
+    op = measured_operating(measured, rec.sample_rate, rec.nominal_speed, rec.load, teeth=z1, gear_teeth=z2,
+                            c_motor=c_motor, solver_step=solver_step if "solver.step_size" in current else None)
+    out_dir.mkdir(exist_ok=True)
+    block = simulate_at(fmu_path, params, op, measured.size, [channel, "motor_speed"])
     simulated = block[:, 0]
-    shaft = estimate_shaft_hz(measured, rec.sample_rate, drive, 19)
-    z1 = int(round(params.get("z1", 19)))
-    z2 = int(round(params.get("z2", 52)))
-    comp = compare_signals(simulated, measured, rec.sample_rate, shaft, z1=z1, z2=z2)
+    comp = compare_signals(simulated, measured, rec.sample_rate, op.shaft_hz, z1=z1, z2=z2)
     from twin._atomic import atomic_path
+    with FMU(fmu_path) as fmu:
+        identity = (fmu.model_name, fmu.guid, fmu.sha256)
     with atomic_path(out_dir / "compare.json") as tmp:
         Path(tmp).write_text(json.dumps({"scenario": scenario.name, "record": rec.name,
-                                         "measurements": str(measurements), **comp.to_dict()}, indent=2))
-    t = settle + dt * np.arange(1, simulated.size + 1)
+                                         "measurements": str(measurements), "operating": asdict(op),
+                                         **comp.to_dict()}, indent=2))
+    dt = 1.0 / rec.sample_rate
+    t = op.settle + dt * np.arange(1, simulated.size + 1)
     write_hdf5(SimulationResult(t, {channel: simulated, "motor_speed": block[:, 1]},
-                                {channel: "m/s2", "motor_speed": "rad/s"}, rec.sample_rate, identity[3],
-                                identity[0], identity[1], identity[2]), out_dir / "simulated.h5")
+                                {channel: "m/s2", "motor_speed": "rad/s"}, rec.sample_rate,
+                                {**current, **params}, *identity), out_dir / "simulated.h5")
     _plot(comp, simulated, measured, rec.sample_rate, out_dir / "compare.png")
     _html(comp, scenario, rec, out_dir / "compare.html")
     return comp

@@ -3,12 +3,15 @@
 A drive speed [Hz] and a brake load [N.m] map onto two inputs (``motor_speed_ref`` in rad/s,
 ``load_torque``) and two parameters (``speed_ref_start``, ``load_start``) that start the run
 already twisted by the load at its slip speed. Every caller (calibration, comparison, archive,
-demo) goes through here so that the mapping exists once.
+demo) goes through here so that the mapping exists once. :func:`measured_operating` and
+:func:`simulate_at` put the model where a measured record was taken (its measured shaft speed),
+for ``twin compare`` and ``twin diagnose`` alike.
 """
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -54,3 +57,66 @@ def simulate_operating_point(fmu_path: str | Path, speed_hz: float, load_nm: flo
         if settle > 0:
             fmu.capture(settle, output_interval, list(channels))
         return fmu.capture(settle + duration, output_interval, list(channels))
+
+
+@dataclass(frozen=True)
+class Operating:
+    """Where a measured record was taken, in model terms (what compare and diagnose simulate at)."""
+
+    drive_hz: float          # motor speed command that gives the measured shaft speed [Hz]
+    shaft_hz: float          # measured pinion speed [Hz]
+    load: float              # brake torque [N.m]
+    sample_rate: float       # Hz
+    settle: float = 0.15     # s simulated and discarded before the compared stretch
+    # RK4 step of the trials [s]: 1e-5 s keeps the response within 4e-4 of the 5e-6 s default
+    # (Gearbox21.readme.md), far below measurement noise, at half the cost
+    solver_step: float | None = 1e-5
+    teeth: int = 19          # pinion teeth, to read the shaft speed off the gear-mesh line
+
+
+def measured_operating(measured: np.ndarray, sample_rate: float, nominal_speed: float, load: float, *,
+                       teeth: int, gear_teeth: int, c_motor: float | None, solver_step: float | None = 1e-5,
+                       shaft_hz: float | None = None) -> Operating:
+    """The operating point of a record: the pinion speed measured on it, and the drive command that
+    gives that speed in the model.
+
+    ``shaft_hz`` [Hz] is the pinion speed when the record gives it (an encoder); otherwise it is
+    read off the gear-mesh line of ``measured`` (an induction motor slips under load, so the
+    nominal drive setting is not the shaft speed). With ``c_motor`` [N.m.s/rad], the slope of the
+    model's motor torque-slip line, the drive command is the shaft speed plus the slip the load
+    causes; without it (a model with another drive), the drive command is the shaft speed.
+    """
+    from twin.calibration.objectives import estimate_shaft_hz
+    shaft = float(shaft_hz) if shaft_hz is not None else estimate_shaft_hz(measured, sample_rate, nominal_speed, teeth)
+    slip = load * teeth / gear_teeth / c_motor / (2 * math.pi) if c_motor else 0.0
+    return Operating(shaft + slip, shaft, float(load), float(sample_rate), solver_step=solver_step, teeth=teeth)
+
+
+def simulate_at(fmu_path, parameters: Mapping[str, float], op: Operating, n: int,
+                channels: str | Sequence[str]) -> np.ndarray:
+    """Model signal at the operating point, after ``op.settle`` s, with the pinion at ``op.shaft_hz``.
+
+    Returns (n,) for one channel name, (n, len(channels)) for a list; the first channel must be a
+    casing acceleration (its gear-mesh line checks the speed). The drive command comes from the
+    slip of the loaded motor; an effect that adds losses (tooth friction) or torque slows the shaft
+    a little more, and at the 13th mesh harmonic a few mHz of shaft speed already move a line by
+    a bin. So the shaft speed of the result is read off its gear-mesh line and, if it is off by
+    more than 1 mHz, the run is repeated with the drive corrected by that amount.
+    """
+    from twin.calibration.objectives import estimate_shaft_hz
+    single = isinstance(channels, str)
+    names = [channels] if single else list(channels)
+    if op.solver_step is not None:
+        parameters = {**parameters, "solver.step_size": op.solver_step}
+    drive = op.drive_hz
+    for attempt in range(2):
+        block = simulate_operating_point(fmu_path, drive, op.load, parameters=parameters, settle=op.settle,
+                                         duration=n / op.sample_rate, channels=names,
+                                         output_interval=1.0 / op.sample_rate)[:n]
+        if attempt or not np.all(np.isfinite(block)):
+            break
+        error = op.shaft_hz - estimate_shaft_hz(block[:, 0], op.sample_rate, op.shaft_hz, op.teeth)
+        if abs(error) <= 1e-3:
+            break
+        drive += error
+    return block[:, 0] if single else block

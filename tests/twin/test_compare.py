@@ -82,3 +82,28 @@ def test_record_without_load_is_a_measurement_error_naming_it(gearbox_fmu, tmp_p
     with pytest.raises(MeasurementError, match="r1.*lacks load"):
         compare(load_scenario(tmp_path / "s.yaml"), tmp_path / "m.h5", tmp_path / "rep")
     assert not (tmp_path / "rep" / "compare.json").exists()
+
+
+def test_compare_simulates_at_the_measured_speed_as_diagnose_does(gearbox_fmu, tmp_path):
+    """A record taken 1 % off its nominal speed: compare and the diagnosis baseline both run the
+    model at the measured speed, so they report the same operating point and the same distance."""
+    from twin.compare import compare
+    from twin.effects.diagnose import record_conditions, simulate
+    from twin.scenario import load_scenario
+    p = {"speed_ref_start": 2 * math.pi * 20.2, "load_start": 20.0, "tooth_stiffness_factor[5]": 0.7}
+    with FMU(gearbox_fmu) as f:
+        f.setup(0.0, parameters=p, inputs={"motor_speed_ref": 2 * math.pi * 20.2, "load_torque": 20.0})
+        f.capture(0.1, 5e-5, ["accel_pinion_casing"])
+        x = _noisy(f.capture(0.6, 5e-5, ["accel_pinion_casing"])[:, 0])
+    write_measurements([Record("r", {"accel_pinion_casing": x}, {"accel_pinion_casing": "m/s2"}, 2e4,
+                               nominal_speed=20.0, load=20.0)], tmp_path / "m.h5")
+    (tmp_path / "s.yaml").write_text(f"version: 1\nname: cmp\nfmu: {gearbox_fmu}\nstop_time: 1.0\n"
+                                     "output: {variables: [accel_pinion_casing]}\n")
+    comp = compare(load_scenario(tmp_path / "s.yaml"), tmp_path / "m.h5", tmp_path / "rep")
+    cond = record_conditions(gearbox_fmu, x, 2e4, 20.0, 20.0, {}, duration=0.5)
+    base = compare_signals(simulate(gearbox_fmu, {}, cond.operating, x.size, "accel_pinion_casing"), x, 2e4,
+                           cond.operating.shaft_hz)
+    data = json.loads((tmp_path / "rep" / "compare.json").read_text())
+    assert data["operating"]["shaft_hz"] == pytest.approx(cond.operating.shaft_hz)
+    assert comp.shaft_hz == pytest.approx(20.2 * SHAFT / 20, rel=2e-3)      # not the nominal 20 Hz
+    assert comp.lsd_db == pytest.approx(base.lsd_db, abs=1e-9)

@@ -37,25 +37,11 @@ import numpy as np
 
 from twin.compare import Comparison, Finding, compare_signals, spectral_levels
 from twin.effects.catalogue import CATALOGUE, Effect, FitParameter, effect as get_effect
+from twin.operating import Operating, simulate_at
 
 MIN_CUT = 0.25      # relative LSD cut for a candidate to count as the missing effect
 MIN_DB = 0.15       # and absolute cut [dB] (the LSD floor of a complete model is about 0.3-0.4 dB)
 MIN_SHARE = 0.05    # findings below this share of the error are not reported as unexplained
-
-
-@dataclass(frozen=True)
-class Operating:
-    """Where the record was taken, in model terms."""
-
-    drive_hz: float          # motor speed command that gives the measured shaft speed [Hz]
-    shaft_hz: float          # measured pinion speed [Hz]
-    load: float              # brake torque [N.m]
-    sample_rate: float       # Hz
-    settle: float = 0.15     # s simulated and discarded before the compared stretch
-    # RK4 step of the trials [s]: 1e-5 s keeps the response within 4e-4 of the 5e-6 s default
-    # (Gearbox21.readme.md), far below measurement noise, at half the cost
-    solver_step: float | None = 1e-5
-    teeth: int = 19          # pinion teeth, to read the shaft speed off the gear-mesh line
 
 
 @dataclass(frozen=True)
@@ -160,31 +146,8 @@ class _Objective:
 
 
 def simulate(fmu_path, parameters: Mapping[str, float], op: Operating, n: int, channel: str) -> np.ndarray:
-    """Model signal (n,) at the operating point, after ``op.settle`` s, with the pinion at ``op.shaft_hz``.
-
-    The drive command comes from the slip of the loaded motor; an effect that adds losses (tooth
-    friction) or torque slows the shaft a little more, and at the 13th mesh harmonic a few mHz of
-    shaft speed already move a line by a bin. So the shaft speed of the result is read off its
-    gear-mesh line and, if it is off by more than 1 mHz, the run is repeated with the drive
-    corrected by that amount.
-    """
-    from twin.calibration.objectives import estimate_shaft_hz
-    from twin.operating import simulate_operating_point
-    if op.solver_step is not None:
-        parameters = {**parameters, "solver.step_size": op.solver_step}
-    drive = op.drive_hz
-    for attempt in range(2):
-        block = simulate_operating_point(fmu_path, drive, op.load, parameters=parameters, settle=op.settle,
-                                         duration=n / op.sample_rate, channels=[channel],
-                                         output_interval=1.0 / op.sample_rate)
-        x = block[:n, 0]
-        if attempt or not np.all(np.isfinite(x)):
-            break
-        error = op.shaft_hz - estimate_shaft_hz(x, op.sample_rate, op.shaft_hz, op.teeth)
-        if abs(error) <= 1e-3:
-            break
-        drive += error
-    return x
+    """Model signal (n,) at the measured operating point (:func:`twin.operating.simulate_at`)."""
+    return simulate_at(fmu_path, parameters, op, n, channel)
 
 
 def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int, np.ndarray]:
@@ -429,9 +392,9 @@ def record_conditions(fmu_path, measured: np.ndarray, sample_rate: float, nomina
     finite, and :class:`ParameterError` for a ``duration`` under 0.25 s or a model that is not
     ``GearTwin.Gearbox21`` or a variant of it.
     """
-    from twin.calibration.objectives import estimate_shaft_hz
     from twin.errors import MeasurementError, ParameterError
     from twin.fmu import FMU
+    from twin.operating import measured_operating
 
     if not (isinstance(duration, (int, float)) and math.isfinite(duration) and duration >= 0.25):
         raise ParameterError(f"duration must be at least 0.25 s of the record, got {duration!r}")
@@ -450,12 +413,9 @@ def record_conditions(fmu_path, measured: np.ndarray, sample_rate: float, nomina
         raise ParameterError(f"{fmu_path} is not a GearTwin.Gearbox21 model (no parameter(s) "
                              f"{', '.join(missing)}); the effect catalogue extends that model")
     z1, z2 = int(round(float(z1_var.start))), int(round(current["z2"]))
-    c_motor = float(parameters.get("c_motor", current["c_motor"]))
-    shaft = estimate_shaft_hz(measured, sample_rate, nominal_speed, z1)
-    # the motor slips by the transmitted torque over the slope of its torque-slip line
-    drive_hz = shaft + load * z1 / z2 / c_motor / (2 * math.pi)
-    op = Operating(drive_hz, shaft, float(load), float(sample_rate),
-                   solver_step=solver_step if "solver.step_size" in current else None, teeth=z1)
+    op = measured_operating(measured, sample_rate, nominal_speed, load, teeth=z1, gear_teeth=z2,
+                            c_motor=float(parameters.get("c_motor", current["c_motor"])),
+                            solver_step=solver_step if "solver.step_size" in current else None)
     return Conditions(measured, current, z1, z2, op)
 
 
