@@ -11,6 +11,11 @@ A variant is a readable ``.mo`` file in ``modelica/GearTwin/Variants/``::
         frequency = 2480.0, damping_ratio = 0.021, participation = 0.9) "Casing or sensor-mount mode";
     end Gearbox21_housing_mode;
 
+Variants written by ``twin add-effect`` carry a short hash of their effects and values in their
+name (``Gearbox21_housing_mode_3f9c1a2b``): two gearboxes given the same effect with different
+fitted values get two models and two FMUs, so neither run overwrites the other, and a scenario
+always points at the FMU of its own values.
+
 The same text is what a user writes by hand for an effect of their own. Hooks that several
 effects drive are summed. ``GearTwin.Variants.Gearbox21Candidates`` carries every catalogue
 effect at its neutral values; :mod:`twin.effects.diagnose` turns the effects on one at a time in
@@ -34,10 +39,19 @@ def _number(v: float) -> str:
     return repr(float(v))
 
 
-def variant_name(effect_ids: Sequence[str]) -> str:
-    """``GearTwin.Variants.Gearbox21_<id>_<id>...`` in catalogue order."""
+def variant_name(effect_ids: Sequence[str], values: Mapping[str, float] | None = None) -> str:
+    """``GearTwin.Variants.Gearbox21_<id>_<id>..._<hash>`` in catalogue order.
+
+    ``<hash>`` (8 hex digits) is taken over the effect ids and ``values``, so different fitted
+    values give different models; without ``values`` the name has no hash.
+    """
+    import hashlib
     ordered = [e for e in CATALOGUE if e in set(effect_ids)]
-    return f"{VARIANTS_PACKAGE}.Gearbox21_" + "_".join(ordered)
+    name = f"{VARIANTS_PACKAGE}.Gearbox21_" + "_".join(ordered)
+    if values is None:
+        return name
+    text = ";".join(ordered) + "|" + ";".join(f"{k}={_number(v)}" for k, v in sorted(values.items()))
+    return name + "_" + hashlib.sha256(text.encode()).hexdigest()[:8]
 
 
 def variant_source(effect_ids: Sequence[str], values: Mapping[str, float] | None = None, *,
@@ -45,7 +59,8 @@ def variant_source(effect_ids: Sequence[str], values: Mapping[str, float] | None
     """Modelica text of the base model with the given effects.
 
     ``values`` maps FMU parameter names (``housing_mode.frequency``) to the values written as
-    modifiers; they become the FMU defaults.
+    modifiers; they become the FMU defaults. The default ``name`` is :func:`variant_name` of the
+    effects and these values.
     """
     ids = [e for e in CATALOGUE if e in set(effect_ids)]
     unknown = sorted(set(effect_ids) - set(CATALOGUE))
@@ -54,9 +69,10 @@ def variant_source(effect_ids: Sequence[str], values: Mapping[str, float] | None
     if not ids:
         from twin.errors import ParameterError
         raise ParameterError("a variant needs at least one effect")
-    name = name or variant_name(ids)
-    short = name.rsplit(".", 1)[-1]
     values = dict(values or {})
+    own = {k: v for k, v in values.items() if k.split('.', 1)[0] in ids}
+    name = name or variant_name(ids, own or None)
+    short = name.rsplit(".", 1)[-1]
     hooks: dict[str, list[str]] = {}
     bindings: dict[str, str] = {}
     for i in ids:

@@ -62,6 +62,11 @@ def test_write_variant_updates_the_package_and_refuses_a_foreign_directory(tmp_p
     assert "Variants" in (root / "GearTwin" / "package.order").read_text().split()
     with pytest.raises(OutputPathError, match="GearTwin"):
         write_variant(variant_source(["housing_mode"]), tmp_path / "elsewhere")
+    # fitted values name the variant: another gearbox's values give another model, not an overwrite
+    a, pa = write_variant(variant_source(["housing_mode"], {"housing_mode.frequency": 2500.0}), root)
+    b, pb = write_variant(variant_source(["housing_mode"], {"housing_mode.frequency": 2600.0}), root)
+    assert a != b and pa != pb and "frequency = 2500.0" in pa.read_text() and "frequency = 2600.0" in pb.read_text()
+    assert a.startswith("GearTwin.Variants.Gearbox21_housing_mode_")
 
 
 def test_neutral_candidate_model_reproduces_the_base_model(gearbox_fmu, candidates_fmu):
