@@ -167,6 +167,13 @@ SCHEMA: dict[str, Any] = {
             },
         },
         "calibration": CALIBRATION_SCHEMA,
+        "diagnosis": {
+            "type": "object", "additionalProperties": False,
+            "description": "Written by twin add-effect and twin improve.",
+            "properties": {"calibrated": {**_NAME_MAP, "description": "calibrated values of the base parameters "
+                                          "an added effect refitted; every later refit stays within the "
+                                          "documented band around these, not around the moved values"}},
+        },
         "executor": {
             "type": "object", "additionalProperties": False,
             "properties": {"type": {"enum": ["local", "dask"]},

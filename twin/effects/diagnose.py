@@ -122,6 +122,8 @@ class TrialSpec:
     related: dict = field(default_factory=dict)
     related_evals: int = 12
     polish_only: bool = False
+    # calibrated values the related parameters stay within +-RELATED_SPAN of (default: ``related``)
+    related_anchor: dict = field(default_factory=dict)
 
 
 class _Objective:
@@ -231,15 +233,18 @@ def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int, np.ndarra
     # 3) the effect and its related base parameters together
     if spec.related:
         names = list(spec.related)
-        v0 = np.array([float(spec.related[k]) for k in names])
+        anchor = np.array([float(spec.related_anchor.get(k, spec.related[k])) for k in names])
+        now = np.array([float(spec.related[k]) for k in names])
         m = len(params)
 
         def unpack(z):
             eff_values = {p.name: from_x(p, zi) for p, zi in zip(params, z[:m])}
             rel = np.clip(z[m:], -1.0, 1.0)
-            return eff_values, {k: float(v * (1 + RELATED_SPAN * r)) for k, v, r in zip(names, v0, rel)}
+            return eff_values, {k: float(v * (1 + RELATED_SPAN * r)) for k, v, r in zip(names, anchor, rel)}
 
-        z0 = np.concatenate([[to_x(p, values[p.name]) for p in params], np.zeros(len(names))])
+        # start from the current values (an earlier step may have moved them), inside the band
+        r0 = np.clip((now / np.where(anchor != 0, anchor, 1.0) - 1.0) / RELATED_SPAN, -1.0, 1.0)
+        z0 = np.concatenate([[to_x(p, values[p.name]) for p in params], r0])
         steps = np.concatenate([np.full(m, 0.05), np.full(len(names), 0.5)])   # 5 % of range, 5 % of value
         simplex = np.vstack([z0] + [z0 + steps[i] * np.eye(z0.size)[i] for i in range(z0.size)])
         res = minimize(lambda z: lsd(*unpack(z)), z0, method="Nelder-Mead",
@@ -424,7 +429,8 @@ def diagnose(fmu_path, measured: np.ndarray, sample_rate: float, nominal_speed: 
              effects: Sequence[str] | None = None, executor=None, record: str = "record",
              candidates_fmu=None, duration: float = 2.0, max_evals: int = 30,
              min_cut: float = MIN_CUT, min_db: float = MIN_DB, solver_step: float | None = 1e-5,
-             related_leaders: int = 2, progress: bool = False) -> Diagnosis:
+             related_leaders: int = 2, anchors: Mapping[str, float] | None = None,
+             progress: bool = False) -> Diagnosis:
     """Diagnose one record (see the module docstring).
 
     Parameters
@@ -439,6 +445,8 @@ def diagnose(fmu_path, measured: np.ndarray, sample_rate: float, nominal_speed: 
     candidates_fmu : the built ``Gearbox21Candidates`` FMU (built on demand when None).
     related_leaders : how many of the leading candidates are refitted once more together with
         their related base parameters (:attr:`Effect.related`); 0 switches that off.
+    anchors : calibrated values of base parameters (a scenario's ``diagnosis.calibrated``): the
+        related parameters stay within +-``RELATED_SPAN`` of these (default: their current values).
     """
     from twin.executor import LocalExecutor
 
@@ -490,7 +498,8 @@ def diagnose(fmu_path, measured: np.ndarray, sample_rate: float, nominal_speed: 
     # the leading candidates are tried again with their related base parameters refitted too
     lead = [c for c in cands[:related_leaders] if c.error is None and c.score > 0 and CATALOGUE[c.effect].related]
     specs2 = [TrialSpec(c.effect, str(candidates_fmu), channel, measured, op, probe, split_fitted(c.effect, c.fitted)[0],
-                        max_evals, related=related_values(CATALOGUE[c.effect], probe, current), polish_only=True)
+                        max_evals, related=related_values(CATALOGUE[c.effect], probe, current), polish_only=True,
+                        related_anchor=dict(anchors or {}))
               for c in lead]
     for c, r in zip(lead, ex.map(_guarded_fit, specs2, progress=progress, desc="related base parameters")
                     if specs2 else ()):

@@ -18,9 +18,15 @@ from pathlib import Path
 import numpy as np
 
 from twin.compare import MeasuredRecord, read_record  # noqa: F401  (part of this module's API)
-from twin.effects.catalogue import effect as get_effect
+from twin.effects.catalogue import RELATED_SPAN, effect as get_effect
 from twin.effects.diagnose import (Diagnosis, TrialSpec, active_effects, diagnose, fit_effect,
                                    record_conditions, related_values, simulate, split_fitted)
+
+
+def neutral_values(active) -> dict:
+    """Every catalogue effect not in ``active`` switched off (FMU names of the candidate model)."""
+    from twin.effects.catalogue import CATALOGUE
+    return {e.parameter(k): v for e in CATALOGUE.values() if e.id not in active for k, v in e.neutral.items()}
 
 
 def _write_json(path: Path, data: dict) -> None:
@@ -48,7 +54,8 @@ def diagnose_scenario(scenario, measurements, *, record: str | None = None, json
     rec = read_record(measurements, channel, record)
     diag = diagnose(scenario.fmu_path(), rec.signal, rec.sample_rate, rec.nominal_speed, rec.load,
                     parameters=dict(scenario.parameters), channel=channel, executor=executor, record=rec.name,
-                    duration=duration, progress=progress, candidates_fmu=candidates_fmu)
+                    duration=duration, progress=progress, candidates_fmu=candidates_fmu,
+                    anchors=(scenario.raw or {}).get("diagnosis", {}).get("calibrated", {}))
     if json_path is not None:
         _write_json(Path(json_path), {"scenario": scenario.name, "measurements": str(measurements),
                                       **diag.to_dict()})
@@ -72,21 +79,60 @@ class Addition:
         return (self.lsd_before_db - self.lsd_after_db) / self.lsd_before_db if self.lsd_before_db > 0 else 0.0
 
 
-def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str | None = None,
-               start: dict | None = None, modelica_dir=None, build_dir=None, duration: float = 2.0,
-               max_evals: int = 30) -> Addition:
-    """``twin add-effect``: variant .mo -> FMU -> recalibration -> before/after report.
+def related_anchors(scenario, eff, parameters: dict, current: dict) -> tuple[dict, dict]:
+    """(calibrated anchors, current values) of the effect's related base parameters.
 
-    ``start`` holds starting values of the effect parameters (FMU names), e.g. from a diagnosis;
-    without it the fit starts from the physics-based guesses of the diagnosis module.
+    The anchors are the values before any effect was added (the scenario's ``diagnosis.calibrated``
+    block, else its current values): every refit keeps a related parameter within
+    +-:data:`~twin.effects.catalogue.RELATED_SPAN` of its anchor, however many effects are added.
+    """
+    block = (scenario.raw or {}).get("diagnosis", {}).get("calibrated", {})
+    now = related_values(eff, parameters, current)
+    return {k: float(block.get(k, v)) for k, v in now.items()}, now
+
+
+def portable_scenario(scenario, name: str, fmu: str, parameter_file: str, anchors: dict) -> dict:
+    """A scenario dict for a variant that stays valid wherever it is read: the parameter set is
+    ``parameter_file`` (relative to the new scenario), files outside it are absolute."""
+    import copy
+
+    from twin.calibration.output import _absolute
+    raw = copy.deepcopy(dict(scenario.raw)) if scenario.raw else {"version": 1, "stop_time": 1.0}
+    base = scenario.source.parent if scenario.source is not None else None
+    raw["name"] = name
+    raw["fmu"] = fmu
+    raw.pop("parameters", None)
+    raw["parameter_files"] = [parameter_file]
+    op = raw.get("operating", {})
+    for _, spec in list(op.items()) + list(op.get("inputs", {}).items()):
+        if isinstance(spec, dict) and "table" in spec:
+            spec["table"]["file"] = _absolute(spec["table"]["file"], base)
+    if anchors:
+        raw["diagnosis"] = {**raw.get("diagnosis", {}), "calibrated": {k: float(v) for k, v in anchors.items()}}
+    return raw
+
+
+def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str | None = None,
+               start: dict | None = None, refit: bool = True, modelica_dir=None, build_dir=None,
+               candidates_fmu=None, duration: float = 2.0, max_evals: int = 30) -> Addition:
+    """``twin add-effect``: fit -> variant .mo -> FMU -> before/after report -> scenario.
+
+    The effect is fitted in the candidate model (the current model's effects at their values,
+    the new one switched on), together with its related base parameters (within
+    +-``RELATED_SPAN`` of their calibrated values). ``start`` holds values of the effect
+    parameters (FMU names), e.g. from a diagnosis; with ``refit=False`` they are taken as they
+    are (the diagnosis already fitted them) and only the variant is written, built and checked.
+    The variant's name carries a hash of its values (:func:`twin.effects.variant.variant_name`),
+    so runs on other gearboxes never overwrite it.
     """
     import yaml
     from fmu_build import build_fmu
 
     from twin._atomic import atomic_path
+    from twin.calibration.problem import write_parameter_set
     from twin.compare import compare_signals
     from twin.effects.diagnose import _band_error, starting_values
-    from twin.effects.variant import _REPO_MODELICA, modelica_root, variant_source, write_variant
+    from twin.effects.variant import CANDIDATES_MODEL, _REPO_MODELICA, modelica_root, variant_source, write_variant
     from twin.errors import ParameterError
 
     eff = get_effect(effect_id)
@@ -108,23 +154,28 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
     values = {k: v for k, v in current.items() if any(k.startswith(a + ".") for a in active)}
     sim0 = simulate(current_fmu, base_params, op, measured.size, channel)
     before = compare_signals(sim0, measured, rec.sample_rate, shaft, z1=z1, z2=z2)
+    anchors, now = related_anchors(scenario, eff, base_params, current)
 
-    # 1) the variant source, with neutral values for the new effect until it is fitted
-    ids = [*active, effect_id]
-    neutral = {eff.parameter(k): v for k, v in eff.neutral.items()}
-    model, path = write_variant(variant_source(ids, {**values, **neutral}), modelica_dir)
-    fmu_path = build_fmu(model, modelica_dir, build_dir)
-    # 2) recalibrate the new effect's parameters on the variant's own FMU
-    guesses = starting_values(before, measured, sim0, rec.sample_rate, shaft, z1, z2).get(effect_id, {})
+    # 1) the effect's parameters (and its related base parameters) in the candidate model
+    guesses = {} if start and not refit else \
+        starting_values(before, measured, sim0, rec.sample_rate, shaft, z1, z2).get(effect_id, {})
     if start:
         guesses.update(split_fitted(effect_id, start)[0])
-    # ... together with the base parameters that shape the same signature (Effect.related)
-    spec = TrialSpec(effect_id, str(fmu_path), channel, measured, op, {**base_params, **values, **neutral},
-                     guesses, max_evals, related=related_values(eff, base_params, current))
-    fitted, _, _, _ = fit_effect(spec)
+    if refit:
+        if candidates_fmu is None:
+            candidates_fmu = build_fmu(CANDIDATES_MODEL, _REPO_MODELICA, _REPO_MODELICA.parent / "build")
+        probe = {**base_params, **values, **neutral_values(active)}
+        spec = TrialSpec(effect_id, str(candidates_fmu), channel, measured, op, probe, guesses, max_evals,
+                         related=now, related_anchor=anchors)
+        fitted, _, _, _ = fit_effect(spec)
+    else:
+        fitted = {**{eff.parameter(k): float(v) for k, v in guesses.items()},
+                  **{k: float(v) for k, v in (start or {}).items() if k in now}}
     fitted_effect, fitted_base = split_fitted(effect_id, fitted)
     base_params.update(fitted_base)
-    # 3) write the variant again with the fitted values as its defaults, rebuild (cached by source)
+    # 2) the variant with the fitted values as its defaults, built (cached by source) and checked
+    neutral = {eff.parameter(k): v for k, v in eff.neutral.items()}
+    ids = [*active, effect_id]
     model, path = write_variant(variant_source(ids, {**values, **neutral,
                                                      **{eff.parameter(k): v for k, v in fitted_effect.items()}}),
                                 modelica_dir)
@@ -133,20 +184,22 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
     after = compare_signals(sim1, measured, rec.sample_rate, shaft, z1=z1, z2=z2)
     per = tuple((f.description, _band_error(before, f.band_hz), _band_error(after, f.band_hz))
                 for f in before.findings)
-    # 4) a scenario for the variant, so the next step (or twin run) starts from it
-    raw = dict(scenario.raw) if scenario.raw else {"version": 1, "name": scenario.name, "stop_time": 1.0}
-    raw["name"] = f"{scenario.name}+{effect_id}"
-    # the model name resolves through the repository's modelica/; a variant written elsewhere is
-    # referenced by its FMU file
-    raw["fmu"] = model if modelica_dir.resolve() == _REPO_MODELICA.resolve() else str(Path(fmu_path).resolve())
-    raw["parameters"] = {k: float(v) for k, v in base_params.items()}   # with the refitted related ones
+    # 3) a scenario for the variant, so the next step (or twin run) starts from it; the model name
+    # resolves through the repository's modelica/, a variant written elsewhere by its FMU file
+    write_parameter_set(base_params, out / f"parameters_{effect_id}.json")
+    fmu_ref = model if modelica_dir.resolve() == _REPO_MODELICA.resolve() else str(Path(fmu_path).resolve())
+    raw = portable_scenario(scenario, f"{scenario.name}+{effect_id}", fmu_ref, f"parameters_{effect_id}.json",
+                            {**(scenario.raw or {}).get("diagnosis", {}).get("calibrated", {}), **anchors})
     scen_file = out / f"scenario_{effect_id}.yaml"
+    from twin.scenario import scenario_from_dict
+    scenario_from_dict(raw, source=scen_file)            # what is written must load
     with atomic_path(scen_file) as tmp:
         Path(tmp).write_text(yaml.safe_dump(raw, sort_keys=False))
     add = Addition(effect_id, model, path, fmu_path, scen_file, fitted, before.lsd_db, after.lsd_db, per)
     _write_json(out / f"add_effect_{effect_id}.json",
                 {"effect": effect_id, "model": model, "modelica_file": str(path), "fmu": str(fmu_path),
                  "scenario": str(scen_file), "fitted_parameters": fitted,
+                 "related_bounds": {k: [a * (1 - RELATED_SPAN), a * (1 + RELATED_SPAN)] for k, a in anchors.items()},
                  "log_spectral_distance_db": {"before": before.lsd_db, "after": after.lsd_db},
                  "reduction": add.reduction,
                  "per_finding": [{"finding": d, "squared_db_error_before": b, "squared_db_error_after": a}
@@ -176,9 +229,10 @@ def improve(scenario, measurements, out_dir, *, record: str | None = None, max_s
         if diag.verdict != "missing_effect":
             history.append(Step(k, None, diag.lsd_db, diag.lsd_db, scenario.fmu, diag.verdict))
             break
+        # the diagnosis fitted the effect already: add it with those values, without a refit
         add = add_effect(scenario, measurements, diag.missing, out, record=record,
-                         start=diag.candidates[0].fitted, modelica_dir=modelica_dir, build_dir=build_dir,
-                         duration=duration)
+                         start=diag.candidates[0].fitted, refit=False, modelica_dir=modelica_dir,
+                         build_dir=build_dir, duration=duration)
         history.append(Step(k, add.effect, add.lsd_before_db, add.lsd_after_db, add.model, diag.verdict))
         if add.lsd_after_db >= add.lsd_before_db:
             break

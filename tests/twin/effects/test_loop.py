@@ -40,7 +40,7 @@ def test_improve_adds_the_missing_effect_and_stops(case_files, tmp_path, capsys)
     assert first["effect"] == "local_tooth_damage"
     assert first["lsd_after_db"] <= 0.5 * first["lsd_before_db"]
     # the variant is a readable Modelica file that extends the base with the component
-    src = (modelica / "GearTwin" / "Variants" / "Gearbox21_local_tooth_damage.mo").read_text()
+    src, = [f.read_text() for f in (modelica / "GearTwin" / "Variants").glob("Gearbox21_local_tooth_damage_*.mo")]
     assert "extends GearTwin.Gearbox21(" in src and "GearTwin.Effects.LocalToothDamage local_tooth_damage(" in src
     # the loop stopped: the next diagnosis found nothing that helps
     assert len(history) <= 2 and (len(history) == 1 or history[1]["effect"] is None)
@@ -89,3 +89,54 @@ def test_unknown_record_name_is_a_typed_error_naming_the_records(tmp_path, gearb
         assert main([*command, str(scen), "--measurements", str(tmp_path / "m.h5"), "--record", "run9"]) == 2
         err = capsys.readouterr().err
         assert "run9" in err and "run1" in err
+
+
+def test_added_effects_never_overwrite_and_their_scenarios_load_anywhere(case_files, tmp_path, monkeypatch):
+    """Two gearboxes given the same effect with other values: two variants, two FMUs, and each
+    scenario (written from one whose parameters live in a relative parameter file) points at
+    its own, from any working directory."""
+    import json
+
+    import yaml
+
+    from twin.effects.loop import add_effect
+    from twin.fmu import FMU
+    from twin.scenario import load_scenario
+    scen, meas, modelica = case_files
+    params = yaml.safe_load(scen.read_text())["parameters"]
+    (tmp_path / "cal").mkdir()
+    (tmp_path / "cal" / "calibrated.json").write_text(json.dumps({"parameters": params}))
+    (tmp_path / "cal" / "calibrated.yaml").write_text(yaml.safe_dump(
+        {"version": 1, "name": "rig", "fmu": yaml.safe_load(scen.read_text())["fmu"], "stop_time": 1.0,
+         "parameter_files": ["calibrated.json"]}))
+    cal = load_scenario(tmp_path / "cal" / "calibrated.yaml")
+    adds = [add_effect(cal, meas, "local_tooth_damage", tmp_path / f"box{i}", refit=False, modelica_dir=modelica,
+                       build_dir=tmp_path / "build", start={"local_tooth_damage.stiffness_loss": loss})
+            for i, loss in enumerate((0.3, 0.6))]
+    assert adds[0].model != adds[1].model and adds[0].fmu != adds[1].fmu
+    monkeypatch.chdir(tmp_path / "cal")                  # relative paths must not resolve from here
+    for add, loss in zip(adds, (0.3, 0.6)):
+        s = load_scenario(add.scenario_file)
+        assert s.parameters["mesh_stiffness_scale"] == pytest.approx(params["mesh_stiffness_scale"])
+        with FMU(s.fmu_path()) as f:
+            assert f.parameter_values()["local_tooth_damage.stiffness_loss"] == pytest.approx(loss)
+
+
+def test_related_refit_stays_in_the_band_around_the_calibrated_value(candidates_fmu):
+    """A parameter an earlier added effect already moved to +10 % of its calibrated value cannot
+    be moved further by the next refit: the band is anchored at the calibrated value."""
+    import numpy as np
+
+    from twin.effects.catalogue import RELATED_SPAN
+    from twin.effects.diagnose import TrialSpec, fit_effect, record_conditions
+    from twin.effects.synthetic import _neutral
+    from twin.operating import simulate_operating_point
+    truth = {**_neutral(), "pinion_eccentricity.eccentricity": 2e-5, "mesh_stiffness_scale": 1.3}
+    x = simulate_operating_point(candidates_fmu, 20.0, 20.0, parameters=truth, settle=0.15, duration=0.4,
+                                 channels=["accel_pinion_casing"], output_interval=5e-5)[:, 0]
+    op = record_conditions(candidates_fmu, x, 20000.0, 20.0, 20.0, {}, duration=0.4).operating
+    fitted, *_ = fit_effect(TrialSpec("pinion_eccentricity", str(candidates_fmu), "accel_pinion_casing", x, op,
+                                      _neutral(), {"eccentricity": 2e-5}, polish_only=True, related_evals=8,
+                                      related={"mesh_stiffness_scale": 1.1},
+                                      related_anchor={"mesh_stiffness_scale": 1.0}))
+    assert fitted["mesh_stiffness_scale"] <= 1.0 * (1 + RELATED_SPAN)
