@@ -136,7 +136,18 @@ def unit_definitions(all_rows: list[_Row]) -> str:
     return "  <UnitDefinitions>\n" + "\n".join(lines) + "\n  </UnitDefinitions>"
 
 
-def _real_attrs(r: _Row, *, fmi3: bool) -> list[str]:
+def _common_attrs(r: _Row, vr: int) -> list[str]:
+    """name, valueReference, description, causality, variability, initial: the same in FMI 2.0 and 3.0."""
+    attrs = [f"name={quoteattr(r.var.name)}", f'valueReference="{vr}"']
+    if r.var.description:
+        attrs.append(f"description={quoteattr(r.var.description)}")
+    attrs += [f'causality="{r.causality}"', f'variability="{r.variability}"']
+    if r.initial:
+        attrs.append(f'initial="{r.initial}"')
+    return attrs
+
+
+def _real_attrs(r: _Row) -> list[str]:
     v = r.var
     attrs = []
     if r.unit:
@@ -175,15 +186,9 @@ def fmi2(ode, info: BuildInfo, structure: ModelStructure) -> str:
     lay = layout(ode)
     xml_rows = []
     for r in all_rows:
-        v = r.var
-        attrs = [f"name={quoteattr(v.name)}", f'valueReference="{r.vr}"']
-        if v.description:
-            attrs.append(f"description={quoteattr(v.description)}")
-        attrs += [f'causality="{r.causality}"', f'variability="{r.variability}"']
-        if r.initial:
-            attrs.append(f'initial="{r.initial}"')
+        attrs = _common_attrs(r, r.vr)
         if r.type == "Real":
-            inner = _real_attrs(r, fmi3=False)
+            inner = _real_attrs(r)
             if r.derivative_of is not None:
                 inner.append(f'derivative="{index[("Real", r.derivative_of)]}"')
         else:
@@ -302,16 +307,9 @@ def fmi3(ode, info: BuildInfo, structure: ModelStructure) -> str:
     xml_rows = [f'    <Float64 name="time" valueReference="{lay["time"]}" causality="independent" '
                 'variability="continuous" unit="s" description="Simulation time"/>']
     for r in all_rows:
-        v = r.var
-        vr = r.vr if r.type == "Real" else lay["c0"] + r.vr
-        attrs = [f"name={quoteattr(v.name)}", f'valueReference="{vr}"']
-        if v.description:
-            attrs.append(f"description={quoteattr(v.description)}")
-        attrs += [f'causality="{r.causality}"', f'variability="{r.variability}"']
-        if r.initial:
-            attrs.append(f'initial="{r.initial}"')
+        attrs = _common_attrs(r, r.vr if r.type == "Real" else lay["c0"] + r.vr)
         if r.type == "Real":
-            attrs += _real_attrs(r, fmi3=True)
+            attrs += _real_attrs(r)
             if r.derivative_of is not None:
                 attrs.append(f'derivative="{r.derivative_of}"')
             xml_rows.append(f'    <Float64 {" ".join(attrs)}/>')
