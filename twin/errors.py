@@ -6,8 +6,22 @@ caller can catch the whole family while still telling boundaries apart.
 from __future__ import annotations
 
 
+def _rebuild(cls, args, state):
+    err = cls.__new__(cls)
+    err.args = args
+    err.__dict__.update(state)
+    return err
+
+
 class TwinError(Exception):
-    """Base class of every error raised on purpose by ``twin`` and ``fmu_build``."""
+    """Base class of every error raised on purpose by ``twin`` and ``fmu_build``.
+
+    Errors cross process boundaries (a worker's error is the caller's): they pickle by their
+    message and attributes, whatever their constructor takes.
+    """
+
+    def __reduce__(self):
+        return (_rebuild, (type(self), self.args, dict(self.__dict__)))
 
 
 class BuildError(TwinError):
@@ -49,6 +63,29 @@ class SimulationError(TwinError):
         where = f" at t={time:.6g} s" if time is not None else ""
         what = f" (status {status})" if status else ""
         super().__init__(f"{message}{where}{what}")
+
+
+class WorkerCrashError(SimulationError):
+    """A process hosting FMU work died (a signal such as SIGSEGV, or ``exit()`` inside the FMU)
+    or was stopped after passing its time limit.
+
+    Attributes
+    ----------
+    exitcode : int or None
+        Exit status of the process; negative: killed by signal ``-exitcode``.
+    timeout : float or None
+        The time limit [s] the task passed, when it was stopped for hanging.
+    """
+
+    def __init__(self, message: str, *, exitcode: int | None = None, timeout: float | None = None):
+        self.exitcode = exitcode
+        self.timeout = timeout
+        super().__init__(message)
+
+
+class ResumeError(TwinError):
+    """A partial result or checkpoint cannot be resumed: unreadable, or made by another scenario,
+    FMU or set of settings (its identity hash differs)."""
 
 
 class ParameterError(TwinError):

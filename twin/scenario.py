@@ -73,6 +73,9 @@ CALIBRATION_SCHEMA: dict[str, Any] = {
         "settle_time": {"type": "number", "minimum": 0},
         "band": {"type": "array", "items": {"type": "number", "minimum": 0}, "minItems": 2, "maxItems": 2},
         "refine": {"type": "boolean", "description": "polish the pick by least squares on the modes (default true)"},
+        "evaluation_timeout": {"type": "number", "exclusiveMinimum": 0,
+                               "description": "s; an evaluation still running then is stopped and scored infeasible "
+                                              "(default 600)"},
     },
 }
 
@@ -178,7 +181,12 @@ SCHEMA: dict[str, Any] = {
             "type": "object", "additionalProperties": False,
             "properties": {"type": {"enum": ["local", "dask"]},
                            "workers": {"type": "integer", "minimum": 1},
-                           "address": {"type": "string"}},
+                           "address": {"type": "string"},
+                           "timeout": {"type": "number", "exclusiveMinimum": 0,
+                                       "description": "s per task; a task still running then is stopped and "
+                                                      "reported (default 3600)"},
+                           "retries": {"type": "integer", "minimum": 0,
+                                       "description": "re-runs of a task whose worker process died (default 0)"}},
         },
     },
 }
@@ -301,11 +309,63 @@ def load_scenario(path: str | Path) -> Scenario:
     path = Path(path)
     if not path.exists():
         raise ScenarioError([(str(path), "", "file does not exist")])
+    if path.is_dir():
+        raise ScenarioError([(str(path), "", "is a directory, not a scenario file")])
     try:
-        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ScenarioError([(str(path), "", f"cannot read: {exc.strerror or exc}")]) from None
+    except UnicodeDecodeError as exc:
+        raise ScenarioError([(str(path), "", f"not a text file ({exc.reason} at byte {exc.start})")]) from None
+    try:
+        data = yaml.load(text, Loader=_unique_key_loader())
     except yaml.YAMLError as exc:
         raise ScenarioError([(str(path), "", f"not valid YAML: {exc}")]) from None
     return scenario_from_dict(data, source=path)
+
+
+def _unique_key_loader():
+    import yaml
+
+    class UniqueKeyLoader(yaml.SafeLoader):
+        """A SafeLoader that refuses a key given twice in one mapping (YAML would keep the last)."""
+
+        def construct_mapping(self, node, deep=False):
+            seen = {}
+            for key_node, _ in node.value:
+                key = self.construct_object(key_node, deep=deep)
+                if key in seen:
+                    raise yaml.constructor.ConstructorError(
+                        "while constructing a mapping", node.start_mark,
+                        f"duplicate key {key!r} (first at line {seen[key] + 1})", key_node.start_mark)
+                seen[key] = key_node.start_mark.line
+            return super().construct_mapping(node, deep=deep)
+
+    # YAML 1.1 (PyYAML) reads 1.0e6 or 1e-5 as strings; YAML 1.2 and every user read numbers
+    import re
+    UniqueKeyLoader.yaml_implicit_resolvers = {k: list(v) for k, v in yaml.SafeLoader.yaml_implicit_resolvers.items()}
+    UniqueKeyLoader.add_implicit_resolver(
+        "tag:yaml.org,2002:float",
+        re.compile(r"^[-+]?(?:[0-9][0-9_]*)(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"), list("-+0123456789"))
+    return UniqueKeyLoader
+
+
+def _value_at(data, path):
+    for p in path:
+        data = data[p]
+    return data
+
+
+def _nonfinite(data, path=()):
+    """Key paths of the non-finite numbers (YAML ``.nan``, ``.inf``) anywhere in ``data``."""
+    if isinstance(data, float) and not math.isfinite(data):
+        yield path
+    elif isinstance(data, dict):
+        for k, v in data.items():
+            yield from _nonfinite(v, (*path, k))
+    elif isinstance(data, list):
+        for i, v in enumerate(data):
+            yield from _nonfinite(v, (*path, i))
 
 
 def _key_path(parts) -> str:
@@ -334,6 +394,7 @@ def scenario_from_dict(data: Any, source: Path | None = None) -> Scenario:
         elif err.validator == "additionalProperties":
             msg = msg.replace("Additional properties are not allowed", "unknown key(s)")
         problems.append((where, _key_path(err.absolute_path), msg))
+    problems += [(where, _key_path(p), f"must be a finite number, got {_value_at(data, p)}") for p in _nonfinite(data)]
     if problems:
         raise ScenarioError(problems)
 
@@ -350,6 +411,16 @@ def scenario_from_dict(data: Any, source: Path | None = None) -> Scenario:
     elif abs(comm * rate - round(comm * rate)) > 1e-6 * comm * rate:
         problems.append((where, "communication_step",
                          f"{comm} s must be a whole number of output samples (1/{rate:g} Hz)"))
+    from twin.checks import sample_budget_problem, whole_multiple
+    if stop > start and not whole_multiple(stop - start, comm):
+        n = (stop - start) / comm
+        problems.append((where, "communication_step",
+                         f"the run of {stop - start:g} s is not a whole number of communication steps of {comm:g} s "
+                         f"({n:.6g} steps); make stop_time {start + max(1, math.floor(n)) * comm:.10g} or "
+                         f"{start + math.ceil(n) * comm:.10g}, or change the step"))
+    n_out = len(out.get("variables", ())) or 32
+    if stop > start and (budget := sample_budget_problem(stop - start, 1.0 / rate, n_out)):
+        problems.append((where, "stop_time", budget))
 
     params: dict[str, float] = {}
     locator = Scenario(name=str(data["name"]), fmu=str(data["fmu"]), stop_time=1.0, source=source)

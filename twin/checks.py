@@ -1,0 +1,111 @@
+"""Checks of times, rates and sizes before a run starts, with errors that name the value.
+
+A stop time of ``nan``, ``inf`` or ``1e12`` s must not reach numpy as an overflow or an
+allocation of a terabyte: it is refused here with the memory the run would need.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from twin.errors import ParameterError
+
+#: Largest sampled result a run may hold in memory [bytes].
+MEMORY_BUDGET = 4 * 1024 ** 3
+
+
+def _bytes(n: float) -> str:
+    for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB"):
+        if n < 1024 or unit == "PiB":
+            return f"{n:.3g} {unit}"
+        n /= 1024
+    return f"{n:.3g} PiB"
+
+
+def whole_multiple(span: float, step: float) -> bool:
+    """True when ``span`` is a whole number (>= 1) of ``step`` (to 1e-6 of a step)."""
+    k = span / step
+    return k >= 1 - 1e-9 and abs(k - round(k)) <= 1e-6
+
+
+def sample_budget_problem(span: float, interval: float, channels: int) -> str | None:
+    """Why sampling ``channels`` channels every ``interval`` s over ``span`` s does not fit in
+    :data:`MEMORY_BUDGET`, or None."""
+    n = span / interval + 1
+    need = n * (channels + 1) * 8.0
+    if need > MEMORY_BUDGET:
+        return (f"{span:g} s sampled every {interval:g} s is {n:.3g} samples x {channels + 1} channels, "
+                f"which would need {_bytes(need)} of memory (the limit is {_bytes(MEMORY_BUDGET)}); "
+                "shorten the run or lower the sample rate")
+    return None
+
+
+def check_times(start_time: float, stop_time: float, output_interval: float, *, n_channels: int | None = None,
+                fmu: Path | None = None) -> None:
+    """Refuse non-finite or absurd times before a simulation (``twin simulate``).
+
+    ``n_channels`` defaults to the number of outputs of ``fmu`` (read from its description).
+    """
+    for name, v in (("--start-time", start_time), ("--stop-time", stop_time), ("--output-interval", output_interval)):
+        if not math.isfinite(v):
+            raise ParameterError(f"{name} must be a finite number of seconds, got {v!r}")
+    if not output_interval > 0:
+        raise ParameterError(f"--output-interval must be > 0 s, got {output_interval!r}")
+    if not stop_time > start_time:
+        raise ParameterError(f"--stop-time ({stop_time:g} s) must be after --start-time ({start_time:g} s)")
+    span = stop_time - start_time
+    if span < output_interval * (1 - 1e-9):
+        raise ParameterError(f"--stop-time {stop_time:g} s leaves no output sample after {start_time:g} s at an "
+                             f"interval of {output_interval:g} s")
+    if not whole_multiple(span, output_interval):
+        raise ParameterError(f"the run of {span:.10g} s is not a whole number of output intervals "
+                             f"({output_interval:g} s); use --stop-time "
+                             f"{start_time + math.floor(span / output_interval) * output_interval:.10g} or "
+                             f"{start_time + math.ceil(span / output_interval) * output_interval:.10g}")
+    if n_channels is None:
+        n_channels = _count_outputs(fmu) if fmu is not None else 1
+    problem = sample_budget_problem(span, output_interval, max(n_channels, 1))
+    if problem:
+        raise ParameterError(f"--stop-time {stop_time:g}: {problem}")
+
+
+def _count_outputs(fmu: Path) -> int:
+    from twin.errors import TwinError
+    try:
+        from twin.fmu import FMU
+        with FMU(fmu) as f:
+            return len(f.outputs)
+    except (TwinError, ImportError):  # the FMU's own errors are reported when it is run
+        return 1
+
+
+def check_assignments(fmu: Path, parameters: dict[str, float], inputs: dict[str, float]) -> None:
+    """Refuse ``--param`` names that are not parameters, ``--input`` names that are not inputs,
+    and values that make no physical sense, before the FMU is loaded."""
+    from twin.fmu import FMU
+    from twin.plausibility import physical_problems
+    with FMU(fmu) as f:
+        problems = []
+        for option, values, causality in (("--param", parameters, "parameter"), ("--input", inputs, "input")):
+            for name in values:
+                v = f.variables.get(name)
+                if v is None:
+                    close = [n for n in f.variables if name.lower() in n.lower()][:5]
+                    problems.append(f"{option} {name}: {f.model_name} has no variable {name!r}"
+                                    + (f" (similar: {', '.join(close)})" if close else ""))
+                elif v.causality != causality:
+                    problems.append(f"{option} {name}: {name!r} is a{'n' if v.causality[0] in 'aeiou' else ''} "
+                                    f"{v.causality}, not a{'n' if causality == 'input' else ''} {causality}"
+                                    + (" (use --input)" if v.causality == "input" else
+                                       " (use --param)" if v.causality == "parameter" else ""))
+        problems += physical_problems({**parameters, **inputs}, {n: v.unit for n, v in f.variables.items()})
+    if problems:
+        raise ParameterError("; ".join(problems))
+
+
+def override_stop_time(scenario, stop_time: float):
+    """The scenario with ``stop_time`` replaced, validated like the file itself."""
+    from twin.scenario import scenario_from_dict
+    raw = dict(scenario.raw)
+    raw["stop_time"] = stop_time
+    return scenario_from_dict(raw, source=scenario.source)
