@@ -147,6 +147,7 @@ class FMU:
         self._buffer_interval = None
         self._scratch = None
         self._initialized = False
+        self._fatal = False
         self._t_start = 0.0
 
     # -- description -----------------------------------------------------------------------
@@ -232,6 +233,7 @@ class FMU:
         except Exception as exc:
             status = getattr(exc, "status", None)
             name = _STATUS[status] if isinstance(status, int) and 0 <= status < len(_STATUS) else None
+            self._fatal = self._fatal or name == "fmi2Fatal"
             detail = "; ".join(self._messages[-3:]) or str(exc)
             self._messages.clear()
             raise SimulationError(f"{self.model_name}: {what} failed: {detail}", time=self.time,
@@ -254,6 +256,13 @@ class FMU:
             self._slave.instantiate(callbacks=self._callbacks)
         except Exception as exc:
             detail = "; ".join(self._messages) or str(exc)
+            # fmi2Instantiate returned NULL: there is no instance to terminate or free (an FMU
+            # given a NULL component may crash), only the library to unload
+            slave, self._slave = self._slave, None
+            try:
+                slave.freeLibrary()
+            except Exception:  # the error below is the one the user needs
+                pass
             raise FMUError(f"{self.path}: fmi2Instantiate failed: {detail}") from exc
         fn = getattr(self._slave.dll, "twin_fmi2GetOutputBuffer", None)
         if fn is not None:
@@ -286,11 +295,15 @@ class FMU:
 
     def close(self) -> None:
         if self._slave is not None:
-            try:
-                self._slave.terminate()
-            except Exception:  # terminating a failed instance may fail again; the instance is freed anyway
-                pass
-            self._slave.freeInstance()
+            # fmi2Terminate only for an initialised instance, and nothing after fmi2Fatal
+            # (FMI 2.0, section 4.2.4); fmi2FreeInstance for any instance that exists
+            if self._initialized and not self._fatal:
+                try:
+                    self._slave.terminate()
+                except Exception:  # terminating a failed instance may fail again; it is freed anyway
+                    pass
+            if not self._fatal and getattr(self._slave, "component", None):
+                self._slave.freeInstance()
             try:
                 self._slave.freeLibrary() if hasattr(self._slave, "freeLibrary") else None
             except Exception:
@@ -495,7 +508,11 @@ class FMU:
         model = FMU2Model(guid=md.guid, unzipDirectory=self._unzip,
                           modelIdentifier=md.modelExchange.modelIdentifier, instanceName="linearize")
         callbacks = self._make_callbacks()
-        model.instantiate(callbacks=callbacks)
+        try:
+            model.instantiate(callbacks=callbacks)
+        except Exception as exc:  # NULL instance: nothing to terminate, see instantiate()
+            detail = "; ".join(self._messages) or str(exc)
+            raise FMUError(f"{self.path}: fmi2Instantiate (Model Exchange) failed: {detail}") from exc
         model.setupExperiment(startTime=0.0)
         model.enterInitializationMode()
         values = {**(parameters or {}), **(inputs or {})}
