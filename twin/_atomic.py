@@ -88,10 +88,15 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
         If the parent directory of ``path`` is missing or ``path`` is a directory.
     """
     target = check_parent(path)
-    with tempfile.NamedTemporaryFile(
-        delete=False, dir=target.parent, prefix=f".{target.name}.", suffix=".tmp"
-    ) as handle:
-        tmp = Path(handle.name)
+    remove_stale_temporaries(target)
+    try:
+        with tempfile.NamedTemporaryFile(
+            delete=False, dir=target.parent, prefix=f".{target.name}.{os.getpid()}.", suffix=".tmp"
+        ) as handle:
+            tmp = Path(handle.name)
+    except OSError as exc:
+        raise OutputPathError(f"cannot write '{target}': {(exc.strerror or str(exc)).lower()} "
+                              f"in directory '{target.parent}'") from None
     try:
         yield tmp
         fd = os.open(tmp, os.O_RDWR)
@@ -112,3 +117,38 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
             os.fsync(dir_fd)
         finally:
             os.close(dir_fd)
+
+
+def partial_path(path: str | os.PathLike[str]) -> Path:
+    """Where an interrupted run keeps its output: ``out.h5`` -> ``out.partial.h5``."""
+    p = Path(path)
+    return p.with_name(f"{p.stem}.partial{p.suffix}")
+
+
+def _pid_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def remove_stale_temporaries(target: Path) -> None:
+    """Remove the temporary siblings of ``target`` left by writers that were killed (SIGKILL,
+    a crash) before they could clean up: ``.<name>.<pid>.<random>.tmp`` whose process is gone."""
+    try:
+        siblings = list(target.parent.glob(f".{glob_escape(target.name)}.*.tmp"))
+    except OSError:
+        return
+    for tmp in siblings:
+        parts = tmp.name[len(target.name) + 2:].split(".")
+        if len(parts) >= 3 and parts[0].isdigit() and not _pid_alive(int(parts[0])):
+            with contextlib.suppress(OSError):
+                tmp.unlink()
+
+
+def glob_escape(name: str) -> str:
+    import glob
+    return glob.escape(name)

@@ -16,8 +16,13 @@ At each update (stage):
    projected back onto the 11 nodes the FMU sees, so that state and simulation agree.
 
 The run stops on the scenario's criterion (pitting density, wear depth or cycles) or after
-``max_updates``.  After every stage the whole record is rewritten atomically, so an
-interrupted run keeps its completed stages and ``resume=True`` continues from the last one.
+``max_updates``.  After every stage the stages so far are rewritten atomically to
+``<stem>.partial<suffix>`` beside the output; only the complete run replaces the output itself
+(and removes the partial file).  An interrupted or killed run therefore leaves an earlier
+result untouched, and ``resume=True`` continues from the last stage of the partial file (or,
+without one, extends the complete output, e.g. to a later stop criterion).  The
+partial file carries the run's identity (:func:`run_identity`, a hash of the scenario and the
+FMU); a partial file of another scenario or FMU is refused, never relabelled.
 """
 from __future__ import annotations
 
@@ -29,7 +34,7 @@ from typing import Any
 import numpy as np
 
 from twin._progress import progress_bar
-from twin.errors import ScenarioError, SimulationError
+from twin.errors import ScenarioError
 from twin.fmu import FMU
 from twin.orchestrator import check_compatibility
 from twin.scenario import Scenario
@@ -104,11 +109,32 @@ def _stop_reached(spec, model_name, damage, cycles) -> bool:
     return False
 
 
+#: Scenario keys that do not change the stages a run computes (only where it stops, where it
+#: runs or what else the file is used for), so a partial run may be resumed across them.
+_IDENTITY_FREE = ("executor", "description", "archive", "calibration")
+_IDENTITY_FREE_DEGRADATION = ("stop", "max_updates")
+
+
+def run_identity(scenario: Scenario, fmu_sha256: str) -> str:
+    """SHA-256 of what decides a degradation run's stages: the scenario's content (not its
+    executor, description or stop criterion) and the FMU file's SHA-256."""
+    import hashlib
+    raw = {k: v for k, v in dict(scenario.raw).items() if k not in _IDENTITY_FREE}
+    if isinstance(raw.get("degradation"), dict):
+        raw["degradation"] = {k: v for k, v in raw["degradation"].items() if k not in _IDENTITY_FREE_DEGRADATION}
+    text = json.dumps({"scenario": raw, "parameters": dict(scenario.parameters), "fmu": fmu_sha256},
+                      sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
 def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu_path: Path | None = None,
                     progress: bool = True, resume: bool = False,
                     channels: tuple[str, ...] | None = None) -> DegradationRun:
     """Run the scenario's degradation block; write the stages to ``output`` (HDF5) if given."""
+    from twin import _interrupt
+    from twin._atomic import partial_path
     from twin.degradation import GearPair, MeshLoad, mesh_parameters, project_wear
+    from twin.plausibility import check_block, check_parameters
 
     spec = scenario.degradation
     if spec is None:
@@ -130,8 +156,10 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
 
     stages: list[Stage] = []
     complete = False
+    partial = partial_path(path) if path is not None else None
     with FMU(fmu_file) as fmu:
         check_compatibility(fmu, scenario)
+        identity = run_identity(scenario, fmu.sha256)
         geometry_values = {v.name: fmu.get(v.name) for v in fmu.parameters if "[" not in v.name}
         geometry_values.update(fmu.structural_values())       # the tooth counts are built in
         geometry_values.update({k: v for k, v in scenario.parameters.items() if "[" not in k})
@@ -139,28 +167,38 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
         k_healthy = tuple(scenario.parameters.get(f"k_pair[{i}]", fmu.variable(f"k_pair[{i}]").start)
                           for i in range(1, 12))
         state = model.initial_state(geometry)
-        if resume and path is not None and path.exists():
-            stages, state = _load_for_resume(path, model, model_name, geometry)
+        source = next((p for p in (partial, path) if p is not None and p.exists()), None) if resume else None
+        if source is not None:     # the partial output, else a complete one to extend (a later stop)
+            stages, state = _load_for_resume(source, model, model_name, geometry, identity)
+        elif resume and path is not None:
+            print(f"note: neither {partial} nor {path} exists; the run starts from the beginning")
         t0 = scenario.start_time
         inputs = {n: p(t0) for n, p in scenario.inputs.items()}
         params = dict(scenario.parameters)
         if stages:
             params.update(stages[-1].parameters)
         from twin.operating import consistent_start
-        fmu.setup(t0, parameters=consistent_start(params, inputs, [v.name for v in fmu.parameters]), inputs=inputs)
+        start = consistent_start(params, inputs, [v.name for v in fmu.parameters])
+        check_parameters(fmu, start)
+        fmu.setup(t0, parameters=start, inputs=inputs)
         fmu.capture(t0 + 0.05, dt, ["mesh_force"])        # settle the lateral static deflection
         bar = progress_bar(max_updates, progress, f"{scenario.name} stages", "stage")
         bar.update(len(stages))
         try:
             for u in range(len(stages), max_updates):
+                _interrupt.check()
                 t = fmu.time
                 names = [*ROLL, *FORCE, "motor_speed"]
                 block = fmu.capture(t + window, dt, names)
+                check_block(names, block, {}, t0=t + dt, dt=dt, load=inputs.get("load_torque"),
+                            contact=block[:, 3:6].sum(axis=1))
                 load = MeshLoad.from_samples(block[:, 0:3], block[:, 3:6])
                 omega1 = float(np.mean(block[:, 6]))
                 vib = {}
                 if rec_dur > 0:
                     snip = fmu.capture(fmu.time + rec_dur, dt, list(channels))
+                    check_block(list(channels), snip, {c: fmu.variables[c].unit for c in channels},
+                                t0=fmu.time - rec_dur, dt=dt)
                     vib = {c: snip[:, j].astype(np.float32) for j, c in enumerate(channels)}
                 damage, dmax, xi, fld = _damage(model_name, state)
                 current = {f"k_pair[{i}]": fmu.get(f"k_pair[{i}]") for i in range(1, 12)}
@@ -169,8 +207,8 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
                 stages.append(Stage(u, float(state.cycles), damage, dmax, current, np.asarray(xi), np.asarray(fld),
                                     trunc, vib))
                 bar.update(1)
-                if path is not None:
-                    _write(path, scenario, model_name, stages, dt, complete=False, state=state)
+                if partial is not None:
+                    _write(partial, scenario, model_name, stages, dt, complete=False, state=state, identity=identity)
                 if _stop_reached(spec, model_name, damage, state.cycles):
                     complete = True
                     break
@@ -194,12 +232,16 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
             bar.close()
     run = DegradationRun(scenario, model_name, tuple(stages), complete, scenario.sample_rate)
     if path is not None and stages:
-        _write(path, scenario, model_name, stages, dt, complete=complete, state=None)
+        if complete:
+            _write(path, scenario, model_name, stages, dt, complete=True, state=None, identity=identity)
+            partial.unlink(missing_ok=True)
+        else:
+            _write(partial, scenario, model_name, stages, dt, complete=False, state=None, identity=identity)
     return run
 
 
 def _write(path: Path, scenario: Scenario, model_name: str, stages: list[Stage], dt: float, *, complete: bool,
-           state) -> None:
+           state, identity: str) -> None:
     import h5py
 
     from twin._atomic import atomic_path
@@ -209,6 +251,7 @@ def _write(path: Path, scenario: Scenario, model_name: str, stages: list[Stage],
             f.attrs["format_version"] = 1
             f.attrs["model"] = model_name
             f.attrs["complete"] = complete
+            f.attrs["run_identity"] = identity
             f.attrs["sample_rate"] = 1.0 / dt
             f.attrs["damage_unit"] = "1" if model_name == "pitting" else "m"
             f.create_group("scenario").attrs["json"] = json.dumps(scenario.raw, default=str)
@@ -228,18 +271,31 @@ def _write(path: Path, scenario: Scenario, model_name: str, stages: list[Stage],
                     sg.create_dataset(f"vibration/{c}", data=v, compression="gzip", compression_opts=4)
 
 
-def _load_for_resume(path: Path, model, model_name: str, geometry):
+def _load_for_resume(path: Path, model, model_name: str, geometry, identity: str):
     import h5py
+
+    from twin.errors import ResumeError
     stages = []
-    with h5py.File(path, "r") as f:
-        if f.attrs.get("format") != "gear-twin-degradation" or f.attrs.get("model") != model_name:
-            raise SimulationError(f"{path} is not a {model_name} degradation record; cannot resume from it")
-        for key in f["stages"]:
-            sg = f["stages"][key]
-            vib = {c: sg["vibration"][c][:] for c in sg.get("vibration", {})}
-            stages.append(Stage(int(key), float(sg.attrs["cycles"]), float(sg.attrs["damage"]),
-                                float(np.max(sg["field"][:])), json.loads(sg.attrs["parameters"]),
-                                sg["field_xi"][:], sg["field"][:], json.loads(sg.attrs["truncation_error"]), vib))
+    try:
+        with h5py.File(path, "r") as f:
+            if f.attrs.get("format") != "gear-twin-degradation" or f.attrs.get("model") != model_name:
+                raise ResumeError(f"'{path}' is not a {model_name} degradation record; cannot resume from it")
+            if f.attrs.get("run_identity") != identity:
+                raise ResumeError(f"'{path}' was written by another scenario or FMU (its run identity differs); "
+                                  "resume refused; remove it or choose another --output")
+            for key in f["stages"]:
+                sg = f["stages"][key]
+                vib = {c: sg["vibration"][c][:] for c in sg.get("vibration", {})}
+                stages.append(Stage(int(key), float(sg.attrs["cycles"]), float(sg.attrs["damage"]),
+                                    float(np.max(sg["field"][:])), json.loads(sg.attrs["parameters"]),
+                                    sg["field_xi"][:], sg["field"][:], json.loads(sg.attrs["truncation_error"]), vib))
+    except ResumeError:
+        raise
+    except (OSError, KeyError, ValueError, TypeError) as exc:
+        raise ResumeError(f"cannot resume from '{path}': the file is damaged or not a degradation record "
+                          f"({type(exc).__name__}: {exc})") from None
+    if not stages:
+        raise ResumeError(f"cannot resume from '{path}': it holds no stage")
     last = stages[-1]
     state = model.state_from_field(geometry, last.cycles, last.field_xi, last.field)
     # the last stage is re-run from its state so its update is applied again

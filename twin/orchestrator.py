@@ -10,8 +10,13 @@ One explicit loop over communication steps::
 
 Before running, the FMU's model description is checked against what the scenario needs
 (variables by name, causality, variability, type); every mismatch is listed in one
-:class:`~twin.errors.FMUCompatibilityError`.  Ctrl-C stops after the current step and the
-samples recorded so far are still written (marked ``complete = False``).
+:class:`~twin.errors.FMUCompatibilityError`.  Parameter values that make no physical sense
+are refused before the run, and a run that leaves physics (:mod:`twin.plausibility`) is a
+:class:`~twin.errors.SimulationError`, not a result.
+
+Only a complete run replaces the output file (atomically).  Ctrl-C stops after the current
+step; the samples recorded so far go to ``<stem>.partial<suffix>`` beside the output (marked
+``complete = False``) and the output itself is left as it was.
 """
 from __future__ import annotations
 
@@ -104,9 +109,15 @@ def run_scenario(scenario: Scenario, output: str | Path | None = None, *, fmu_pa
                  hooks: Sequence[Hook] = (), progress: bool = True) -> RunRecord:
     """Run ``scenario``; write the result to ``output`` (HDF5) if given.
 
-    Returns a :class:`RunRecord`. On Ctrl-C the partial result is written and returned with
-    ``complete=False``.
+    Returns a :class:`RunRecord`.  A complete run replaces ``output`` atomically and removes a
+    partial file left by an earlier interrupted run.  On Ctrl-C the partial result is written
+    to :func:`~twin._atomic.partial_path` of ``output`` (``output`` is left untouched) and
+    returned with ``complete=False``.
     """
+    from twin import _interrupt
+    from twin._atomic import partial_path
+    from twin.plausibility import DEFAULT_LIMITS, check_block, check_parameters, contact_channels
+
     path = Path(output) if output is not None else None
     if path is not None:
         from twin.results import check_output_path
@@ -116,10 +127,13 @@ def run_scenario(scenario: Scenario, output: str | Path | None = None, *, fmu_pa
     with FMU(fmu_file) as fmu:
         check_compatibility(fmu, scenario)
         names = list(scenario.outputs) if scenario.outputs else [v.name for v in fmu.outputs]
+        # the pair forces are sampled too (not stored) so a run with the flanks apart is caught
+        captured = names + [n for n in contact_channels(fmu.variables) if n not in names]
         t0 = scenario.start_time
         inputs_now = {n: p(t0) for n, p in scenario.inputs.items()}
         from twin.operating import consistent_start
         start = consistent_start(scenario.parameters, inputs_now, [v.name for v in fmu.parameters])
+        check_parameters(fmu, start)
         fmu.setup(t0, parameters=start, inputs=inputs_now)
         initial = {n: fmu.get(n) for n in required_variables(scenario)
                    if fmu.variables[n].causality in ("parameter", "input")}
@@ -128,7 +142,7 @@ def run_scenario(scenario: Scenario, output: str | Path | None = None, *, fmu_pa
         dt = scenario.output_interval
         n_steps = int(round((scenario.stop_time - t0) / h))
         per_step = int(round(h / dt))
-        blocks = [np.asarray(fmu.get(names)).reshape(1, -1)]
+        blocks = [np.asarray(fmu.get(captured)).reshape(1, -1)]
         overrides: dict[str, float] = {}
         biases: dict[str, float] = {}
         events = list(scenario.events)
@@ -137,6 +151,7 @@ def run_scenario(scenario: Scenario, output: str | Path | None = None, *, fmu_pa
         complete = True
         try:
             for k in range(n_steps):
+                _interrupt.check()
                 t = t0 + k * h
                 while events and events[0].time <= t + 1e-9 * h:
                     e = events.pop(0)
@@ -154,7 +169,7 @@ def run_scenario(scenario: Scenario, output: str | Path | None = None, *, fmu_pa
                 ctx.time, ctx.step = t, k
                 for hook in hooks:
                     hook(ctx)
-                blocks.append(fmu.capture(t0 + (k + 1) * h, dt, names))
+                blocks.append(fmu.capture(t0 + (k + 1) * h, dt, captured))
                 bar.update(per_step)
             # events at exactly stop_time change nothing simulated but are applied and logged
             while events and events[0].time <= scenario.stop_time + 1e-9 * h:
@@ -165,13 +180,36 @@ def run_scenario(scenario: Scenario, output: str | Path | None = None, *, fmu_pa
             bar.close()
         data = np.concatenate(blocks)
         time = t0 + dt * np.arange(data.shape[0])
+        if complete:
+            check_block(captured, data, {n: fmu.variables[n].unit for n in captured}, t0=t0, dt=dt,
+                        load=_held_load(scenario), contact=_contact(captured, data), limits=DEFAULT_LIMITS)
+        data = data[:, :len(names)]
         result = SimulationResult(time=time, signals={n: data[:, j].copy() for j, n in enumerate(names)},
                                   units={n: fmu.variables[n].unit for n in names}, sample_rate=scenario.sample_rate,
                                   parameters=start_parameters, model_name=fmu.model_name, guid=fmu.guid,
                                   fmu_sha256=fmu.sha256)
+    written = None
     if path is not None:
-        write_hdf5(result, path, extra=lambda f: _write_run_groups(f, scenario, complete, applied, ctx.store))
-    return RunRecord(scenario, result, complete, path, tuple(applied))
+        written = path if complete else partial_path(path)
+        write_hdf5(result, written, extra=lambda f: _write_run_groups(f, scenario, complete, applied, ctx.store))
+        if complete:
+            partial_path(path).unlink(missing_ok=True)
+    return RunRecord(scenario, result, complete, written, tuple(applied))
+
+
+def _held_load(scenario: Scenario) -> float | None:
+    """The smallest brake load [N.m] over the run when the scenario holds one (no event changes
+    it), else None: only then must the flanks stay in contact at some time."""
+    prof = scenario.inputs.get("load_torque")
+    if prof is None or any("load_torque" in {*e.override, *e.bias, *e.reset} for e in scenario.events):
+        return None
+    t = np.linspace(scenario.start_time, scenario.stop_time, 64)
+    return float(np.min(np.abs([prof(x) for x in t])))
+
+
+def _contact(names: list[str], data: np.ndarray) -> np.ndarray | None:
+    idx = [names.index(n) for n in ("pair_force[1]", "pair_force[2]", "pair_force[3]") if n in names]
+    return data[:, idx].sum(axis=1) if len(idx) == 3 else None
 
 
 def _apply_event(fmu: FMU, e, initial, overrides, biases) -> list[tuple[float, str]]:

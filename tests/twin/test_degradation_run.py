@@ -80,9 +80,11 @@ def test_interrupt_keeps_completed_stages(gearbox_fmu, tmp_path, monkeypatch):
         return real(self, *a, **k)
 
     monkeypatch.setattr(dr.FMU, "capture", flaky)
+    (tmp_path / "i.h5").write_bytes(b"an earlier result")
     run = run_degradation(_lubricated(), tmp_path / "i.h5", fmu_path=gearbox_fmu, progress=False)
     assert not run.complete and len(run.stages) >= 2
-    with h5py.File(tmp_path / "i.h5") as f:
+    assert (tmp_path / "i.h5").read_bytes() == b"an earlier result"     # only a complete run replaces it
+    with h5py.File(tmp_path / "i.partial.h5") as f:
         assert not f.attrs["complete"] and len(f["stages"]) == len(run.stages)
 
 

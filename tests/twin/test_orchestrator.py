@@ -67,8 +67,9 @@ def test_missing_variables_are_listed(two_mass_fmu):
     assert len(m) == 4
 
 
-def test_ctrl_c_keeps_what_was_recorded(two_mass_fmu, tmp_path):
-    out = tmp_path / "partial.h5"
+def test_ctrl_c_keeps_what_was_recorded_beside_the_output(two_mass_fmu, tmp_path):
+    out = tmp_path / "run.h5"
+    out.write_bytes(b"an earlier result")
 
     def interrupt(ctx):
         if ctx.step == 4:
@@ -77,9 +78,13 @@ def test_ctrl_c_keeps_what_was_recorded(two_mass_fmu, tmp_path):
     rec = run_scenario(_scenario(two_mass_fmu), out, hooks=[interrupt], progress=False)
     assert not rec.complete
     assert rec.result.time[-1] == pytest.approx(0.4)
-    with h5py.File(out) as f:
+    assert rec.path == tmp_path / "run.partial.h5"
+    assert out.read_bytes() == b"an earlier result"      # only a complete run replaces it
+    with h5py.File(rec.path) as f:
         assert not f.attrs["complete"]
         assert f["time"].shape == (41,)
+    done = run_scenario(_scenario(two_mass_fmu), out, progress=False)
+    assert done.complete and done.path == out and not rec.path.exists()
 
 
 def test_event_on_a_recorded_output_is_refused(two_mass_fmu):
