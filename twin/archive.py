@@ -59,11 +59,13 @@ class RecordTask:
 def simulate_record(task: RecordTask) -> dict[str, np.ndarray]:
     """Simulate one archive record; returns channel -> (n,) float32 array (noise added)."""
     from twin.fmu import FMU
+    from twin.plausibility import checked_capture
     with FMU(task.fmu_path) as fmu:
         fmu.setup(0.0, parameters=task.parameters, inputs=task.inputs)
         if task.settle_time > 0:
             fmu.capture(task.settle_time, task.output_interval, list(task.channels))
-        block = fmu.capture(task.settle_time + task.duration, task.output_interval, list(task.channels))
+        block = checked_capture(fmu, task.settle_time + task.duration, task.output_interval, task.channels,
+                                load=task.inputs.get("load_torque"), constant_inputs=True)
     rng = np.random.default_rng(task.seed)
     out = {}
     for j, c in enumerate(task.channels):

@@ -48,15 +48,24 @@ def simulate_operating_point(fmu_path: str | Path, speed_hz: float, load_nm: flo
     """Run at a steady operating point; discard ``settle`` s, return the next ``duration`` s.
 
     Returns shape (round(duration / output_interval), len(channels)).
+
+    The run is judged physically (:mod:`twin.plausibility`): parameters that make no sense
+    are a :class:`~twin.errors.ParameterError`; flanks apart for the whole window at load,
+    accelerations beyond the bound or vibration growing at these constant inputs are a
+    :class:`~twin.errors.SimulationError`.
     """
     from twin.fmu import FMU
+    from twin.plausibility import check_parameters, checked_capture
 
     start, inputs = operating_point(speed_hz, load_nm)
     with FMU(fmu_path) as fmu:
-        fmu.setup(0.0, parameters={**(parameters or {}), **start}, inputs=inputs)
+        params = {**(parameters or {}), **start}
+        check_parameters(fmu, params)
+        fmu.setup(0.0, parameters=params, inputs=inputs)
         if settle > 0:
             fmu.capture(settle, output_interval, list(channels))
-        return fmu.capture(settle + duration, output_interval, list(channels))
+        return checked_capture(fmu, settle + duration, output_interval, channels, load=load_nm,
+                               constant_inputs=True)
 
 
 @dataclass(frozen=True)
