@@ -116,11 +116,21 @@ def evaluate_candidate(task: EvalTask) -> tuple[np.ndarray, dict]:
     return np.array([values[o] for o in tg.objectives]), info
 
 
-def _guarded_eval(task: EvalTask):
+def _guarded_eval(task: EvalTask, evaluate=None):
     try:
-        return evaluate_candidate(task)
+        return (evaluate or evaluate_candidate)(task)
     except Exception as exc:  # an FMU failure scores the candidate infeasible, it does not end the run
         return exc
+
+
+@dataclass(frozen=True)
+class _Evaluation:
+    """Picklable ``task -> objectives`` for the executor's workers: ``evaluate`` or the default."""
+
+    evaluate: object = None
+
+    def __call__(self, task: EvalTask):
+        return _guarded_eval(task, self.evaluate)
 
 
 @dataclass(frozen=True)
@@ -145,8 +155,14 @@ class ParameterSpace:
 
 
 def make_problem(fmu_path: Path, space: ParameterSpace, target: CalibrationTarget, *, executor,
-                 settle: float = 0.1, duration: float = 0.3, fixed: Mapping[str, float] | None = None):
-    """A pymoo Problem with the target's objectives and 1 constraint (evaluation failed)."""
+                 settle: float = 0.1, duration: float = 0.3, fixed: Mapping[str, float] | None = None,
+                 evaluate=None):
+    """A pymoo Problem with the target's objectives and 1 constraint (evaluation failed).
+
+    ``evaluate`` (a picklable top-level function ``EvalTask -> (objectives, info)``) replaces
+    :func:`evaluate_candidate`.  An evaluation that raises, or whose worker process dies or hangs
+    past the executor's time limit, is logged with its parameters and the signal or error, and
+    scored infeasible."""
     from pymoo.core.problem import Problem
 
     shaft_hz = target.measured_shaft_hz if target.needs_simulation else target.drive_hz   # once, not per candidate
@@ -161,7 +177,7 @@ def make_problem(fmu_path: Path, space: ParameterSpace, target: CalibrationTarge
         def _evaluate(self, X, out, *args, **kwargs):
             tasks = [EvalTask(str(fmu_path), {**(fixed or {}), **space.to_dict(x)}, target, settle, duration,
                               shaft_hz) for x in X]
-            results = executor.map(_guarded_eval, tasks, desc="calibration evaluations")
+            results = executor.map(_Evaluation(evaluate), tasks, desc="calibration evaluations")
             F = np.empty((len(X), len(target.objectives)))
             G = np.zeros((len(X), 1))
             for i, r in enumerate(results):
@@ -196,7 +212,8 @@ def calibrate(fmu_path: Path, space: ParameterSpace, target: CalibrationTarget, 
               pop_size: int = 20, n_gen: int = 10, seed: int = 0, executor=None, checkpoint: Path | None = None,
               settle: float = 0.1, duration: float = 0.3, fixed: Mapping[str, float] | None = None,
               verbose: bool = False, resume: bool = False, refine: bool = False,
-              nominal: Mapping[str, float] | None = None) -> CalibrationResult:
+              nominal: Mapping[str, float] | None = None, evaluate=None,
+              identity: str | None = None) -> CalibrationResult:
     """Calibrate ``space`` against ``target`` with MOGOA or NSGA-II (see the module docstring).
 
     ``refine`` polishes the pick on the modes alone: with the "modes" objective by the fit in
@@ -206,24 +223,106 @@ def calibrate(fmu_path: Path, space: ParameterSpace, target: CalibrationTarget, 
     With ``resume=True`` and an existing ``checkpoint``, the run continues: the last checkpointed
     generation seeds the population and only the remaining generations are run. The evaluation
     history carries over. The random stream restarts, so a resumed run is not bit-identical to an
-    uninterrupted one.
-    """
-    from pymoo.algorithms.moo.nsga2 import NSGA2
-    from pymoo.optimize import minimize
+    uninterrupted one.  The checkpoint holds ``identity`` (default: :func:`calibration_identity`
+    of the FMU, space, target and settings); a checkpoint of another calibration is refused with
+    a :class:`~twin.errors.ResumeError` instead of being continued.
 
-    from twin.calibration import MOGOA, knee_point, least_crowded
+    ``evaluate`` replaces :func:`evaluate_candidate` (see :func:`make_problem`).
+    """
     from twin.executor import LocalExecutor
 
     if algorithm not in ("mogoa", "nsga2"):
         raise ParameterError(f"algorithm must be 'mogoa' or 'nsga2', got {algorithm!r}")
+    check_calibration_parameters(fmu_path, space, fixed)
+    if identity is None:
+        identity = calibration_identity(fmu_path, space, target, algorithm=algorithm, pop_size=pop_size,
+                                        seed=seed, settle=settle, duration=duration, fixed=fixed)
+    own = executor is None
     ex = executor or LocalExecutor(1)
-    problem = make_problem(Path(fmu_path), space, target, executor=ex, settle=settle, duration=duration, fixed=fixed)
+    try:
+        return _calibrate(fmu_path, space, target, ex, algorithm=algorithm, pop_size=pop_size, n_gen=n_gen, seed=seed,
+                          checkpoint=checkpoint, settle=settle, duration=duration, fixed=fixed, verbose=verbose,
+                          resume=resume, refine=refine, nominal=nominal, evaluate=evaluate, identity=identity)
+    finally:
+        if own:
+            ex.close()
+
+
+def calibration_identity(fmu_path: Path, space: ParameterSpace, target: CalibrationTarget, **settings) -> str:
+    """SHA-256 over what decides a calibration's evaluations: the FMU file, the bounds, the
+    measured target and the settings (algorithm, population, seed, windows, fixed parameters)."""
+    import hashlib
+    h = hashlib.sha256()
+    with open(fmu_path, "rb") as f:
+        for chunk in iter(lambda: f.read(1 << 20), b""):
+            h.update(chunk)
+    fields = {k: getattr(target, k) for k in ("sample_rate", "drive_hz", "load", "channel", "fmin", "fmax", "shaft_hz",
+                                              "teeth", "objectives") if hasattr(target, k)}
+    h.update(json.dumps({"names": list(space.names), "lower": space.lower.tolist(), "upper": space.upper.tolist(),
+                         "settings": {k: (dict(v) if isinstance(v, Mapping) else v) for k, v in settings.items()},
+                         "target": fields,
+                         "modes": np.asarray(target.natural_frequencies, float).tolist()},
+                        sort_keys=True, default=str).encode())
+    h.update(np.ascontiguousarray(np.asarray(target.signal, dtype=np.float64)).tobytes())
+    return h.hexdigest()
+
+
+def check_calibration_parameters(fmu_path: Path, space: ParameterSpace, fixed: Mapping[str, float] | None) -> None:
+    """Refuse, before the first evaluation, names the FMU does not have as Real parameters and
+    bounds or values that make no physical sense (a negative stiffness, damping, mass, ...)."""
+    from twin.fmu import FMU
+    from twin.plausibility import physical_problems
+    with FMU(fmu_path) as fmu:
+        variables = fmu.variables
+        problems = []
+        for name in [*space.names, *(fixed or {})]:
+            v = variables.get(name)
+            if v is None:
+                close = [n for n in variables if name.lower() in n.lower()][:5]
+                problems.append(f"{fmu.model_name} has no parameter {name!r}" + (f" (similar: {', '.join(close)})"
+                                                                                if close else ""))
+            elif v.causality != "parameter" or v.type != "Real":
+                problems.append(f"{name!r} is a {v.type} {v.causality}, not a Real parameter")
+        units = {n: v.unit for n, v in variables.items()}
+    for name, lo in zip(space.names, space.lower):
+        problems += physical_problems({name: float(lo)}, units, what="lower bound of")
+    problems += physical_problems(dict(fixed or {}), units)
+    if problems:
+        raise ParameterError("calibration refused before the first evaluation: " + "; ".join(problems))
+
+
+def _read_checkpoint(checkpoint: Path) -> dict:
+    from twin.errors import ResumeError
+    try:
+        ck = json.loads(Path(checkpoint).read_text())
+        int(ck["generation"])
+        list(ck["history"])
+    except OSError as exc:
+        raise ResumeError(f"cannot read checkpoint '{checkpoint}': {exc.strerror or exc}") from None
+    except (ValueError, KeyError, TypeError) as exc:
+        raise ResumeError(f"checkpoint '{checkpoint}' is damaged or not a calibration checkpoint "
+                          f"({type(exc).__name__}: {exc}); delete it to start afresh") from None
+    return ck
+
+
+def _calibrate(fmu_path, space, target, ex, *, algorithm, pop_size, n_gen, seed, checkpoint, settle, duration, fixed,
+               verbose, resume, refine, nominal, evaluate, identity) -> CalibrationResult:
+    from pymoo.algorithms.moo.nsga2 import NSGA2
+    from pymoo.optimize import minimize
+
+    from twin.calibration import MOGOA, knee_point, least_crowded
+    from twin.errors import ResumeError
+    problem = make_problem(Path(fmu_path), space, target, executor=ex, settle=settle, duration=duration, fixed=fixed,
+                           evaluate=evaluate)
     done, sampling = 0, None
     if resume and checkpoint is not None and Path(checkpoint).exists():
-        ck = json.loads(Path(checkpoint).read_text())
+        ck = _read_checkpoint(Path(checkpoint))
         if ck.get("names") != list(space.names) or ck.get("algorithm") != algorithm:
-            raise ParameterError(f"checkpoint {checkpoint} is for {ck.get('algorithm')} over {ck.get('names')}, "
-                                 f"not {algorithm} over {list(space.names)}")
+            raise ResumeError(f"checkpoint {checkpoint} is for {ck.get('algorithm')} over {ck.get('names')}, "
+                              f"not {algorithm} over {list(space.names)}")
+        if ck.get("identity") != identity:
+            raise ResumeError(f"checkpoint {checkpoint} belongs to another calibration (its FMU, bounds, "
+                              "measurement or settings differ); resume refused; remove it or use another --out")
         done = int(ck["generation"])
         problem.history.extend(ck["history"])
         sampling = np.array([h["x"] for h in ck["history"][-pop_size:]])
@@ -238,7 +337,7 @@ def calibrate(fmu_path: Path, space: ParameterSpace, target: CalibrationTarget, 
             return
         from twin._atomic import atomic_path
         data = {"algorithm": algorithm, "generation": done + int(alg.n_gen), "names": list(space.names),
-                "history": problem.history}
+                "identity": identity, "history": problem.history}
         with atomic_path(checkpoint) as tmp:
             Path(tmp).write_text(json.dumps(data))
 

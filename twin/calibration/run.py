@@ -17,6 +17,7 @@ Scenario block (every key but ``parameters`` optional)::
       settle_time: 0.1
       band: [10, 5000]            # Hz, spectrum objective
       refine: true                # polish the pick by least squares on the modes (default)
+      evaluation_timeout: 600     # s; an evaluation still running then is stopped, scored infeasible
 
 ``parameters: auto`` chooses the parameters the measured modes can identify, with bounds from
 physics (:mod:`twin.calibration.sensitivity`). The default objectives are the paper's
@@ -145,7 +146,7 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
     from twin.calibration.objectives import match_modes
     from twin.calibration.output import write_calibrated_scenario
     from twin.calibration.problem import (CalibrationTarget, EvalTask, ParameterSpace, calibrate,
-                                          evaluate_candidate, write_parameter_set)
+                                          check_calibration_parameters, evaluate_candidate, write_parameter_set)
     from twin.calibration.report import psd_overlay, write_html, write_pareto
     from twin.calibration.sensitivity import model_modes, mode_sensitivity
     from twin.executor import make_executor
@@ -190,7 +191,11 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
                                objectives=objectives, mode_rel_sd=rel_sd)
     fmu = scenario.fmu_path()
     fixed = dict(scenario.parameters)
-    ex = executor or make_executor(scenario.executor)
+    if not auto:       # unknown or non-physical names and bounds: refused before the first evaluation
+        check_calibration_parameters(fmu, ParameterSpace.from_bounds(spec["parameters"]),
+                                     {k: v for k, v in fixed.items() if k not in spec["parameters"]})
+    timeout = float(spec.get("evaluation_timeout", scenario.executor.get("timeout", 600.0)))
+    ex = executor or make_executor({**scenario.executor, "timeout": timeout})
     try:
         sensitivity = None
         if auto:

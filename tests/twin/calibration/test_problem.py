@@ -9,7 +9,7 @@ import pytest
 
 from twin.calibration.problem import (CalibrationTarget, EvalTask, ParameterSpace, calibrate, evaluate_candidate,
                                       write_parameter_set)
-from twin.errors import ParameterError
+from twin.errors import ParameterError, ResumeError
 from twin.executor import LocalExecutor
 from twin.fmu import FMU
 from twin.linearize import natural_frequencies
@@ -35,14 +35,13 @@ def test_truth_scores_near_zero_and_defaults_do_not(gearbox_fmu, target):
     assert f_def[2] > 100 * max(f_true[2], 1e-3)
 
 
-def test_calibration_moves_towards_truth_and_survives_failures(gearbox_fmu, target, tmp_path):
-    # m5 down to -0.5 kg makes part of the space non-physical: those runs fail and must be infeasible
-    space = ParameterSpace.from_bounds({"kt12": [1000.0, 2500.0], "m5": [-0.5, 1.0]})
+def test_calibration_moves_towards_truth(gearbox_fmu, target, tmp_path):
+    # failing and crashing evaluations are scored infeasible: tests/robustness/test_isolation.py
+    space = ParameterSpace.from_bounds({"kt12": [1000.0, 2500.0], "m5": [0.2, 1.0]})
     res = calibrate(gearbox_fmu, space, target, algorithm="nsga2", pop_size=6, n_gen=3, seed=1,
                     executor=LocalExecutor(2), settle=0.1, duration=0.2, fixed={"c_mesh": TRUTH["c_mesh"]},
                     checkpoint=tmp_path / "ckpt.json")
     assert res.n_evals == 18
-    assert res.failed_evals >= 1
     assert np.all(np.isfinite(res.F)) and res.F[:, 2].min() < 1e3
     assert set(res.chosen) == {"kt12", "m5"} and res.chosen["m5"] > 0
     ck = json.loads((tmp_path / "ckpt.json").read_text())
@@ -72,9 +71,12 @@ def test_resume_continues_from_the_checkpoint(gearbox_fmu, target, tmp_path):
     res = calibrate(gearbox_fmu, space, target, n_gen=4, resume=True, **common)
     data = json.loads(ck.read_text())
     assert data["generation"] == 4 and res.n_evals == 16
-    with pytest.raises(ParameterError, match="checkpoint"):
+    with pytest.raises(ResumeError, match="checkpoint"):
         calibrate(gearbox_fmu, ParameterSpace.from_bounds({"I1": [3e-3, 6e-3]}), target, n_gen=3, resume=True,
                   **common)
+    with pytest.raises(ResumeError, match="another calibration"):     # same names, other bounds
+        calibrate(gearbox_fmu, ParameterSpace.from_bounds({"kt12": [1200.0, 2500.0]}), target, n_gen=5,
+                  resume=True, **common)
 
 
 def test_refinement_recovers_the_modes(gearbox_fmu, target):
