@@ -79,9 +79,11 @@ def _count_outputs(fmu: Path) -> int:
         return 1
 
 
-def check_assignments(fmu: Path, parameters: dict[str, float], inputs: dict[str, float]) -> None:
+def check_assignments(fmu: Path, parameters: dict[str, float], inputs: dict[str, float], *,
+                      values: dict[str, float] | None = None) -> None:
     """Refuse ``--param`` names that are not parameters, ``--input`` names that are not inputs,
-    and values that make no physical sense, before the FMU is loaded."""
+    and values that make no physical sense (of ``values`` too: start values from other
+    sources), before the FMU is loaded."""
     from twin.fmu import FMU
     from twin.plausibility import physical_problems
     with FMU(fmu) as f:
@@ -98,7 +100,8 @@ def check_assignments(fmu: Path, parameters: dict[str, float], inputs: dict[str,
                                     f"{v.causality}, not a{'n' if causality == 'input' else ''} {causality}"
                                     + (" (use --input)" if v.causality == "input" else
                                        " (use --param)" if v.causality == "parameter" else ""))
-        problems += physical_problems({**parameters, **inputs}, {n: v.unit for n, v in f.variables.items()})
+        problems += physical_problems({**(values or {}), **parameters, **inputs},
+                                      {n: v.unit for n, v in f.variables.items()})
     if problems:
         raise ParameterError("; ".join(problems))
 

@@ -14,7 +14,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from types import ModuleType
 
-from twin.errors import ParameterError, TwinError
+from twin.errors import ParameterError, TwinError, WorkerCrashError
 
 DEFAULT_MODEL = "GearTwin.Gearbox21"
 #: Measured natural frequencies [Hz] of the test rig (paper, Table 2).
@@ -158,15 +158,42 @@ def _fmpy_simulate_values(args: argparse.Namespace, parameters: dict, outputs: l
     return {**parameters, **pairs}, outputs
 
 
+def _simulate_in_child(args: argparse.Namespace, fmu: Path, options: dict, target: Path) -> str:
+    results = _lib("twin.results")
+    if args.input_file:
+        inputs_lib = _lib("twin.inputs")
+        result = inputs_lib.simulate_with_inputs(fmu, inputs_lib.InputTable.read(args.input_file), **options)
+    else:
+        result = _lib("twin.fmu").simulate_fmu(fmu, **options)
+    _lib("twin.plausibility").check_result(result, load=options["inputs"].get("load_torque"),
+                                           constant_inputs=not args.input_file)
+    written = results.write_result(result, target)
+    lines = []
+    if args.show_plot:
+        channels = list(result.signals)[:12]
+        png = _lib("twin.plotting").plot_time(result, channels, Path(written).with_suffix(".png"),
+                                              float(result.time[0]), float(result.time[-1]), title=result.model_name)
+        lines.append(f"plot of {len(channels)} channel(s) -> {png}")
+    n = len(result.time)
+    span = f"t=[{result.time[0]:.6g}, {result.time[-1]:.6g}] s" if n else "no samples"
+    lines.append(f"wrote {written}: {n} samples x {len(result.signals)} channels, "
+                 f"{span}, {result.sample_rate:.6g} Hz")
+    return "\n".join(lines)
+
+
 def _cmd_simulate(args: argparse.Namespace) -> int:
-    parameters = parse_assignments(args.param, "--param")
+    given = parse_assignments(args.param, "--param")
     inputs = parse_assignments(args.input, "--input")
     outputs = [s.strip() for s in args.outputs.split(",") if s.strip()] if args.outputs else None
-    parameters, outputs = _fmpy_simulate_values(args, parameters, outputs)
+    parameters, outputs = _fmpy_simulate_values(args, given, outputs)
     results = _lib("twin.results")
-    # Reject a bad output path before a possibly long simulation, not after it.
+    # Reject a bad output path, bad times and names before a possibly long simulation, not after it.
     target = results.check_output_path(args.output)
     fmu, parameters = _ssp_or_fmu(args.fmu, parameters)
+    checks = _lib("twin.checks")
+    checks.check_times(args.start_time, args.stop_time, args.output_interval,
+                       n_channels=len(outputs) if outputs else None, fmu=fmu)
+    checks.check_assignments(fmu, given, inputs, values=parameters)
     if args.validate:
         problems = _lib("twin.fmu").validate(fmu)
         if problems:
@@ -174,21 +201,9 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
                                                 + "\n  ".join(problems))
     options = dict(stop_time=args.stop_time, start_time=args.start_time, output_interval=args.output_interval,
                    outputs=outputs, parameters=parameters, inputs=inputs, progress=not args.no_progress)
-    if args.input_file:
-        inputs_lib = _lib("twin.inputs")
-        result = inputs_lib.simulate_with_inputs(fmu, inputs_lib.InputTable.read(args.input_file), **options)
-    else:
-        result = _lib("twin.fmu").simulate_fmu(fmu, **options)
-    written = results.write_result(result, target)
-    if args.show_plot:
-        channels = list(result.signals)[:12]
-        png = _lib("twin.plotting").plot_time(result, channels, Path(written).with_suffix(".png"),
-                                              float(result.time[0]), float(result.time[-1]), title=result.model_name)
-        print(f"plot of {len(channels)} channel(s) -> {png}")
-    n = len(result.time)
-    span = f"t=[{result.time[0]:.6g}, {result.time[-1]:.6g}] s" if n else "no samples"
-    print(f"wrote {written}: {n} samples x {len(result.signals)} channels, "
-          f"{span}, {result.sample_rate:.6g} Hz")
+    # the FMU runs in a child process: a crash inside it is reported, not fatal to the CLI
+    print(_lib("twin.isolation").run_isolated(_simulate_in_child, args, fmu, options, target,
+                                              what=f"FMU {fmu}", timeout=args.timeout))
     return 0
 
 
@@ -202,6 +217,20 @@ def _cmd_schema(args: argparse.Namespace) -> int:
     return 0
 
 
+def _run_in_child(scenario, out: Path, progress: bool, resume: bool) -> tuple[str, int]:
+    if scenario.degradation is not None:
+        run = _lib("twin.degradation_run").run_degradation(scenario, out, progress=progress, resume=resume)
+        if not run.stages:
+            return f"{scenario.name}: interrupted before the first stage; nothing written", 130
+        where = out if run.complete else _lib("twin._atomic").partial_path(out)
+        state = "complete" if run.complete else "not complete, kept for --resume"
+        return f"{scenario.name}: {len(run.stages)} stages ({state}), {run.summary()} -> {where}", 0 if run.complete else 130
+    rec = _lib("twin.orchestrator").run_scenario(scenario, out, progress=progress)
+    state = "complete" if rec.complete else f"interrupted; partial result kept beside, {out} unchanged"
+    return (f"{scenario.name}: {rec.result.time.size} samples of {len(rec.result.signals)} channels "
+            f"({state}) -> {rec.path}", 0 if rec.complete else 130)
+
+
 def _cmd_run(args: argparse.Namespace) -> int:
     scenarios = _lib("twin.scenario")
     if args.scenario.endswith(".ssp"):       # an SSP runs as it is, over its default experiment
@@ -209,19 +238,18 @@ def _cmd_run(args: argparse.Namespace) -> int:
     else:
         scenario = scenarios.load_scenario(Path(args.scenario))
     if args.stop_time is not None:
-        scenario = scenario.with_overrides(stop_time=args.stop_time)
-    orch = _lib("twin.orchestrator")
+        scenario = _lib("twin.checks").override_stop_time(scenario, args.stop_time)
     out = Path(args.output) if args.output else Path(f"{scenario.name}.h5")
-    if scenario.degradation is not None:
-        run = _lib("twin.degradation_run").run_degradation(scenario, out, progress=not args.no_progress,
-                                                          resume=args.resume)
-        print(f"{scenario.name}: {len(run.stages)} stages, {run.summary()} -> {out}")
-        return 0 if run.complete else 130
-    rec = orch.run_scenario(scenario, out, progress=not args.no_progress)
-    state = "complete" if rec.complete else "interrupted, partial result kept"
-    print(f"{scenario.name}: {rec.result.time.size} samples of {len(rec.result.signals)} channels "
-          f"({state}) -> {out}")
-    return 0 if rec.complete else 130
+    _lib("twin.results").check_output_path(out)
+    if args.resume and scenario.degradation is None:
+        raise _lib("twin.errors").ResumeError("--resume continues degradation runs only; a plain run starts "
+                                              "from its start time (its partial output is kept for inspection)")
+    scenario.fmu_path()            # build or find the FMU here, so its errors are reported plainly
+    text, code = _lib("twin.isolation").run_isolated(_run_in_child, scenario, out, not args.no_progress,
+                                                     args.resume, what=f"scenario {scenario.name}",
+                                                     timeout=args.timeout)
+    print(text)
+    return code
 
 
 def _cmd_archive(args: argparse.Namespace) -> int:
@@ -308,7 +336,7 @@ def _add_sensitivity_parser(sub) -> None:
     p.add_argument("--modes-from", metavar="RECORD", help="run-up or hammer record of the measured modes")
     p.add_argument("--modes", type=int, default=8,
                    help="without measurements: the model's first N visible modes (default: 8)")
-    p.add_argument("--workers", type=int, help="local worker processes (default: one)")
+    p.add_argument("--workers", type=_positive_int, help="local worker processes (default: one)")
     p.add_argument("--json", type=Path, help="write the sensitivities and the choice here")
     p.set_defaults(handler=_cmd_sensitivity)
 
@@ -473,6 +501,26 @@ def _loop_arguments(p: argparse.ArgumentParser, *, out: bool) -> None:
                        help="Modelica root the variant is written to (default: the repository's modelica/)")
 
 
+def _positive_seconds(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"'{text}' is not a number of seconds") from None
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"must be a positive finite number of seconds, got '{text}'")
+    return value
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"'{text}' is not a whole number") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be at least 1, got '{text}'")
+    return value
+
+
 def build_parser() -> argparse.ArgumentParser:
     """Return the ``twin`` argument parser (one sub-parser per command)."""
     parser = argparse.ArgumentParser(
@@ -517,6 +565,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--input", action="append", metavar="NAME=VALUE",
                    help="hold an input at a constant value (repeatable)")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    p.add_argument("--timeout", type=_positive_seconds, metavar="SECONDS",
+                   help="stop the FMU and report an error if the run takes longer")
     _add_fmpy_simulate_options(p)
     p.set_defaults(handler=_cmd_simulate)
 
@@ -527,13 +577,15 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--stop-time", type=float, help="override the scenario's stop time [s]")
     p.add_argument("--resume", action="store_true", help="degradation runs: continue from the last completed stage")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    p.add_argument("--timeout", type=_positive_seconds, metavar="SECONDS",
+                   help="stop the FMU and report an error if the run takes longer")
     p.set_defaults(handler=_cmd_run)
 
     p = sub.add_parser("archive", help="simulate the labelled degradation archive of a scenario")
     p.add_argument("scenario", metavar="SCENARIO", help="scenario .yaml with degradation and archive blocks")
     p.add_argument("--out", help="archive HDF5 file (default: <scenario name>_archive.h5)")
     p.add_argument("--records-per-stage", type=int, help="override archive.records_per_stage")
-    p.add_argument("--workers", type=int, help="local worker processes (default: one per core)")
+    p.add_argument("--workers", type=_positive_int, help="local worker processes (default: one per core)")
     p.add_argument("--scheduler", help="address of a dask.distributed scheduler (tcp://host:port)")
     p.add_argument("--seed", type=int, help="override the scenario's seed")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bars")
@@ -552,7 +604,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("scenario", metavar="SCENARIO", help="scenario .yaml with a calibration block")
     p.add_argument("--measurements", required=True, help="measurement HDF5 (or CSV + sidecar)")
     p.add_argument("--out", default="calibration", help="output directory (default: calibration)")
-    p.add_argument("--workers", type=int, help="local worker processes for the evaluations")
+    p.add_argument("--workers", type=_positive_int, help="local worker processes for the evaluations")
     p.add_argument("--seed", type=int, help="override the scenario's seed")
     p.add_argument("--resume", action="store_true", help="continue from <out>/checkpoint.json")
     p.add_argument("--modes-from", metavar="RECORD",
@@ -575,7 +627,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("diagnose", help="rank the catalogue effects the model may be missing, by trying each")
     _loop_arguments(p, out=False)
     p.add_argument("--json", type=Path, help="write the diagnosis here")
-    p.add_argument("--workers", type=int, help="local worker processes (default: one per core)")
+    p.add_argument("--workers", type=_positive_int, help="local worker processes (default: one per core)")
     p.set_defaults(handler=_cmd_diagnose)
 
     p = sub.add_parser("add-effect", help="write a model variant with an effect, build it, recalibrate, report")
@@ -586,7 +638,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("improve", help="diagnose -> add-effect -> recalibrate until nothing improves the fit")
     _loop_arguments(p, out=True)
     p.add_argument("--max-steps", type=int, default=4)
-    p.add_argument("--workers", type=int, help="local worker processes (default: one per core)")
+    p.add_argument("--workers", type=_positive_int, help="local worker processes (default: one per core)")
     p.set_defaults(handler=_cmd_improve)
 
     p = sub.add_parser("effects", help="list the effect catalogue")
@@ -616,22 +668,84 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Run the CLI; return the exit code (0 ok, 2 usage or :class:`TwinError`).
+def _os_error_message(exc: OSError) -> str:
+    """One line for an OS error on a path: what went wrong and which path."""
+    what = (exc.strerror or str(exc)).rstrip(".")
+    what = what[:1].lower() + what[1:]
+    if exc.filename is not None and exc.filename2 is not None:
+        return f"{what}: '{exc.filename}' -> '{exc.filename2}'"
+    if exc.filename is not None:
+        return f"{what}: '{exc.filename}'"
+    return what
 
-    Exceptions other than :class:`TwinError` propagate: they are bugs and
-    deserve a traceback.
+
+def _add_debug_option(parser: argparse.ArgumentParser) -> None:
+    """``--debug`` on the main parser and on every sub-command (so it may come anywhere)."""
+    parser.add_argument("--debug", action="store_true",
+                        help="show the Python traceback of an error instead of one line")
+    for action in parser._subparsers._group_actions if parser._subparsers else ():
+        for sub in getattr(action, "choices", {}).values():
+            sub.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                             help="show the Python traceback of an error instead of one line")
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the CLI; return the exit code.
+
+    0 success; 2 usage error or bad input (:class:`TwinError`, an OS error on a path: one
+    ``twin: error:`` line naming the value or the path); 130 interrupted by Ctrl-C (or SIGTERM);
+    1 anything else, which is a bug: one line naming the exception and a hint to re-run with
+    ``--debug`` (or ``TWIN_DEBUG=1``) for the traceback.
     """
+    import os
+
+    from twin import _interrupt
+
     parser = build_parser()
+    _add_debug_option(parser)
     try:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # --help or a usage error; argparse already printed
         return exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 2)
+    debug = bool(getattr(args, "debug", False)) or os.environ.get("TWIN_DEBUG", "") not in ("", "0")
+    _interrupt.install()
     try:
-        return args.handler(args)
+        code = args.handler(args)
+    except KeyboardInterrupt:
+        if debug:
+            import traceback
+            traceback.print_exc()
+        print("twin: interrupted; results written before the interruption are unchanged", file=sys.stderr)
+        return 130
     except TwinError as exc:
+        if debug:
+            raise
         print(f"twin: error: {exc}", file=sys.stderr)
         return 2
+    except OSError as exc:
+        if debug:
+            raise
+        print(f"twin: error: {_os_error_message(exc)}", file=sys.stderr)
+        return 2
+    except MemoryError as exc:
+        if debug:
+            raise
+        print(f"twin: error: out of memory{': ' + str(exc) if str(exc) else ''}", file=sys.stderr)
+        return 2
+    except Exception as exc:  # the last line of defence: a bug, reported in one line
+        if debug:
+            raise
+        text = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
+        print(f"twin: error: internal error {type(exc).__name__}{': ' + text if text else ''} "
+              "(re-run with --debug for the traceback)", file=sys.stderr)
+        return 1
+    finally:
+        interrupted = _interrupt.requested()
+        _interrupt.uninstall()
+    if interrupted:  # the request arrived where nothing checked it: still honoured
+        print("twin: interrupted", file=sys.stderr)
+        return 130
+    return code
 
 
 if __name__ == "__main__":

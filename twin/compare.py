@@ -279,6 +279,37 @@ def read_record(measurements, channel: str = "accel_pinion_casing", record: str 
                           float(rec.nominal_speed), float(rec.load))
 
 
+#: Pinion revolutions a compared record must hold: the shaft speed is estimated from the mesh
+#: line and the synchronous average needs whole revolutions.
+MIN_REVOLUTIONS = 4
+
+
+def check_duration(measurements, rec: MeasuredRecord, duration: float) -> None:
+    """Refuse a non-finite, non-positive or too long ``duration`` [s] of record ``rec``."""
+    from twin.errors import MeasurementError
+    available = rec.signal.size / rec.sample_rate
+    if not (np.isfinite(duration) and duration > 0):
+        raise MeasurementError(str(measurements), rec.name, f"--duration must be a positive number of seconds, "
+                                                            f"got {duration}")
+    if duration > available * (1 + 1e-9):
+        raise MeasurementError(str(measurements), rec.name, f"--duration {duration:g} s is longer than the record "
+                                                            f"({available:.6g} s)")
+
+
+def check_length(measurements, rec: MeasuredRecord, n: int) -> None:
+    """Refuse a record too short to compare: it must hold :data:`MIN_REVOLUTIONS` pinion
+    revolutions at its drive speed; the message gives the length needed."""
+    from twin.errors import MeasurementError
+    if not rec.nominal_speed > 0:
+        raise MeasurementError(str(measurements), rec.name, f"nominal_speed must be > 0 Hz, got {rec.nominal_speed}")
+    need = int(np.ceil(MIN_REVOLUTIONS * rec.sample_rate / rec.nominal_speed))
+    if n < need:
+        raise MeasurementError(str(measurements), rec.name,
+                               f"{n} samples ({n / rec.sample_rate:.3g} s) are too short to compare: at least {need} "
+                               f"samples ({need / rec.sample_rate:.3g} s, {MIN_REVOLUTIONS} revolutions at "
+                               f"{rec.nominal_speed:g} Hz) are needed")
+
+
 def compare(scenario, measurements, out_dir, *, record: str | None = None, duration: float | None = None,
             solver_step: float | None = 1e-5):
     """``twin compare``: simulate at the record's measured operating point and write the comparison.
@@ -311,7 +342,9 @@ def compare(scenario, measurements, out_dir, *, record: str | None = None, durat
     rec = read_record(measurements, channel, record)
     measured = rec.signal
     if duration is not None:
+        check_duration(measurements, rec, duration)
         measured = measured[-int(round(duration * rec.sample_rate)):]
+    check_length(measurements, rec, measured.size)
     fmu_path = scenario.fmu_path()
     params = dict(scenario.parameters)
     with FMU(fmu_path) as fmu:
