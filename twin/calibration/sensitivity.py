@@ -275,6 +275,12 @@ def mode_sensitivity(fmu_path, values: Mapping[str, float], measured_hz, *, spee
         moved = executor.map(_modes_task, tasks, desc="sensitivities")
     else:
         moved = [_modes_task(t) for t in tasks]
+    failed = [(c.name, r) for c, r in zip(cands, moved) if isinstance(r, BaseException)]
+    if failed:      # a crashed or failed linearisation: named, not an AttributeError further down
+        from twin.errors import SimulationError
+        name, err = failed[0]
+        raise SimulationError(f"{len(failed)} of {len(cands)} sensitivity runs failed; first ({name} moved by "
+                              f"{100 * step:g} %): {err}")
     S = np.empty((which.size, len(cands)))
     for j, mv in enumerate(moved):
         S[:, j] = np.log(follow(base, mv, which) / base.frequency[which]) / math.log(1 + step)
