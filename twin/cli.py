@@ -720,6 +720,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     except TwinError as exc:
         if debug:
             raise
+        if isinstance(exc, WorkerCrashError) and not getattr(args, "no_progress", True):
+            print(file=sys.stderr)      # the dead process's progress bar may have left a line open
         print(f"twin: error: {exc}", file=sys.stderr)
         return 2
     except OSError as exc:

@@ -142,8 +142,10 @@ class DaskExecutor(Executor):
         if address:
             self.client = Client(address)
         else:
-            # a task whose worker died is not handed to another worker: it would kill that one too
-            with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+            # a task whose worker died is not handed to another worker: it would kill that one too;
+            # one task per worker thread at a time, so a death takes no queued task with it
+            with dask.config.set({"distributed.scheduler.allowed-failures": 0,
+                                  "distributed.scheduler.worker-saturation": 1.0}):
                 self._cluster = LocalCluster(n_workers=workers or len(os.sched_getaffinity(0)),
                                              threads_per_worker=1, processes=True, dashboard_address=None)
             self.client = Client(self._cluster)
