@@ -8,10 +8,12 @@ three uncorrelated parts seen through the sensor's gain ``g``:
 ``M`` from the mesh (stiffness variation under load: physics, no free level), ``R`` from the flank
 roughness and ``F`` from the process force, ``a`` and ``b`` the squared ratios of their RMS levels
 to the values simulated. So three simulations (nothing; roughness alone added; process force
-alone added) give every level at once: ``g^2``, ``a`` and ``b`` are fitted to the measured
-spectrum's band levels (1/12 octave) by least squares in dB, with a fourth term for the
-measurement's own noise (white; it is reported, not put in the model). The mesh lines fix the
-gain, the floor between them the roughness and process levels.
+alone added) give every level at once. The gain comes from the gear-mesh harmonics (measured over
+simulated amplitude: band levels alone cannot tell a louder mesh from more roughness, whose
+orders include the mesh orders; the roughness in the measured lines biases it by up to about
+20 %); ``a`` and ``b`` are then fitted to the measured spectrum's band
+levels (1/12 octave) by least squares in dB, with a third term for the measurement's own noise
+(white; it is reported, not put in the model).
 """
 from __future__ import annotations
 
@@ -60,6 +62,9 @@ class LevelFit:
     noise_psd: float             # white measurement noise [unit^2/Hz]
     distance_db: float           # RMS dB difference of the band levels after the fit
     parameters: Mapping[str, float]   # FMU parameter values to set
+    band_hz: np.ndarray | None = None       # (m,) band centres [Hz]
+    measured_db: np.ndarray | None = None   # (m,) measured band levels [dB]
+    model_db: np.ndarray | None = None      # (m,) fitted model band levels, noise included [dB]
 
     def describe(self) -> str:
         return (f"sensor gain {self.gain:.3g}, roughness x{self.roughness_scale:.3g}, process force "
@@ -95,11 +100,11 @@ def fit_levels(fmu_path, parameters: Mapping[str, float], measured, fs: float, *
             "process": {**base, ROUGHNESS[0]: 0.0, ROUGHNESS[1]: 0.0, PROCESS: p0}}
     measured = np.asarray(measured, float)
     resolution = max(2.0, 8.0 / min(duration, measured.size / fs))
-    levels = {}
+    levels, signals = {}, {}
     for name, values in runs.items():
-        x = simulate_operating_point(fmu_path, speed_hz, load_nm, parameters=values, settle=settle, duration=duration,
-                                     channels=[channel], output_interval=1.0 / fs)[:, 0]
-        fc, levels[name] = band_levels(x, fs, fmin, fmax, resolution=resolution)
+        signals[name] = simulate_operating_point(fmu_path, speed_hz, load_nm, parameters=values, settle=settle,
+                                                 duration=duration, channels=[channel], output_interval=1.0 / fs)[:, 0]
+        fc, levels[name] = band_levels(signals[name], fs, fmin, fmax, resolution=resolution)
     fm, lm = band_levels(measured, fs, fmin, fmax, resolution=resolution)
     n = fc.size
     M = levels["mesh"][:n]
@@ -107,15 +112,82 @@ def fit_levels(fmu_path, parameters: Mapping[str, float], measured, fs: float, *
     F = np.maximum(levels["process"][:n] - M, 1e-6 * levels["process"][:n])
     target = 10 * np.log10(lm[:n])
     noise0 = float(np.min(lm[:n]))
+    # The gain from the mesh lines: band levels alone cannot tell a louder mesh from more
+    # roughness, whose orders include the mesh orders. The measured lines hold some roughness too
+    # (added with a random phase), which biases the gain by up to about 20 %.
+    line_meas, ring_meas = mesh_lines(measured, fs, speed_hz, fmax=fmax)
+    line_mesh, _ = mesh_lines(signals["mesh"], fs, speed_hz, fmax=fmax)
+    usable = np.isfinite(line_meas) & (line_meas >= 4.0 * ring_meas) & (line_mesh > 0)
+    if not usable.any():
+        raise ValueError("no gear-mesh harmonic stands out of the measured spectrum: the sensor gain cannot be set")
+    g2 = float(np.median(line_meas[usable] / line_mesh[usable]))
 
     def model(q):
-        g2, a, b, w = np.exp(q)
+        a, b, w = np.exp(q)
         return 10 * np.log10(g2 * (M + a * R + b * F) + w * noise0)
 
-    q0 = np.log([np.median(lm[:n] / np.maximum(M + R + F, 1e-300)), 1.0, 1.0, 0.1])
-    sol = least_squares(lambda q: model(q) - target, q0, bounds=(q0 - 25, q0 + 25))
-    g2, a, b, w = np.exp(sol.x)
+    # the broadband levels within a factor 100 of the simulated ones (power 1e4), the noise free;
+    # a level the spectrum does not need goes to the low end, not to zero
+    lo = np.array([np.log(1e-4), np.log(1e-4), np.log(1e-6)])
+    hi = np.array([np.log(1e4), np.log(1e4), np.log(1e6)])
+    sol = least_squares(lambda q: model(q) - target, np.log([1.0, 1.0, 0.1]), bounds=(lo, hi))
+    a, b, w = np.exp(sol.x)
     gain = float(np.sqrt(g2))
     rs, ps = float(np.sqrt(a)), float(np.sqrt(b))
-    values = {f"{sensor}.gain": gain, ROUGHNESS[0]: r0 * rs, ROUGHNESS[1]: r0 * rs, PROCESS: p0 * ps}
-    return LevelFit(gain, rs, ps, float(w * noise0), float(np.sqrt(np.mean(sol.fun ** 2))), values)
+    with FMU(fmu_path) as fmu:
+        limits = {sv.name: (sv.min, sv.max) for sv in fmu.model_description.modelVariables}
+    values = {}
+    for name, v in ((f"{sensor}.gain", gain), (ROUGHNESS[0], r0 * rs), (ROUGHNESS[1], r0 * rs), (PROCESS, p0 * ps)):
+        lo_v, hi_v = limits.get(name, (None, None))
+        values[name] = float(np.clip(v, float(lo_v) if lo_v is not None else -np.inf,
+                                     float(hi_v) if hi_v is not None else np.inf))
+    return LevelFit(gain, rs, ps, float(w * noise0), float(np.sqrt(np.mean(sol.fun ** 2))), values, fc[:n],
+                    target, model(sol.x))
+
+
+def mesh_lines(x, fs: float, nominal_hz: float, *, teeth: int = 19, fmax: float = 5000.0, harmonics: int = 6
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """(power of each gear-mesh harmonic, power of the spectrum around it), both (harmonics,) [unit^2].
+
+    The shaft speed is read off the signal's own mesh line (an induction motor slips, a rig's
+    speed is off its setting); amplitudes from a Hann spectrum, the line being the largest of
+    the bins within 2.5 bins of k times the mesh frequency, its surroundings the median of the
+    bins up to 40 away. NaN above ``fmax``.
+    """
+    from twin.calibration.objectives import estimate_shaft_hz
+    from twin.signals import amplitude_spectrum
+
+    x = np.asarray(x, float)
+    shaft = estimate_shaft_hz(x, fs, nominal_hz, teeth)
+    f, amp = amplitude_spectrum(x - x.mean(), fs)
+    df = f[1] - f[0]
+    line, around = np.full(harmonics, np.nan), np.full(harmonics, np.nan)
+    for k in range(1, harmonics + 1):
+        fk = k * teeth * shaft
+        if fk > fmax:
+            break
+        near = np.abs(f - fk) <= 2.5 * df
+        ring = (np.abs(f - fk) <= 40 * df) & ~near
+        line[k - 1] = amp[near].max() ** 2
+        around[k - 1] = np.median(amp[ring]) ** 2
+    return line, around
+
+
+def panel_participations(fit: LevelFit, parameters: Mapping[str, float], channel: str) -> dict[str, float]:
+    """One correction of the casing panel modes' participations from the band levels of a level fit.
+
+    Near its resonance a panel mode lifts the band by its participation (amplitude), so the
+    participation is scaled by the measured-minus-model band level there (in amplitude), within
+    [0.1, 10]. Returns the new participations (empty without panel modes).
+    """
+    sensor = SENSOR_OF_CHANNEL[channel]
+    out = {}
+    for slot in (1, 2, 3):
+        w = parameters.get(f"{sensor}.panel_participation[{slot}]", 0.0)
+        f = parameters.get(f"{sensor}.panel_frequency[{slot}]")
+        if not w or f is None or fit.band_hz is None:
+            continue
+        i = int(np.argmin(np.abs(np.log(fit.band_hz / f))))
+        out[f"{sensor}.panel_participation[{slot}]"] = float(
+            np.clip(w * 10 ** ((fit.measured_db[i] - fit.model_db[i]) / 20), 0.1, 10.0))
+    return out

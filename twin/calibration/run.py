@@ -99,8 +99,10 @@ def _block(scenario, modes_from: str | None) -> dict:
     return spec
 
 
-def measured_modes(spec: dict, mset, source: str, out_dir: Path) -> tuple[np.ndarray, np.ndarray, str]:
-    """(frequencies [Hz], relative sd, description) of the measured modes the block asks for."""
+def measured_modes(spec: dict, mset, source: str, out_dir: Path, *, with_damping: bool = False):
+    """(frequencies [Hz], relative sd, description) of the measured modes the block asks for;
+    with ``with_damping`` also their damping ratios (NaN where unknown), confidences and the
+    channels they were read from (empty when typed)."""
     from twin.modes import MIN_CONFIDENCE, survey_record, write_survey_json
     from twin.signals import remove_foundation_modes
 
@@ -118,11 +120,17 @@ def measured_modes(spec: dict, mset, source: str, out_dir: Path) -> tuple[np.nda
                                   f"confidence >= {threshold:g} (see {out_dir / 'modes.json'})")])
         freqs = np.array([m.frequency for m in used])
         rel = np.array([m.evidence.get("frequency_sd_hz", 0.0) / m.frequency for m in used])
+        damping = np.array([m.damping for m in used])
+        confidence = np.array([m.confidence for m in used])
+        channels = tuple(survey.channels)
         what = (f"{freqs.size} modes read from record {name!r} ({survey.method}, confidence >= {threshold:g}; "
                 f"{len(survey.lines)} fixed lines and {len(survey.orders)} orders set aside)")
     elif spec.get("natural_frequencies"):
         freqs = np.asarray(spec["natural_frequencies"], float)
         rel = np.zeros(freqs.size)
+        damping = np.full(freqs.size, np.nan)
+        confidence = np.ones(freqs.size)
+        channels = ()
         what = "typed in the scenario"
     else:
         raise ScenarioError([(source, "calibration.natural_frequencies",
@@ -131,8 +139,10 @@ def measured_modes(spec: dict, mset, source: str, out_dir: Path) -> tuple[np.nda
     if spec.get("foundation_modes"):
         kept, removed = remove_foundation_modes(freqs, np.asarray(spec["foundation_modes"]))
         keep = np.isin(freqs, kept)
-        freqs, rel = freqs[keep], rel[keep]
+        freqs, rel, damping, confidence = freqs[keep], rel[keep], damping[keep], confidence[keep]
         print(f"removed foundation modes {list(np.round(removed, 1))} Hz from the measured list")
+    if with_damping:
+        return freqs, rel, what, damping, confidence, channels
     return freqs, rel, what
 
 
@@ -141,7 +151,7 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
                     modes_from: str | None = None) -> CalibrationReport:
     """Calibrate the scenario's FMU to a measurement file (see the module docstring)."""
     from twin._atomic import check_output_dir
-    from twin.calibration.levels import fit_levels, has_levels
+    from twin.calibration.levels import fit_levels, has_levels, panel_participations
     from twin.calibration.modal_fit import mode_errors, on_bounds
     from twin.calibration.objectives import match_modes
     from twin.calibration.output import write_calibrated_scenario
@@ -162,7 +172,8 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
     mset = load_measurements(measurements)
     for note in mset.notes:
         print(f"note: {note}")
-    freqs, rel_sd, modes_what = measured_modes(spec, mset, source, out_dir)
+    freqs, rel_sd, modes_what, damping, confidence, seen_by = measured_modes(spec, mset, source, out_dir,
+                                                                             with_damping=True)
     steady_name = spec.get("record") or next((n for n in mset.names if n != spec.get("modes_from")), mset.names[0])
     if steady_name not in mset.names:
         raise ScenarioError([(source, "calibration.record", f"no record {steady_name!r} in the measurements")])
@@ -186,21 +197,25 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
     objectives = tuple(spec.get("objectives", default_obj))
     band = spec.get("band", [10.0, 5000.0])
     n = int(round(duration * rec.sample_rate))
+    fmu = scenario.fmu_path()
+    # the model's modes are read at the sensors the measured ones were seen by (those it has)
+    outputs = _outputs(fmu)
+    mode_channels = tuple(c for c in seen_by if c in outputs) or (channel,)
     target = CalibrationTarget(np.asarray(rec[channel][-n:], float), rec.sample_rate, float(rec.nominal_speed),
                                float(rec.load), freqs, channel=channel, fmin=band[0], fmax=band[1],
-                               objectives=objectives, mode_rel_sd=rel_sd)
-    fmu = scenario.fmu_path()
+                               objectives=objectives, mode_rel_sd=rel_sd, mode_channels=mode_channels)
     fixed = dict(scenario.parameters)
     if not auto:       # unknown or non-physical names and bounds: refused before the first evaluation
         check_calibration_parameters(fmu, ParameterSpace.from_bounds(spec["parameters"]),
                                      {k: v for k, v in fixed.items() if k not in spec["parameters"]})
     timeout = float(spec.get("evaluation_timeout", scenario.executor.get("timeout", 600.0)))
     ex = executor or make_executor({**scenario.executor, "timeout": timeout})
+    path_note = None
     try:
         sensitivity = None
         if auto:
             sensitivity = mode_sensitivity(fmu, fixed, freqs, speed_hz=target.drive_hz, load_nm=target.load,
-                                           rel_sd=rel_sd, channels=(channel,), executor=ex)
+                                           rel_sd=rel_sd, channels=mode_channels, executor=ex)
             (out_dir / "sensitivity.json").write_text(json.dumps(sensitivity.to_dict(), indent=2))
             if not sensitivity.chosen:
                 raise ScenarioError([(source, "calibration.parameters", "no parameter is identifiable from the "
@@ -209,12 +224,23 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
                 print(sensitivity.table())
             bounds = sensitivity.bounds()
             nominal = {c.name: c.nominal for c in sensitivity.candidates}
+            path = {}
+            for ch in mode_channels:
+                path.update(casing_path(fmu, ch, sensitivity.unmatched_hz, freqs, damping, confidence,
+                                        shared=len(mode_channels)))
+            if path:
+                fixed.update(path)
+                attributed = sorted(v for k, v in path.items() if "panel_frequency" in k)
+                path_note = ("attributed to casing panel modes in the sensor path (no gearbox mode within 15 %): "
+                             + ", ".join(f"{f:.1f} Hz" for f in attributed))
+                if progress:
+                    print(path_note)
         else:
             bounds = spec["parameters"]
             nominal = {}
         space = ParameterSpace.from_bounds(bounds)
         fixed = {k: v for k, v in fixed.items() if k not in space.names}
-        kw = dict(speed_hz=target.drive_hz, load_nm=target.load, channels=(channel,))
+        kw = dict(speed_hz=target.drive_hz, load_nm=target.load, channels=mode_channels)
         shaft = target.measured_shaft_hz if target.needs_simulation else target.drive_hz
         before, _ = evaluate_candidate(EvalTask(str(fmu), {**fixed, **nominal}, target, settle, duration, shaft))
         result = calibrate(fmu, space, target, algorithm=spec.get("algorithm", "mogoa"),
@@ -227,10 +253,17 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
         levels = None
         if has_levels(fmu, channel):
             # the level of the spectrum: sensor gain, roughness and process-force levels (three runs)
+            level_kw = dict(speed_hz=target.drive_hz, load_nm=target.load, channel=channel, fmin=band[0],
+                            fmax=min(band[1], 0.45 * rec.sample_rate), settle=settle)
             levels = fit_levels(fmu, {**fixed, **chosen}, np.asarray(rec[channel], float), rec.sample_rate,
-                                speed_hz=target.drive_hz, load_nm=target.load, channel=channel, fmin=band[0],
-                                fmax=min(band[1], 0.45 * rec.sample_rate), settle=settle)
+                                **level_kw)
             chosen.update(levels.parameters)
+            panels = panel_participations(levels, {**fixed, **chosen}, channel)
+            if panels:
+                chosen.update(panels)
+                levels = fit_levels(fmu, {**fixed, **chosen}, np.asarray(rec[channel], float), rec.sample_rate,
+                                    **level_kw)
+                chosen.update(levels.parameters)
             if progress:
                 print(f"levels: {levels.describe()}")
         after, _ = evaluate_candidate(EvalTask(str(fmu), {**fixed, **chosen}, target, settle, duration, shaft))
@@ -241,7 +274,7 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
                 "beyond what physics allows, so the model's structure may lack something the rig has"
                 for n, lo, hi in zip(space.names, space.lower, space.upper)
                 if n in on_bounds(space.names, [chosen[k] for k in space.names], space.lower, space.upper)]
-    notes = (f"levels: {levels.describe()}",) if levels is not None else ()
+    notes = tuple(n for n in (path_note, f"levels: {levels.describe()}" if levels is not None else None) if n)
     for w in warnings:
         print(f"warning: {w}")
     full = {**fixed, **chosen}
@@ -267,6 +300,48 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
     psd_overlay(fmu, target, {**fixed, **nominal}, chosen, settle, duration, out_dir / "report_psd.png")
     write_html(report, scenario, measurements, out_dir / "report.html")
     return report
+
+
+#: Casing panel modes a sensor path of GearTwin.Gearbox21Measured can hold.
+PANEL_SLOTS = 3
+
+
+def casing_path(fmu, channel: str, unmatched_hz, freqs, damping, confidence, *, shared: int = 1
+                ) -> dict[str, float]:
+    """Parameters that put the measured modes no gearbox mode can reach into the sensor's casing path.
+
+    A measured mode with no visible mode of the gearbox model within 15 % is something the
+    gearbox model does not have; at a casing accelerometer the casing wall between the bearings
+    and the sensor is what it most likely is (the rig's counterpart of the paper's foundation
+    modes, which were measured apart and removed). The most confident of them, at most
+    PANEL_SLOTS, become the path's panel modes: frequency and damping as measured, the sensor on
+    the modal mass (participation 1; 1/``shared`` when the modes were read at several sensors,
+    whose paths all get them, since a run-up does not say which sensor's casing they belong to).
+    Empty when the model has no such path.
+    """
+    from twin.calibration.levels import SENSOR_OF_CHANNEL
+    from twin.fmu import FMU
+
+    sensor = SENSOR_OF_CHANNEL.get(channel)
+    if sensor is None or len(unmatched_hz) == 0:
+        return {}
+    with FMU(fmu) as f:
+        if f"{sensor}.panel_frequency[1]" not in f.variables:
+            return {}
+    picks = [i for i in np.argsort(-np.asarray(confidence)) if np.any(np.isclose(freqs[i], unmatched_hz))]
+    out = {}
+    for slot, i in enumerate(sorted(picks[:PANEL_SLOTS], key=lambda i: freqs[i]), start=1):
+        zeta = float(damping[i]) if np.isfinite(damping[i]) else 0.02
+        out[f"{sensor}.panel_frequency[{slot}]"] = float(freqs[i])
+        out[f"{sensor}.panel_damping[{slot}]"] = float(np.clip(zeta, 0.005, 0.1))
+        out[f"{sensor}.panel_participation[{slot}]"] = 1.0 / shared
+    return out
+
+
+def _outputs(fmu) -> set[str]:
+    from twin.fmu import FMU
+    with FMU(fmu) as f:
+        return {v.name for v in f.outputs}
 
 
 def _start(target) -> dict:

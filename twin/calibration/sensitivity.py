@@ -50,6 +50,21 @@ MODEL_FORM = 0.01
 MATCH_REACH = 0.15
 #: Parameters moved together to form a transmission error (mesh excitation) in GearTwin models.
 MESH_EXCITATION = "profile_deviation"
+#: Levels of the broadband sources of GearTwin.Gearbox21Measured, set to zero to linearise.
+BROADBAND_LEVELS = ("pinion_roughness.rms", "gear_roughness.rms", "process.rms")
+
+
+def _variables(fmu_path) -> frozenset[str]:
+    """Variable names of an FMU (read once per file and content)."""
+    from twin.fmu import FMU
+    key = (str(fmu_path), Path(fmu_path).stat().st_mtime_ns)
+    if key not in _VARIABLES:
+        with FMU(fmu_path) as fmu:
+            _VARIABLES[key] = frozenset(fmu.variables)
+    return _VARIABLES[key]
+
+
+_VARIABLES: dict = {}
 
 
 @dataclass(frozen=True)
@@ -129,7 +144,10 @@ def model_modes(fmu_path, parameters: Mapping[str, float], *, speed_hz: float, l
 
     start, inputs = operating_point(speed_hz, load_nm)
     excitations = {"mesh": [MESH_EXCITATION + "[*]"]}
-    lm = linear_model(fmu_path, parameters={**parameters, **start}, inputs=inputs, outputs=list(channels),
+    # the broadband sources are excitation, not structure: linearised without them (a rough
+    # flank's transmission error would otherwise add its slope to the mesh stiffness)
+    quiet = {n: 0.0 for n in BROADBAND_LEVELS if n in _variables(fmu_path)}
+    lm = linear_model(fmu_path, parameters={**parameters, **quiet, **start}, inputs=inputs, outputs=list(channels),
                       excitations=excitations, settle=0.02, window=2.5e-3, samples=4)
     mm = modal_model(lm)
     keep = mm.frequency <= fmax

@@ -1,0 +1,46 @@
+"""The benchmark's own spectral distance: zero for the same shape, blind to gain and to what lies
+under the measurement's noise floor, and growing with a missing resonance."""
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+from scipy import signal as sps
+
+_spec = importlib.util.spec_from_file_location(
+    "spectral_distance", Path(__file__).resolve().parents[2] / "bench" / "spectral_distance.py")
+sd = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(sd)
+
+FS = 10000.0
+
+
+def _signal(seed, resonance=True, n=40000):
+    rng = np.random.default_rng(seed)
+    x = rng.standard_normal(n)
+    t = np.arange(n) / FS
+    x = x + 5 * np.sin(2 * np.pi * 380 * t)
+    if resonance:
+        b, a = sps.iirpeak(1500.0, 10.0, FS)
+        x = x + 20 * sps.lfilter(b, a, rng.standard_normal(n))
+    return x
+
+
+def test_same_shape_any_gain_is_close_to_zero():
+    clean = _signal(0)
+    measured = clean + 0.01 * np.random.default_rng(7).standard_normal(clean.size)
+    report = sd.spectral_distance_report(3.0 * clean, measured, FS)
+    assert report["distance_db"] < 0.5 and abs(report["gain_db"] + 20 * np.log10(3.0)) < 0.5
+    other = sd.spectral_distance_report(3.0 * _signal(1), measured, FS)      # another draw of the same process
+    assert other["distance_db"] < 2.5
+
+
+def test_a_missing_resonance_counts_and_silence_under_the_noise_does_not():
+    measured = _signal(0) + 0.01 * np.random.default_rng(5).standard_normal(40000)
+    without = sd.log_spectral_distance(_signal(1, resonance=False), measured, FS)
+    with_it = sd.log_spectral_distance(_signal(1), measured, FS)
+    assert without > with_it + 1.0
+    quiet = np.zeros(40000)
+    noise = 1e-3 * np.random.default_rng(2).standard_normal(40000)
+    assert sd.log_spectral_distance(quiet, noise, FS) < 1e-9
