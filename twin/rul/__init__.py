@@ -1,8 +1,10 @@
 """Remaining useful life from a time series of assessed wear stages (``twin rul``).
 
-The method, the input formats and the API are described in :mod:`twin.rul.core`; this package
-module only registers the command line (:func:`add_subcommands`) and forwards the public names
-lazily, so that ``twin --help`` does not import numpy.
+The method is described in :mod:`twin.rul.estimator`, the input formats in
+:mod:`twin.rul.observations`; the model trajectory is :mod:`twin.rul.trajectory`, the JSON output,
+plot and the whole ``twin rul`` pipeline :mod:`twin.rul.io`.  This package module registers the
+command line (:func:`add_subcommands`) and forwards the public names lazily, so that
+``twin --help`` does not import numpy.
 
 Public API (from ``twin.rul``): :class:`Trajectory`, :func:`trajectory_from_scenario`,
 :func:`read_trajectory`, :class:`Observation`, :class:`ObservationSet`,
@@ -16,18 +18,24 @@ import argparse
 import importlib
 from pathlib import Path
 
-_PUBLIC = ("Trajectory", "trajectory_from_scenario", "read_trajectory", "Observation", "ObservationSet",
-           "read_observations", "observations_from_dict", "check_stages", "RULEstimator", "RULEstimate",
-           "RULError", "run_rul", "write_json", "read_json", "plot_rul", "rul_document",
-           "weighted_quantile", "scenario_speed_hz", "simulate_assessments", "default_threshold", "format_damage",
-           "DAMAGE_KINDS", "RUL_FORMAT")
+# public name -> the module of twin.rul that defines it
+_WHERE = {
+    **dict.fromkeys(("RULError", "DAMAGE_KINDS", "RUL_FORMAT", "format_damage"), "base"),
+    **dict.fromkeys(("Trajectory", "trajectory_from_scenario", "read_trajectory", "scenario_speed_hz",
+                     "default_threshold"), "trajectory"),
+    **dict.fromkeys(("Observation", "ObservationSet", "read_observations", "observations_from_dict",
+                     "check_stages", "simulate_assessments"), "observations"),
+    **dict.fromkeys(("RULEstimator", "RULEstimate", "weighted_quantile"), "estimator"),
+    **dict.fromkeys(("run_rul", "write_json", "read_json", "plot_rul", "rul_document"), "io"),
+}
+_PUBLIC = tuple(_WHERE)
 
 __all__ = [*_PUBLIC, "add_subcommands"]
 
 
 def __getattr__(name: str):
-    if name in _PUBLIC:
-        return getattr(importlib.import_module("twin.rul.core"), name)
+    if name in _WHERE:
+        return getattr(importlib.import_module(f"twin.rul.{_WHERE[name]}"), name)
     raise AttributeError(f"module 'twin.rul' has no attribute {name!r}")
 
 
@@ -49,7 +57,7 @@ def _pair(text: str, option: str) -> tuple[float, float]:
 
 def _cmd_rul(args: argparse.Namespace) -> int:
     scenario = importlib.import_module("twin.scenario").load_scenario(Path(args.scenario))
-    core = importlib.import_module("twin.rul.core")
+    rul_io = importlib.import_module("twin.rul.io")
     opts = {}
     if args.rate_range is not None:
         opts["rate_range"] = _pair(args.rate_range, "--rate-range")
@@ -59,14 +67,14 @@ def _cmd_rul(args: argparse.Namespace) -> int:
         opts["temperature"] = args.temperature
     if args.floor is not None:
         opts["floor"] = args.floor
-    result, _ = core.run_rul(scenario, Path(args.assessed), threshold=args.threshold,
-                             stages=_floats(args.stages, "--stages") if args.stages else None,
-                             cycles_file=Path(args.cycles) if args.cycles else None, speed_hz=args.speed,
-                             trajectory=Path(args.trajectory) if args.trajectory else None,
-                             method="static" if args.static else "cosim", now=args.now, sort=args.sort,
-                             json_path=Path(args.json) if args.json else None,
-                             plot_path=Path(args.plot) if args.plot else None,
-                             progress=not args.no_progress, **opts)
+    result, _ = rul_io.run_rul(scenario, Path(args.assessed), threshold=args.threshold,
+                               stages=_floats(args.stages, "--stages") if args.stages else None,
+                               cycles_file=Path(args.cycles) if args.cycles else None, speed_hz=args.speed,
+                               trajectory=Path(args.trajectory) if args.trajectory else None,
+                               method="static" if args.static else "cosim", now=args.now, sort=args.sort,
+                               json_path=Path(args.json) if args.json else None,
+                               plot_path=Path(args.plot) if args.plot else None,
+                               progress=not args.no_progress, **opts)
     print(result.table())
     for what, p in (("estimate", args.json), ("plot", args.plot)):
         if p:
