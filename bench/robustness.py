@@ -573,8 +573,12 @@ def main(argv=None) -> int:
     ap.add_argument("--only", help="run only the cases whose name contains one of these ('|'-separated)")
     args = ap.parse_args(argv)
     work = args.work or Path(tempfile.mkdtemp(prefix="twin_robustness_"))
+    if args.work is not None and work.exists() and any(work.iterdir()):
+        ap.error(f"--work {work} is not empty: files of an earlier run would change the outcomes")
     work.mkdir(parents=True, exist_ok=True)
     t0 = time.monotonic()
+    tmp = Path(tempfile.gettempdir())
+    temporaries = {p.name for pattern in ("twin_run_*", "twin_pool_*", "twin_fmu_*") for p in tmp.glob(pattern)}
     fmus = prepare(work)
     make_guards(work)
     only = args.only.split("|") if args.only else None
@@ -589,8 +593,10 @@ def main(argv=None) -> int:
             print(f"[{i:3d}/{len(all_cases)}] {cat:12s} {case.name}: {detail}", flush=True)
     finally:
         subprocess.run(["chattr", "-i", str(work / "ro")], capture_output=True)
-    leftovers = [p.name for p in Path(tempfile.gettempdir()).glob("twin_run_*")] + \
-        [p.name for p in Path(tempfile.gettempdir()).glob("twin_pool_*")]
+    # temporary directories made during the cases and still there (a SIGKILLed parent's are removed
+    # by the next run, which the cases after it are)
+    leftovers = sorted({p.name for pattern in ("twin_run_*", "twin_pool_*", "twin_fmu_*") for p in tmp.glob(pattern)}
+                       - temporaries)
     summary = {"date": time.strftime("%Y-%m-%d"), "machine": f"{platform.processor() or platform.machine()}, "
                f"{os.cpu_count()} CPUs", "cases": len(all_cases), "tally": tally,
                "kinds": {k: sum(1 for c in all_cases if c.kind == k) for k in sorted({c.kind for c in all_cases})},

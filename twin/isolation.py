@@ -32,6 +32,7 @@ from collections.abc import Callable, Sequence
 from concurrent.futures import FIRST_COMPLETED
 from concurrent.futures import TimeoutError as FutureTimeout
 from concurrent.futures import wait
+from pathlib import Path
 from typing import Any
 
 from twin import _interrupt
@@ -55,6 +56,28 @@ def describe_exit(exitcode: int | None) -> str:
         except ValueError:
             return f"killed by signal {-exitcode}"
     return f"exited with status {exitcode}"
+
+
+def _private_root(kind: str) -> str:
+    """A new directory for the temporary files of this process's workers or child, named with
+    this process's id; those of processes that are gone (a parent killed by SIGKILL cannot clean
+    up) are removed first."""
+    base = Path(tempfile.gettempdir())
+    for old in base.glob(f"twin_{kind}_*"):
+        pid = old.name.split("_")[2] if old.name.count("_") >= 3 else ""
+        if pid.isdigit() and not _alive(int(pid)):
+            shutil.rmtree(old, ignore_errors=True)
+    return tempfile.mkdtemp(prefix=f"twin_{kind}_{os.getpid()}_")
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
 
 
 def _use_tempdir(root: str) -> None:
@@ -97,7 +120,7 @@ class IsolatedPool:
         self.workers = int(workers)
         self.timeout = timeout
         self.retries = int(retries)
-        self._root = tempfile.mkdtemp(prefix="twin_pool_")
+        self._root = _private_root("pool")
         self._pool = pebble.ProcessPool(max_workers=self.workers, initializer=_pool_worker_init,
                                         initargs=(self._root,), context=multiprocessing.get_context("spawn"))
         self.crashes: list[WorkerCrashError] = []
@@ -201,7 +224,7 @@ def run_isolated(fn: Callable[..., Any], *args, timeout: float | None = None, wh
     """
     import pebble
 
-    root = tempfile.mkdtemp(prefix="twin_run_")
+    root = _private_root("run")
     task = pebble.concurrent.process(daemon=True, context=multiprocessing.get_context("fork"))(_child_main)
     before = {p.pid for p in multiprocessing.active_children()}
     t0 = time.monotonic()
