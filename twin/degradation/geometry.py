@@ -10,7 +10,10 @@ Conventions (shared with ``GearTwin.Gearbox21``)
 * ``s`` is the distance along the line of action [m] measured from ``T1``, the point where the
   line of action touches the pinion's base circle.  On an involute the radius of curvature at
   the contact point equals that distance, so ``rho1 = s`` and ``rho2 = T1T2 - s``.
-* Standard (unshifted) gears on the standard centre distance ``a = r1 + r2``.
+* Profile-shifted gears (coefficients ``x1``, ``x2``) run on the centre distance without
+  backlash: ``inv(alpha_w) = inv(alpha) + 2 tan(alpha) (x1 + x2) / (z1 + z2)``,
+  ``a_w = (r1 + r2) cos(alpha) / cos(alpha_w)``; tip radii ``r + (h_a + x) m`` (no tip
+  shortening).  Unshifted gears (the default) give ``alpha_w = alpha`` and ``a = r1 + r2``.
 * Speeds: ``omega1`` [rad/s] is the pinion (input shaft) speed; ``omega2 = omega1 * z1 / z2``.
 
 Hertz line contact per unit face width ``w = F / face_width`` [N/m], equal materials:
@@ -42,7 +45,32 @@ _FMU_NAMES = {
     "addendum_coefficient": "addendum_coefficient",
     "youngs_modulus": "youngs_modulus",
     "poisson_ratio": "poisson_ratio",
+    "profile_shift_pinion": "profile_shift_pinion",
+    "profile_shift_gear": "profile_shift_gear",
+    "dedendum_coefficient": "dedendum_coefficient",
+    "root_radius_coefficient": "root_radius_coefficient",
+    "bore_radius_pinion": "bore_radius_pinion",
+    "bore_radius_gear": "bore_radius_gear",
 }
+
+
+def involute(angle):
+    """inv(a) = tan(a) - a [rad]."""
+    return np.tan(angle) - angle
+
+
+def inverse_involute(value: float) -> float:
+    """The angle a in (0, pi/2) with tan(a) - a = value (Newton from Cheng's cube-root start)."""
+    if not (math.isfinite(value) and value > 0):
+        raise ParameterError(f"involute function value must be > 0, got {value!r}")
+    a = min(1.5, (3.0 * value) ** (1.0 / 3.0))
+    for _ in range(60):
+        t = math.tan(a)
+        step = (t - a - value) / (t * t)
+        a -= step
+        if abs(step) < 1e-15:
+            break
+    return a
 
 # Tolerance on xi when checking that a roll position lies on the path of contact.
 _XI_TOL = 1e-9
@@ -87,6 +115,17 @@ class GearPair:
         Young's modulus [Pa] of both gears; 206 GPa for JIS S45C.
     poisson_ratio : float
         Poisson's ratio of both gears.
+    profile_shift_pinion, profile_shift_gear : float
+        Profile shift coefficients x1, x2 (multiples of the module).
+    dedendum_coefficient : float
+        Dedendum of the generating rack (= root depth below the reference circle for x = 0) as a
+        multiple of the module; 1.25 for the ISO 53 basic rack.
+    root_radius_coefficient : float
+        Tip radius of the generating rack (the root fillet) as a multiple of the module; 0.38
+        for ISO 53 profile A.
+    bore_radius_pinion, bore_radius_gear : float or None
+        Inner radius of the gear body (shaft bore) [m], for the fillet-foundation compliance of
+        the mesh stiffness; None takes half the root radius.
     """
 
     z1: int = 19
@@ -97,6 +136,12 @@ class GearPair:
     addendum_coefficient: float = 1.0
     youngs_modulus: float = 206e9
     poisson_ratio: float = 0.3
+    profile_shift_pinion: float = 0.0
+    profile_shift_gear: float = 0.0
+    dedendum_coefficient: float = 1.25
+    root_radius_coefficient: float = 0.38
+    bore_radius_pinion: float | None = None
+    bore_radius_gear: float | None = None
 
     def __post_init__(self):
         for name in ("z1", "z2"):
@@ -122,6 +167,26 @@ class GearPair:
         if not (isinstance(nu, (int, float)) and 0 <= nu < 0.5):
             raise ParameterError(f"poisson_ratio must lie in [0, 0.5), got {nu!r}")
         object.__setattr__(self, "poisson_ratio", float(nu))
+        for name in ("profile_shift_pinion", "profile_shift_gear"):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and -1.0 <= value <= 1.5):
+                raise ParameterError(f"{name} must be a number in [-1, 1.5], got {value!r}")
+            object.__setattr__(self, name, float(value))
+        for name, lo, hi in (("dedendum_coefficient", 1.0, 2.0), ("root_radius_coefficient", 0.0, 0.6)):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and lo <= value <= hi):
+                raise ParameterError(f"{name} must be a number in [{lo}, {hi}], got {value!r}")
+            object.__setattr__(self, name, float(value))
+        for name, root in (("bore_radius_pinion", self.root_radius_pinion),
+                           ("bore_radius_gear", self.root_radius_gear)):
+            value = getattr(self, name)
+            if value is None:
+                continue
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and 0 < value < root):
+                raise ParameterError(f"{name} must be a number in (0, root radius {root:.4g} m), got {value!r}")
+            object.__setattr__(self, name, float(value))
+        if self.root_radius_pinion <= 0 or self.root_radius_gear <= 0:
+            raise ParameterError(f"root circle radius must be > 0 (z1={self.z1}, z2={self.z2})")
         # Contact must start outside the pinion base circle (no interference / undercut) and end
         # before the gear base circle, otherwise rho1 or rho2 would vanish on the path.
         if self.contact_start <= 0:
@@ -173,16 +238,38 @@ class GearPair:
 
     @property
     def tip_radius_pinion(self) -> float:
-        return self.pitch_radius_pinion + self.addendum_coefficient * self.module
+        return self.pitch_radius_pinion + (self.addendum_coefficient + self.profile_shift_pinion) * self.module
 
     @property
     def tip_radius_gear(self) -> float:
-        return self.pitch_radius_gear + self.addendum_coefficient * self.module
+        return self.pitch_radius_gear + (self.addendum_coefficient + self.profile_shift_gear) * self.module
+
+    @property
+    def root_radius_pinion(self) -> float:
+        """rf1 = r1 - (h_f - x1) m [m]."""
+        return self.pitch_radius_pinion - (self.dedendum_coefficient - self.profile_shift_pinion) * self.module
+
+    @property
+    def root_radius_gear(self) -> float:
+        """rf2 = r2 - (h_f - x2) m [m]."""
+        return self.pitch_radius_gear - (self.dedendum_coefficient - self.profile_shift_gear) * self.module
+
+    @property
+    def working_pressure_angle(self) -> float:
+        """alpha_w [rad]: inv(alpha_w) = inv(alpha) + 2 tan(alpha) (x1 + x2) / (z1 + z2)."""
+        shift = self.profile_shift_pinion + self.profile_shift_gear
+        if shift == 0:
+            return self.pressure_angle
+        a = self.pressure_angle
+        return inverse_involute(math.tan(a) - a + 2.0 * math.tan(a) * shift / (self.z1 + self.z2))
 
     @property
     def centre_distance(self) -> float:
-        """a = r1 + r2 [m] (standard centre distance)."""
-        return self.pitch_radius_pinion + self.pitch_radius_gear
+        """a_w = (r1 + r2) cos(alpha) / cos(alpha_w) [m] (r1 + r2 for unshifted gears)."""
+        a = self.pitch_radius_pinion + self.pitch_radius_gear
+        if self.profile_shift_pinion + self.profile_shift_gear == 0:
+            return a
+        return a * math.cos(self.pressure_angle) / math.cos(self.working_pressure_angle)
 
     @property
     def base_pitch(self) -> float:
@@ -191,8 +278,8 @@ class GearPair:
 
     @property
     def line_of_action_length(self) -> float:
-        """T1T2 = a sin(alpha) [m], between the tangent points on the two base circles."""
-        return self.centre_distance * math.sin(self.pressure_angle)
+        """T1T2 = a_w sin(alpha_w) [m], between the tangent points on the two base circles."""
+        return self.centre_distance * math.sin(self.working_pressure_angle)
 
     @property
     def contact_start(self) -> float:
@@ -218,8 +305,8 @@ class GearPair:
 
     @property
     def pitch_point_xi(self) -> float:
-        """Roll position of the pitch point (rho1 = r1 sin(alpha)), where sliding vanishes."""
-        pitch = self.pitch_radius_pinion * math.sin(self.pressure_angle)
+        """Roll position of the (operating) pitch point, rho1 = rb1 tan(alpha_w), where sliding vanishes."""
+        pitch = self.base_radius_pinion * math.tan(self.working_pressure_angle)
         return (pitch - self.contact_start) / self.path_of_contact_length
 
     @property

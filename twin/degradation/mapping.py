@@ -26,7 +26,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import nnls
 
 from twin.degradation._nodes import HEALTHY_K_PAIR, hat_matrix, interp_nodes
 from twin.degradation.base import PittingState, WearState
@@ -79,6 +78,7 @@ def project_on_nodes(xi, values, n_nodes: int) -> tuple[np.ndarray, float]:
     scale = float(np.max(np.abs(values)))
     if scale == 0:
         return np.zeros(n_nodes), 0.0
+    from scipy.optimize import nnls          # imported here: scipy.optimize costs seconds to import
     # Unit-scaled problem: nnls's tolerances are absolute.
     coeffs, _ = nnls(basis, values / scale)
     nodes = coeffs * scale
