@@ -53,11 +53,14 @@ def model_file(modelica_dir: Path, model: str) -> Path:
                      f"(looked for {'/'.join(parts)}.mo and package.mo files)")
 
 
-def _sources_hash(modelica_dir: Path, model: str, step_size: float, fmi_version: int = 2) -> str:
+def _sources_hash(modelica_dir: Path, model: str, step_size: float, fmi_version: int = 2,
+                  modifiers: dict | None = None) -> str:
     h = hashlib.sha256()
     h.update(f"{BUILDER_VERSION}|{model}|{step_size!r}|{' '.join(CFLAGS)}".encode())
     if fmi_version != 2:
         h.update(f"|fmi{fmi_version}".encode())
+    if modifiers:
+        h.update(json.dumps(modifiers, sort_keys=True).encode())
     for f in sorted(modelica_dir.rglob("*")):
         if f.is_file() and f.suffix in (".mo", ".order", ".md"):
             h.update(str(f.relative_to(modelica_dir)).encode())
@@ -74,8 +77,12 @@ def _sources_hash(modelica_dir: Path, model: str, step_size: float, fmi_version:
     return h.hexdigest()
 
 
-def flatten(modelica_dir: Path, model: str) -> str:
-    """Flat Modelica text of ``model`` rendered by rumoca, after the subset check."""
+def flatten(modelica_dir: Path, model: str, modifiers: dict | None = None) -> str:
+    """Flat Modelica text of ``model`` rendered by rumoca, after the subset check.
+
+    ``modifiers`` (from :func:`check_modifiers`) are applied as the modification of an
+    ``extends`` clause: the model is flattened as ``model <Name> extends <model>(...); end``.
+    """
     import rumoca
 
     from .subset import check_subset
@@ -87,15 +94,166 @@ def flatten(modelica_dir: Path, model: str) -> str:
     check_subset(modelica_dir, model)
     try:
         session = rumoca.Session(roots=[str(modelica_dir)])
-        compiled = session.load(str(src), model=model)
-        return compiled.render("flat-modelica")
+        if not modifiers:
+            return session.load(str(src), model=model).render("flat-modelica")
+        name = model.rsplit(".", 1)[-1]
+        text = _variant_source(name, model, modifiers, _class_description(src, name))
+        return session.loads(text, model=name, filename=f"{name}.variant.mo").render("flat-modelica")
     except Exception as exc:  # rumoca raises its own exception family
-        raise BuildError(f"rumoca could not compile {model} from {src}:\n{exc}") from exc
+        what = f" with {_modifier_text(modifiers)}" if modifiers else ""
+        raise BuildError(f"rumoca could not compile {model}{what} from {src}:\n{exc}") from exc
+
+
+def _modifier_value(value) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        return repr(value)
+    return "{" + ", ".join(_modifier_value(v) for v in value) + "}"
+
+
+def _modifier_text(modifiers: dict) -> str:
+    return ", ".join(f"{k} = {_modifier_value(v)}" for k, v in modifiers.items())
+
+
+def _class_description(src: Path, name: str) -> str:
+    import re
+    m = re.search(r"\b(?:model|block|class)\s+" + re.escape(name) + r'\s+"((?:[^"\\]|\\.)*)"', src.read_text())
+    return m.group(1) if m else ""
+
+
+def _variant_source(name: str, model: str, modifiers: dict, description: str) -> str:
+    """A class that only extends ``model`` with ``modifiers`` (no equations of its own)."""
+    shown = ", ".join(f"{k} = {_modifier_value(v)}" for k, v in modifiers.items()
+                      if not isinstance(v, (list, tuple)))
+    desc = f"{description} (built with {shown})" if shown else description
+    desc = desc.replace("\\", "\\\\").replace('"', '\\"')
+    return f'model {name} "{desc}"\n  extends {model}({_modifier_text(modifiers)});\nend {name};\n'
+
+
+def _plain_modifiers(modifiers) -> dict:
+    """``modifiers`` as a dict of numbers, booleans and lists of numbers (nothing else)."""
+    out = {}
+    for name, value in dict(modifiers or {}).items():
+        if not (isinstance(name, str) and name.isidentifier()):
+            raise BuildError(f"bad build option: parameter name must be an identifier, got {name!r}")
+        if isinstance(value, (bool, int, float)):
+            out[name] = value
+        elif isinstance(value, (list, tuple)) and all(
+                isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
+            out[name] = [float(v) for v in value]
+        else:
+            raise BuildError(f"bad build option {name!r}: needs a number, a boolean or a list of numbers, "
+                             f"got {value!r}")
+    return out
+
+
+def check_modifiers(modelica_dir: Path | str, model: str, modifiers) -> dict:
+    """Validate build-time modifications of ``model``'s parameters; return them normalised.
+
+    ``modifiers`` maps parameter names to values: an ``int`` for a structural ``Integer``
+    (``z1``, ``n_profile``), ``True``/``False`` for a ``Boolean``, a finite number for a
+    ``Real`` scalar and a sequence of finite numbers for a ``Real`` array (its length is
+    checked once the structural values are applied).  A Real value becomes the parameter's
+    default (it stays tunable).  Raises :class:`BuildError` naming each bad entry.
+    """
+    import math
+
+    if not modifiers:
+        return {}
+    decls = _declarations(flatten(modelica_dir, model))
+    problems, out = [], {}
+    for name, value in modifiers.items():
+        d = decls.get(name)
+        if d is None or d[0] != "parameter":
+            what = "is not a parameter of" if d is not None else "is not declared in"
+            problems.append(f"{name!r} {what} {model}")
+            continue
+        if d[1] == "Integer":
+            ok = isinstance(value, int) and not isinstance(value, bool) or (
+                isinstance(value, float) and value.is_integer())
+            if not ok:
+                problems.append(f"{name!r} is a structural Integer of {model}, got {value!r}")
+                continue
+            out[name] = int(value)
+        elif d[1] == "Boolean":
+            if not isinstance(value, bool):
+                problems.append(f"{name!r} is a structural Boolean of {model}, got {value!r}")
+                continue
+            out[name] = value
+        elif d[2]:
+            try:
+                vals = [float(v) for v in value]
+            except (TypeError, ValueError):
+                problems.append(f"{name!r} is a Real array of {model}, needs a list of numbers, got {value!r}")
+                continue
+            if not vals or not all(math.isfinite(v) for v in vals):
+                problems.append(f"{name!r} needs finite numbers, got {value!r}")
+                continue
+            out[name] = vals
+        else:
+            try:
+                v = float(value)
+            except (TypeError, ValueError):
+                problems.append(f"{name!r} is a Real parameter of {model}, needs a number, got {value!r}")
+                continue
+            if isinstance(value, bool) or not math.isfinite(v):
+                problems.append(f"{name!r} needs a finite number, got {value!r}")
+                continue
+            out[name] = v
+    if problems:
+        raise BuildError("bad build option(s): " + "; ".join(problems))
+    return out
+
+
+_DECLARATION = None
+
+
+def _declarations(flat_text: str) -> dict[str, tuple[str, str, str]]:
+    """``{name: (prefix, type, dims)}`` of the declarations in rumoca's flat text (dims as
+    written, e.g. ``"18"``; empty for scalars).  A light scan: the full parser is not needed
+    to check build options."""
+    import re
+    global _DECLARATION
+    if _DECLARATION is None:
+        _DECLARATION = re.compile(r"^\s*(?:(parameter|constant|input|output)\s+)?(Real|Integer|Boolean)"
+                                  r"(?:\[([^\]]*)\])?\s+([A-Za-z_][\w.]*)", re.M)
+    return {m.group(4): (m.group(1) or "", m.group(2), m.group(3) or "") for m in _DECLARATION.finditer(flat_text)}
+
+
+def _check_array_sizes(flat_text: str, modifiers: dict, model: str) -> None:
+    """A list modifier must have the length its array gets with the structural values applied."""
+    decls = _declarations(flat_text)
+    problems = []
+    for name, value in modifiers.items():
+        if isinstance(value, list):
+            dims = decls.get(name, ("", "", ""))[2]
+            if dims.strip().isdigit() and int(dims) != len(value):
+                problems.append(f"{name!r} has {int(dims)} elements in this build, got {len(value)}")
+    if problems:
+        raise BuildError(f"bad build option(s) for {model}: " + "; ".join(problems))
+
+
+def variant_name(model: str, modifiers: dict | None) -> str:
+    """File stem of the FMU built from ``model`` with ``modifiers``: ``model`` without any, else
+    ``model`` followed by the scalar modifiers (``GearTwin.Gearbox21-z1_18-z2_35``) and, when
+    arrays are modified too, a short hash of them."""
+    if not modifiers:
+        return model
+    parts = [f"{k}_{_modifier_value(v)}" for k, v in sorted(modifiers.items()) if not isinstance(v, list)]
+    arrays = {k: v for k, v in modifiers.items() if isinstance(v, list)}
+    if arrays:
+        parts.append(hashlib.sha256(json.dumps(arrays, sort_keys=True).encode()).hexdigest()[:8])
+    stem = "-".join([model, *parts])
+    safe = "".join(c if c.isalnum() or c in "._-" else "_" for c in stem)
+    return safe if len(safe) <= 120 else model + "-" + hashlib.sha256(stem.encode()).hexdigest()[:12]
 
 
 def build_fmu(model: str = "GearTwin.Gearbox21", modelica_dir: Path | str = "modelica",
               out_dir: Path | str = "build", *, step_size: float = DEFAULT_STEP_SIZE,
-              force: bool = False, fmi_version: int = 2) -> Path:
+              force: bool = False, fmi_version: int = 2, modifiers=None, name: str | None = None) -> Path:
     """Build ``<out_dir>/<model>.fmu`` from ``<modelica_dir>`` and return its path.
 
     Parameters
@@ -104,6 +262,10 @@ def build_fmu(model: str = "GearTwin.Gearbox21", modelica_dir: Path | str = "mod
     step_size : default internal RK4 step [s] (the FMU parameter ``solver.step_size``).
     force : rebuild even when the cache says the FMU is current.
     fmi_version : 2 (FMI 2.0) or 3 (FMI 3.0); both run the same generated code and solver.
+    modifiers : build options, ``{parameter: value}``; structural Integers (``z1``,
+        ``n_profile``) resize the model, Real values become defaults (:func:`check_modifiers`).
+        The FMU is then ``<out_dir>/<name>.fmu`` with ``name`` defaulting to
+        :func:`variant_name`, and the cache key covers the modifiers.
     """
     if not (step_size > 0):
         raise BuildError(f"step_size must be > 0 s, got {step_size!r}")
@@ -116,9 +278,13 @@ def build_fmu(model: str = "GearTwin.Gearbox21", modelica_dir: Path | str = "mod
     if not out_dir.parent.exists():
         raise BuildError(f"output directory's parent {out_dir.parent} does not exist")
     out_dir.mkdir(exist_ok=True)
-    digest = _sources_hash(modelica_dir, model, step_size, fmi_version)
-    fmu_path = out_dir / f"{model}.fmu"
-    stamp = out_dir / f".{model}.fmu.hash"
+    mods = _plain_modifiers(modifiers)
+    stem = name or variant_name(model, mods)
+    if not stem or any(not (c.isalnum() or c in "._-") for c in stem):
+        raise BuildError(f"FMU name must use letters, digits, '.', '_' and '-' only, got {stem!r}")
+    digest = _sources_hash(modelica_dir, model, step_size, fmi_version, mods)
+    fmu_path = out_dir / f"{stem}.fmu"
+    stamp = out_dir / f".{stem}.fmu.hash"
     if not force and fmu_path.exists() and stamp.exists() and stamp.read_text().strip() == digest:
         return fmu_path
 
@@ -131,9 +297,15 @@ def build_fmu(model: str = "GearTwin.Gearbox21", modelica_dir: Path | str = "mod
     src_file = model_file(modelica_dir, model)
     experiment = default_experiment(src_file, model.split(".")[-1])
     metadata = library_metadata(modelica_dir, model)
-    flat_text = flatten(modelica_dir, model)
+    mods = check_modifiers(modelica_dir, model, mods)
+    if any(isinstance(v, list) for v in mods.values()):
+        # array lengths follow the structural values: check them on the model resized first,
+        # so that a wrong length is named (rumoca reports a bare shape mismatch)
+        scalars = {k: v for k, v in mods.items() if not isinstance(v, list)}
+        _check_array_sizes(flatten(modelica_dir, model, scalars), mods, model)
+    flat_text = flatten(modelica_dir, model, mods)
     ode = build_ode(parse_flat(flat_text))
-    identifier = model.replace(".", "_")
+    identifier = "".join(c if c.isalnum() else "_" for c in stem)
     guid = "{" + digest[:8] + "-" + digest[8:12] + "-" + digest[12:16] + "-" + digest[16:20] + "-" + digest[20:32] + "}"
     info = description.BuildInfo(model=model, identifier=identifier, guid=guid, step_size=step_size,
                                  builder_version=BUILDER_VERSION, experiment=experiment, metadata=metadata,
@@ -173,7 +345,7 @@ def build_fmu(model: str = "GearTwin.Gearbox21", modelica_dir: Path | str = "mod
             raise BuildError("gcc not found; a C compiler is needed to build FMUs") from exc
         if proc.returncode != 0:
             raise BuildError(f"gcc failed for {model}:\n{proc.stderr[-4000:]}")
-        tmp_fmu = out_dir / f".{model}.fmu.tmp"
+        tmp_fmu = out_dir / f".{stem}.fmu.tmp"
         _zip_reproducible(root, tmp_fmu)
         os.replace(tmp_fmu, fmu_path)
     stamp.write_text(digest + "\n")

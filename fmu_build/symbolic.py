@@ -318,16 +318,30 @@ def build_ode(flat: FlatModel) -> OdeModel:
     consts: dict = {}          # structural values (Integer/Boolean parameters, constants)
     notes: list[str] = []
 
-    # Pass 1: structural integers, evaluated in declaration order.
+    # Pass 1: structural integers.  rumoca lists an extended base class first, so a binding may
+    # name a structural value declared further down (``extends Base(z2 = wheel_teeth)``): sweep
+    # until every binding has been evaluated, and report the ones that never resolve.
     num_env = _Env(consts, symbolic=False)
+    pending = []
     for d in flat.decls:
         if d.prefix in ("parameter", "constant") and d.type in ("Integer", "Boolean"):
             if d.binding is None:
                 raise BuildError(f"structural parameter {d.name} needs a binding")
-            consts[d.name] = _const_value(evaluate(d.binding, num_env), d.name)
+            pending.append(d)
         elif d.type in ("Integer", "Boolean", "String") and d.prefix not in ("parameter", "constant"):
             raise BuildError(f"variable {d.name}: only Real variables may vary in time "
                              f"(found {d.type}); discrete variables are outside the supported subset")
+    while pending:
+        waiting, error = [], None
+        for d in pending:
+            try:
+                consts[d.name] = _const_value(evaluate(d.binding, num_env), d.name)
+            except BuildError as exc:
+                waiting.append(d)
+                error = error or exc
+        if len(waiting) == len(pending):
+            raise error
+        pending = waiting
 
     def dims_of(d: Decl) -> list[int]:
         out = []

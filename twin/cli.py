@@ -59,10 +59,16 @@ def _cmd_build(args: argparse.Namespace) -> int:
     out = Path(args.out) if args.out else Path("build") / ("fmi3" if args.fmi == 3 else "")
     if args.fmi == 3 and not args.out:
         out.parent.mkdir(exist_ok=True)
+    sets = parse_assignments(args.set, "--set")
     for model in args.models or [DEFAULT_MODEL]:
         options = {"fmi_version": 3} if args.fmi == 3 else {}
-        path = fmu_build.build_fmu(model, Path(args.modelica_dir), out, step_size=args.step_size,
-                                   force=args.force, **options)
+        if sets:
+            path = _lib("twin.variants").build_variant(model, sets, modelica_dir=Path(args.modelica_dir),
+                                                       out_dir=out, step_size=args.step_size,
+                                                       force=args.force, **options)
+        else:
+            path = fmu_build.build_fmu(model, Path(args.modelica_dir), out, step_size=args.step_size,
+                                       force=args.force, **options)
         print(path)
     return 0
 
@@ -537,6 +543,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--force", action="store_true", help="rebuild even if up to date")
     p.add_argument("--fmi", type=int, choices=(2, 3), default=2,
                    help="FMI version of the FMU: 2 (FMI 2.0, default) or 3 (FMI 3.0 Co-Simulation and Model Exchange)")
+    p.add_argument("--set", action="append", metavar="NAME=VALUE",
+                   help="build option (repeatable): a structural parameter such as z1, z2, n_profile, or a "
+                        "parameter default; a changed gear geometry also recomputes the default k_pair")
     p.set_defaults(handler=_cmd_build)
 
     p = sub.add_parser("info", help="describe an FMU (fast); --modes or --measurements add its natural frequencies")

@@ -349,9 +349,9 @@ def compare(scenario, measurements, out_dir, *, record: str | None = None, durat
     params = dict(scenario.parameters)
     with FMU(fmu_path) as fmu:
         current = fmu.parameter_values()
-        z1_var = fmu.variables.get("z1")
-    z1 = int(round(float(z1_var.start))) if z1_var is not None and z1_var.start is not None else 19
-    z2 = int(round(params.get("z2", current.get("z2", 52))))
+        teeth = {**{k: v for k, v in current.items() if k in ("z1", "z2")}, **fmu.structural_values()}
+    z1 = int(round(float(teeth.get("z1", 19))))
+    z2 = int(round(float(teeth.get("z2", 52))))
     c_motor = params.get("c_motor", current.get("c_motor"))
     op = measured_operating(measured, rec.sample_rate, rec.nominal_speed, rec.load, teeth=z1, gear_teeth=z2,
                             c_motor=c_motor, solver_step=solver_step if "solver.step_size" in current else None)

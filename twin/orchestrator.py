@@ -82,8 +82,17 @@ def required_variables(scenario: Scenario) -> dict[str, list[tuple[set[str], str
 def check_compatibility(fmu: FMU, scenario: Scenario) -> None:
     """Raise :class:`FMUCompatibilityError` listing every way ``fmu`` does not fit ``scenario``."""
     problems = []
+    built = fmu.structural_values()
+    for name, value in scenario.structural.items():
+        if name in built and built[name] != value:
+            problems.append(f"the FMU was built with {name} = {built[name]}, the scenario's structural block "
+                            f"says {value!r}; name the model in 'fmu' to build the variant")
     for name, reqs in required_variables(scenario).items():
         v = fmu.variables.get(name)
+        if v is not None and v.variability == "constant" and name in built:
+            from twin.variants import rebuild_hint
+            problems.append(rebuild_hint(fmu.model_name, name, scenario.parameters.get(name, "<value>")))
+            continue
         if v is None:
             problems.append(f"missing variable {name!r} ({'; '.join(why for _, why, _ in reqs)})")
             continue

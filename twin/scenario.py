@@ -104,6 +104,10 @@ SCHEMA: dict[str, Any] = {
                            "variables": {"type": "array", "items": {"type": "string"}, "minItems": 1}},
         },
         "parameters": {**_NAME_MAP, "description": "Parameter values by FMU variable name."},
+        "structural": {**_NAME_MAP,
+                       "description": "Build options of the model named in 'fmu': structural parameters (z1, z2, "
+                                      "n_profile) and build-time defaults; the variant is built and cached "
+                                      "(like `twin build MODEL --set NAME=VALUE`)."},
         "parameter_files": {"type": "array", "items": {"type": "string"},
                             "description": "JSON ({name: value}) or SSP .ssv parameter sets, applied in order before "
                                            "'parameters' (and after the bindings of an .ssp fmu); .ssv values are "
@@ -229,6 +233,7 @@ class Scenario:
     sample_rate: float = 100_000.0
     outputs: tuple[str, ...] | None = None
     parameters: Mapping[str, float] = field(default_factory=dict)
+    structural: Mapping[str, float] = field(default_factory=dict)
     inputs: Mapping[str, Profile] = field(default_factory=dict)
     events: tuple[Event, ...] = ()
     degradation: Mapping[str, Any] | None = None
@@ -252,8 +257,12 @@ class Scenario:
             if self.fmu.endswith(".ssp"):
                 return _ssp_system(candidate, self.source).fmu
             return candidate
-        from fmu_build import build_fmu
         repo = Path(__file__).resolve().parents[1]
+        if self.structural:
+            from twin.variants import build_variant
+            return build_variant(self.fmu, dict(self.structural), modelica_dir=modelica_dir or repo / "modelica",
+                                 out_dir=build_dir or repo / "build")
+        from fmu_build import build_fmu
         return build_fmu(self.fmu, modelica_dir or repo / "modelica", build_dir or repo / "build")
 
     def _given_path(self) -> Path:
@@ -439,6 +448,9 @@ def scenario_from_dict(data: Any, source: Path | None = None) -> Scenario:
         except ScenarioError as exc:
             problems += [(where, f"parameter_files[{i}]", r) for _, _, r in exc.problems]
     params.update({k: float(v) for k, v in data.get("parameters", {}).items()})
+    structural = {k: int(v) if float(v).is_integer() else float(v) for k, v in data.get("structural", {}).items()}
+    for k in sorted(set(structural) & set(params)):
+        problems.append((where, f"parameters.{k}", f"{k!r} is also in 'structural'; give it in one place"))
 
     inputs: dict[str, Profile] = {}
     op = data.get("operating", {})
@@ -493,7 +505,7 @@ def scenario_from_dict(data: Any, source: Path | None = None) -> Scenario:
     outputs = tuple(out["variables"]) if "variables" in out else None
     return Scenario(name=data["name"], fmu=data["fmu"], stop_time=stop, source=source,
                     description=data.get("description", ""), start_time=start, communication_step=comm,
-                    sample_rate=rate, outputs=outputs, parameters=params, inputs=inputs,
+                    sample_rate=rate, outputs=outputs, parameters=params, structural=structural, inputs=inputs,
                     events=tuple(events), degradation=deg, archive=arc, executor=dict(ex),
                     seed=int(data.get("seed", 0)), raw=data)
 

@@ -7,7 +7,7 @@ model Gearbox21 "21-DOF lumped model of the UNSW spur-gear test rig (Feng et al.
 
   // ---- Gear geometry -------------------------------------------------------------------------
   parameter Integer z1 = 19 "Number of pinion teeth (structural: sizes the per-tooth arrays)";
-  parameter Real z2 = 52 "Number of gear teeth";
+  parameter Integer z2 = 52 "Number of gear teeth (structural: sets the geometry the built-in mesh stiffness is computed for)";
   parameter Real module(unit = "m", min = 0) = 3.0e-3 "Normal module";
   parameter Real alpha(unit = "rad", min = 0, max = GearTwin.pi / 2) = 20 * GearTwin.pi / 180 "Pressure angle";
   parameter Real face_width(unit = "m", min = 0) = 0.020 "Face width (stated assumption)";
@@ -22,10 +22,10 @@ model Gearbox21 "21-DOF lumped model of the UNSW spur-gear test rig (Feng et al.
 
   // ---- Mesh stiffness and profile (tunable; the degradation models write these) -------------
   parameter Integer n_profile = 11 "Number of nodes along the path of contact (structural)";
-  parameter Real k_pair[n_profile](each unit = "N/m", each min = 0, each nominal = 1e8) = {1.650e8, 2.136e8, 2.514e8, 2.784e8, 2.946e8, 3.000e8, 2.946e8, 2.784e8, 2.514e8, 2.136e8, 1.650e8} "Single-tooth-pair stiffness at equally spaced roll positions from start (root of pinion) to end (tip of pinion) of the path of contact";
-  parameter Real profile_deviation[n_profile](each unit = "m", each nominal = 1e-6) = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0} "Material missing from the pinion flank (wear depth, relief) at the same nodes, common to all teeth";
-  parameter Real tooth_stiffness_factor[z1] = {1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1} "Per-pinion-tooth multiplier of the pair stiffness (crack, spall, pitting of one tooth)";
-  parameter Real tooth_deviation_offset[z1](each unit = "m") = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0} "Per-pinion-tooth extra material loss, added to profile_deviation";
+  parameter Real k_pair[n_profile](each unit = "N/m", each min = 0, each nominal = 1e8) = {1.650e8 + 1.350e8 * (1 - (2 * (n - 1) / (n_profile - 1) - 1) ^ 2) for n in 1:n_profile} "Single-tooth-pair stiffness at equally spaced roll positions from start (root of pinion) to end (tip of pinion) of the path of contact";
+  parameter Real profile_deviation[n_profile](each unit = "m", each nominal = 1e-6) = fill(0.0, n_profile) "Material missing from the pinion flank (wear depth, relief) at the same nodes, common to all teeth";
+  parameter Real tooth_stiffness_factor[z1] = fill(1.0, z1) "Per-pinion-tooth multiplier of the pair stiffness (crack, spall, pitting of one tooth)";
+  parameter Real tooth_deviation_offset[z1](each unit = "m") = fill(0.0, z1) "Per-pinion-tooth extra material loss, added to profile_deviation";
   parameter Integer tooth_prev[z1] = {if j == 1 then z1 else j - 1 for j in 1:z1} "Index of the tooth ahead of tooth j (structural)";
   parameter Integer tooth_next[z1] = {if j == z1 then 1 else j + 1 for j in 1:z1} "Index of the tooth behind tooth j (structural)";
   parameter Real mesh_stiffness_scale(min = 0) = 1.0 "Calibration multiplier of all pair stiffnesses";
@@ -192,9 +192,9 @@ model Gearbox21 "21-DOF lumped model of the UNSW spur-gear test rig (Feng et al.
   // `twin add-effect` (or by hand, see
   // GearTwin/Effects/README.md) extends this model and binds a hook to the output of an effect
   // component from GearTwin.Effects, e.g. extends Gearbox21(effect_drive_torque = ripple.torque).
-  parameter Real effect_tooth_stiffness_factor[z1] = {1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1} "Per-pinion-tooth stiffness multiplier from an effect (local tooth damage); multiplies tooth_stiffness_factor";
-  parameter Real effect_tooth_offset[z1](each unit = "m") = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0} "Per-pinion-tooth material loss from an effect (spall); added to tooth_deviation_offset";
-  parameter Real effect_profile_deviation[n_profile](each unit = "m") = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0} "Material missing along the profile from an effect (distributed wear); added to profile_deviation";
+  parameter Real effect_tooth_stiffness_factor[z1] = fill(1.0, z1) "Per-pinion-tooth stiffness multiplier from an effect (local tooth damage); multiplies tooth_stiffness_factor";
+  parameter Real effect_tooth_offset[z1](each unit = "m") = fill(0.0, z1) "Per-pinion-tooth material loss from an effect (spall); added to tooth_deviation_offset";
+  parameter Real effect_profile_deviation[n_profile](each unit = "m") = fill(0.0, n_profile) "Material missing along the profile from an effect (distributed wear); added to profile_deviation";
   Real effect_pair_deviation[3](each unit = "m") = {0, 0, 0} "Extra material loss at the contact of each pair (leading, current, next): the gear's tooth errors (GearTwin.Variants.Gearbox21WheelErrors); added to pair_deviation";
   Real effect_mesh_displacement(unit = "m") = 0 "Extra approach of the flanks along the line of action (run-out)";
   Real effect_mesh_displacement_rate(unit = "m/s") = 0 "Time derivative of effect_mesh_displacement";

@@ -412,12 +412,12 @@ def record_conditions(fmu_path, measured: np.ndarray, sample_rate: float, nomina
     measured = measured[-int(round(min(duration, measured.size / sample_rate) * sample_rate)):]
     with FMU(fmu_path) as fmu:
         current = fmu.parameter_values()
-        z1_var = fmu.variables.get("z1")
-    missing = (["z1"] if z1_var is None else []) + [h for h in ("z2", "c_motor") if h not in current]
+        teeth = {**{k: v for k, v in current.items() if k in ("z1", "z2")}, **fmu.structural_values()}
+    missing = [h for h in ("z1", "z2") if h not in teeth] + [h for h in ("c_motor",) if h not in current]
     if missing:
         raise ParameterError(f"{fmu_path} is not a GearTwin.Gearbox21 model (no parameter(s) "
                              f"{', '.join(missing)}); the effect catalogue extends that model")
-    z1, z2 = int(round(float(z1_var.start))), int(round(current["z2"]))
+    z1, z2 = int(round(float(teeth["z1"]))), int(round(float(teeth["z2"])))
     op = measured_operating(measured, sample_rate, nominal_speed, load, teeth=z1, gear_teeth=z2,
                             c_motor=float(parameters.get("c_motor", current["c_motor"])),
                             solver_step=solver_step if "solver.step_size" in current else None)

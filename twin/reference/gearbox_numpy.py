@@ -71,7 +71,7 @@ _ARRAY_FIELDS = ("k_pair", "profile_deviation", "tooth_stiffness_factor", "tooth
                  "wheel_tooth_deviation_offset", "effect_tooth_stiffness_factor", "effect_tooth_offset",
                  "effect_profile_deviation")
 #: Structural Integer parameters of the model: FMU constants, never set as start values.
-STRUCTURAL = ("z1", "n_profile")
+STRUCTURAL = ("z1", "z2", "n_profile")
 #: Fields that only ``GearTwin.Variants.Gearbox21WheelErrors`` has as parameters (the base model
 #: has them at zero, through its hook ``effect_pair_deviation``).
 VARIANT_FIELDS = ("wheel_tooth_deviation_offset",)
@@ -91,7 +91,7 @@ class GearboxParams:
 
     # ---- gear geometry
     z1: int = 19                         # pinion teeth (structural)
-    z2: float = 52.0                     # gear teeth
+    z2: int = 52                         # gear teeth (structural)
     module: float = 3.0e-3               # m, normal module
     alpha: float = 20 * PI / 180         # rad, pressure angle
     face_width: float = 0.020            # m
@@ -275,7 +275,7 @@ class GearboxParams:
     def fmu_start_values(self, only_changed: bool = True, variant: bool = False) -> dict[str, float]:
         """Start values for the compiled FMU, keyed by its variable names (``k_pair[3]``, ...).
 
-        ``z1`` and ``n_profile`` are structural constants of the FMU and never included.  With
+        ``z1``, ``z2`` and ``n_profile`` are structural constants of the FMU and never included.  With
         ``only_changed`` only the fields that differ from the defaults are returned.  The gear's
         tooth offsets (:data:`VARIANT_FIELDS`) are parameters of the variant only: they are
         included when they are not all zero, or when ``variant`` is true.

@@ -164,7 +164,8 @@ def trajectory_from_scenario(scenario, *, method: str = "cosim", reach: float | 
     from twin._progress import progress_bar
     from twin.degradation import GearPair, MeshLoad, WearState, mesh_parameters, project_wear
     model = _degradation_model(scenario)
-    geometry = GearPair.from_parameters({k: v for k, v in scenario.parameters.items() if "[" not in k})
+    geometry = GearPair.from_parameters({**{k: v for k, v in scenario.parameters.items() if "[" not in k},
+                                         **scenario.structural})
     torque_pinion = _nominal(scenario, "load_torque", 20.0) * geometry.z1 / geometry.z2
     omega1 = 2 * math.pi * scenario_speed_hz(scenario)
     params = {k: v for k, v in scenario.parameters.items() if "[" in k or k == "mesh_stiffness_scale"}

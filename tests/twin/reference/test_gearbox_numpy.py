@@ -96,6 +96,7 @@ def test_parameters_and_start_state_match_fmu(gearbox_fmu, tmp_path):
         value = getattr(p, base)[int(index[:-1]) - 1] if index else getattr(p, base)
         assert float(by_name[name].start) == pytest.approx(value, rel=1e-15, abs=0), name
     assert int(by_name["z1"].start) == p.z1 and int(by_name["n_profile"].start) == p.n_profile
+    assert int(by_name["z2"].start) == p.z2
 
     derived = [v.name for v in md.modelVariables if v.causality == "calculatedParameter"]
     names = derived + list(gn.STATE_NAMES)
@@ -375,7 +376,7 @@ def test_gear_tooth_follows_the_mesh_count():
 
 
 def test_gear_tooth_array_needs_z2_entries():
-    with pytest.raises(ValueError, match="wheel_tooth_deviation_offset needs z2=52.0 entries, got 19"):
+    with pytest.raises(ValueError, match="wheel_tooth_deviation_offset needs z2=52 entries, got 19"):
         GearboxParams(wheel_tooth_deviation_offset=np.zeros(19))
 
 
