@@ -16,15 +16,18 @@ $(STAMP): pyproject.toml
 	$(VENV)/bin/pip install -e '.[test]'
 	touch $(STAMP)
 
-# The independent simulators of rigs/ write the pitting records that demo step 9 scores the
-# transfer on (twin/ never imports rigs/: it reads their files).
+# The independent simulators of rigs/ write the records that demo step 6 calibrates to and step 9
+# scores the transfer on (twin/ never imports rigs/: it reads their files).
 RIG_RECORDS := --records-per-stage 3 --record-duration 0.3 --damage-sampling snapshot --damage-scatter 0.1 --no-progress
 
 demo: venv
 	mkdir -p $(DEMO)/rigs
 	$(VENV)/bin/python -m rigs.lumped target scenarios/lubricated.yaml --out $(DEMO)/rigs/lumped.h5 --seed 3 $(RIG_RECORDS)
 	$(VENV)/bin/python -m rigs.ltca target scenarios/lubricated.yaml --out $(DEMO)/rigs/ltca.h5 --seed 4 $(RIG_RECORDS)
-	$(VENV)/bin/twin demo --out $(DEMO) --rig-records $(DEMO)/rigs/lumped.h5 $(DEMO)/rigs/ltca.h5
+	$(VENV)/bin/python -m rigs.pedestal steady --gearbox 3 --scatter 0.12 --seed 3 --duration 2 --out $(DEMO)/rigs/pedestal_steady.h5
+	$(VENV)/bin/python -m rigs.pedestal runup --gearbox 3 --scatter 0.12 --seed 3 --from 2 --to 20 --duration 6 --out $(DEMO)/rigs/pedestal_runup.h5
+	$(VENV)/bin/twin demo --out $(DEMO) --rig-records $(DEMO)/rigs/lumped.h5 $(DEMO)/rigs/ltca.h5 \
+		--calibration-records $(DEMO)/rigs/pedestal_steady.h5 $(DEMO)/rigs/pedestal_runup.h5
 
 test: venv
 	$(VENV)/bin/python -m pytest

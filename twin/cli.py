@@ -214,7 +214,8 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
 
 
 def _cmd_demo(args: argparse.Namespace) -> int:
-    _lib("twin.demo").run_demo(Path(args.out), stop_time=args.stop_time, rig_records=args.rig_records)
+    _lib("twin.demo").run_demo(Path(args.out), stop_time=args.stop_time, rig_records=args.rig_records,
+                               calibration_records=args.calibration_records)
     return 0
 
 
@@ -673,6 +674,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="simulated time [s] (default: 10)")
     p.add_argument("--rig-records", nargs="+", default=(), metavar="FILE",
                    help="pitting records of independent simulators (python -m rigs.lumped target ...) for step 9")
+    p.add_argument("--calibration-records", nargs=2, default=(), metavar=("STEADY", "RUNUP"),
+                   help="a steady and a run-up record of an independent simulator (python -m rigs.pedestal ...) "
+                        "for step 6")
     p.set_defaults(handler=_cmd_demo)
     return parser
 

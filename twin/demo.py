@@ -10,10 +10,12 @@ they stop is in the report files it writes and in ``docs/``.
    with a gear that has tooth errors of its own.
 5. The lubricated endurance scenario: fatigue pitting coupled to the co-simulation, to 20 %
    pitting density; mesh stiffness and vibration at five stages.
-6. Calibrate the default model with MOGOA to a built-in record and print the paper's Table 2. The
-   record is synthetic: a variant of the twin with four drive-train parameters off by 15-25 % and
-   5 % noise.
-7. ``twin compare`` of the calibrated model against that record and one with a cracked tooth.
+6. A gearbox the twin did not generate (records of ``rigs/pedestal`` read from files,
+   ``calibration_records``): ``twin modes`` on its raw run-up, ``twin calibrate --modes-from
+   runup`` to a calibrated scenario, and ``twin compare`` on that scenario (:mod:`twin.demo_rig`).
+7. Calibrate the default model with MOGOA to a built-in record of a twin variant with four
+   drive-train parameters off by 15-25 % and 5 % noise (the paper's Table 2), then ``twin compare``
+   of it against that record and one with a cracked tooth.
 8. ``twin improve`` on a record with a hidden casing mode.
 9. Wear-stage assessment by transfer learning: CNN, MMD and the proposed method on an emulated
    rig, then the proposed method on the records of the independent simulators of ``rigs/``
@@ -50,8 +52,12 @@ def _written(*paths) -> None:
 
 
 def run_demo(out_dir: Path | str = "demo_out", *, stop_time: float = 10.0,
-             modelica_dir: Path | str | None = None, rig_records=()) -> dict:
+             modelica_dir: Path | str | None = None, rig_records=(), calibration_records=()) -> dict:
     """Run the demo and return a dict of the produced paths and headline numbers.
+
+    ``calibration_records``: a steady and a run-up record of a rig of ``rigs/`` (two files, in
+    that order; ``make demo`` writes them with ``python -m rigs.pedestal``) for step 6, which is
+    skipped without them.
 
     ``rig_records``: measurement files of the pitting stages written by the independent simulators
     of ``rigs/`` (``make demo`` writes them with ``python -m rigs.lumped target`` and ``python -m
@@ -67,7 +73,10 @@ def run_demo(out_dir: Path | str = "demo_out", *, stop_time: float = 10.0,
 
     out_dir = Path(out_dir)
     rig_records = [Path(f) for f in rig_records]
-    missing = [f for f in rig_records if not f.is_file()]
+    calibration_records = [Path(f) for f in calibration_records]
+    if calibration_records and len(calibration_records) != 2:
+        raise ParameterError(f"calibration records: give a steady and a run-up file, got {len(calibration_records)}")
+    missing = [f for f in (*rig_records, *calibration_records) if not f.is_file()]
     if missing:
         raise ParameterError(f"rig records '{missing[0]}' do not exist")
     if not out_dir.parent.exists():
@@ -112,13 +121,19 @@ def run_demo(out_dir: Path | str = "demo_out", *, stop_time: float = 10.0,
     _gear_errors_demo(result, modelica_dir, stop_time, pinion_hz)
     _written(h5, png)
     stages_png, stage_rows = _degradation_demo(fmu, out_dir)
+    rig = None
+    if calibration_records:
+        from twin.demo_rig import rig_calibration_demo
+        rig = rig_calibration_demo(out_dir, *calibration_records)
+    else:
+        _heading(6, "skipped: no rig records (make demo writes them with python -m rigs.pedestal)")
     report = _calibration_demo(fmu, out_dir)
     _compare_demo(out_dir)
     history = _loop_demo(out_dir)
     transfer = _transfer_demo(out_dir, rig_records)
     return {"loop": history, "transfer": transfer, "fmu": fmu, "hdf5": Path(h5), "png": Path(png), "natural_frequencies": freqs,
             "simulation_wall_time": wall, "stages_png": stages_png, "stages": stage_rows,
-            "calibration": report}
+            "calibration": report, "rig_calibration": rig}
 
 
 def _gear_errors_demo(base, modelica_dir: Path, stop_time: float, pinion_hz: float) -> None:
@@ -177,8 +192,8 @@ def _calibration_demo(fmu: Path, out_dir: Path):
                         "natural_frequencies": modes.tolist(), "record_duration": 0.3}})
     report = run_calibration(scenario, rig, out_dir / "calibration", progress=False)
     r = report.result
-    _heading(6, f"Calibration of 4 drive-train parameters with MOGOA ({r.n_evals} evaluations)",
-             time.perf_counter() - t)
+    _heading(7, f"Calibration of 4 drive-train parameters with MOGOA ({r.n_evals} evaluations) to a twin "
+                f"variant; then twin compare", time.perf_counter() - t)
     _lines(report.table())
     ob, oa = report.objectives_before, report.objectives_after
     _lines(f"  f1 {ob[0]:.4f} -> {oa[0]:.4f}   f2 {ob[1]:.4f} -> {oa[1]:.4f}   f3 {ob[2]:.1f} -> {oa[2]:.2f} Hz^2")
@@ -253,7 +268,7 @@ def _compare_demo(out_dir: Path) -> None:
                                    "parameters": calibrated})
     healthy = compare(scenario, out_dir / "rig_measurement.h5", out_dir / "compare_healthy", duration=0.3)
     damaged = compare(scenario, rig, out_dir / "compare_damaged", duration=0.5)
-    _heading(7, "twin compare: the calibrated model against the rig's records")
+    _lines("twin compare: the calibrated model against the variant's records")
     rows = ["record               log-spectral distance   findings",
             f"healthy              {healthy.lsd_db:17.2f} dB   {len(healthy.findings):8d}",
             f"cracked pinion tooth {damaged.lsd_db:17.2f} dB   {len(damaged.findings):8d}"]

@@ -39,7 +39,7 @@ def shaft_angle(record) -> np.ndarray | None:
     if record.tachometer is not None:
         x = record[record.tachometer]
         if record.tachometer_kind == "angle":
-            return shaft_angle_from_encoder(x)
+            return smooth_counts(shaft_angle_from_encoder(x))
         return shaft_angle_from_tacho(x, fs, record.pulses_per_rev or 1)
     for name in record.channel_names:
         unit = record.units[name]
@@ -47,6 +47,37 @@ def shaft_angle(record) -> np.ndarray | None:
             speed = np.asarray(record[name], float) / (2 * np.pi if unit == "rad/s" else 1.0)
             return shaft_angle_from_speed(speed.size, fs, speed)
     return None
+
+
+def smooth_counts(angle: np.ndarray) -> np.ndarray:
+    """A quantised encoder angle [rad] made smooth and strictly increasing.
+
+    A 512-line encoder read at 50 kHz holds each count for many samples at low speed. Each
+    change of count is taken to happen half a sample before it is seen, and the angle between
+    changes follows a monotone cubic (PCHIP) through them; before the first and after the last
+    change it is extrapolated at the speed of the nearest interval. An angle that already
+    increases at every sample is returned unchanged.
+    """
+    from scipy.interpolate import PchipInterpolator
+
+    angle = np.asarray(angle, float)
+    step = np.diff(angle)
+    if np.all(step > 0):
+        return angle
+    change = np.flatnonzero(step != 0) + 1
+    if change.size < 3:
+        return angle
+    t = change - 0.5
+    a = angle[change]
+    keep = np.concatenate([[True], np.diff(a) > 0])
+    t, a = t[keep], a[keep]
+    n = np.arange(angle.size, dtype=float)
+    out = PchipInterpolator(t, a, extrapolate=False)(n)
+    first = (a[1] - a[0]) / (t[1] - t[0])
+    last = (a[-1] - a[-2]) / (t[-1] - t[-2])
+    out[n < t[0]] = a[0] + first * (n[n < t[0]] - t[0])
+    out[n > t[-1]] = a[-1] + last * (n[n > t[-1]] - t[-1])
+    return out
 
 
 def _force_channel(record) -> str | None:

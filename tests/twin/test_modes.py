@@ -87,3 +87,18 @@ def test_cli_bad_record_and_bad_output_path(runup, tmp_path, capsys):
     assert "record 'steady': no such record" in capsys.readouterr().err
     assert main(["modes", str(h5), "--json", str(tmp_path / "no" / "m.json")]) == 2
     assert "does not exist" in capsys.readouterr().err
+
+
+def test_a_quantised_encoder_gives_the_same_survey(runup):
+    x, angle, truth = runup
+    counts = np.floor(angle / (2 * np.pi / 512)) * (2 * np.pi / 512)       # a 512-line encoder
+    from twin.modes import smooth_counts
+    smooth = smooth_counts(counts)
+    assert np.all(np.diff(smooth) > 0)
+    assert np.max(np.abs(smooth - angle)) < 2 * np.pi / 512
+    rec = Record("r", {"accel_pinion_casing": x, "encoder": counts}, {"accel_pinion_casing": "m/s2", "encoder": "rad"},
+                 FS, tachometer="encoder", tachometer_kind="angle")
+    s = survey_record(rec)
+    assert any(abs(o.order - 19.0) < 0.05 for o in s.orders)
+    for fn, _ in truth["modes"][:6]:
+        assert min(abs(s.frequencies() - fn)) / fn < 0.02

@@ -230,7 +230,7 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
                                         shared=len(mode_channels)))
             if path:
                 fixed.update(path)
-                attributed = sorted(v for k, v in path.items() if "panel_frequency" in k)
+                attributed = sorted({v for k, v in path.items() if "panel_frequency" in k})
                 path_note = ("attributed to casing panel modes in the sensor path (no gearbox mode within 15 %): "
                              + ", ".join(f"{f:.1f} Hz" for f in attributed))
                 if progress:
@@ -275,8 +275,9 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
                 for n, lo, hi in zip(space.names, space.lower, space.upper)
                 if n in on_bounds(space.names, [chosen[k] for k in space.names], space.lower, space.upper)]
     notes = tuple(n for n in (path_note, f"levels: {levels.describe()}" if levels is not None else None) if n)
-    for w in warnings:
-        print(f"warning: {w}")
+    if progress:
+        for w in warnings:
+            print(f"warning: {w}")
     full = {**fixed, **chosen}
     write_parameter_set(full, out_dir / "calibrated.json")
     write_parameter_set(full, out_dir / "calibrated.ssv", name=f"{scenario.name}-calibrated", fmu=fmu)
