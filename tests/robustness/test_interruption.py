@@ -78,10 +78,18 @@ def test_ctrl_c_is_honoured_every_time_in_a_degradation_run(work, gearbox_fmu):
 
 def test_resume_continues_its_own_partial_run_and_refuses_another(work, gearbox_fmu):
     (work / "deg.yaml").write_text(DEGRADATION.format(name="deg", fmu=gearbox_fmu, stop=0.05, inc=0.01,
-                                                      stop_density=0.04))
+                                                      stop_density=0.12))
     (work / "other.yaml").write_text(DEGRADATION.format(name="other", fmu=gearbox_fmu, stop=0.05, inc=0.02,
-                                                        stop_density=0.04))
-    code, _, _ = interrupt(work, ["run", "deg.yaml", "--output", "d.h5", "--no-progress"], signal.SIGINT, 6.0)
+                                                        stop_density=0.12))
+    # Interrupt once the first stage is on disk, however fast the machine: a fixed delay let a fast
+    # machine finish the whole run first.
+    proc = start_twin(["run", "deg.yaml", "--output", "d.h5", "--no-progress"], work)
+    deadline = time.monotonic() + 120
+    while not (work / "d.partial.h5").exists() and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGINT)
+    proc.communicate(timeout=120)
+    code = proc.returncode
     assert code == 130 and (work / "d.partial.h5").exists() and not (work / "d.h5").exists()
     with h5py.File(work / "d.partial.h5") as f:
         done = len(f["stages"])
