@@ -593,7 +593,41 @@ def validate(path: str | Path) -> list[str]:
         raise FMUError(f"FMU file {path} does not exist")
     if not zipfile.is_zipfile(path) and not path.is_dir():
         raise FMUError(f"{path} is not an FMU (not a zip archive)")
-    return [str(p) for p in validate_fmu(str(path))]
+    problems = [str(p) for p in validate_fmu(str(path))]
+    if not problems and zipfile.is_zipfile(path):
+        problems += _binary_problems(path)
+    return problems
+
+
+def _instantiate_only(path: str) -> None:
+    import shutil
+    import tempfile
+
+    from fmpy import extract, instantiate_fmu, read_model_description
+
+    unzipdir = extract(path, unzipdir=tempfile.mkdtemp(prefix="twin_fmu_"))
+    try:
+        md = read_model_description(unzipdir)
+        kind = "CoSimulation" if md.coSimulation is not None else "ModelExchange"
+        try:
+            instance = instantiate_fmu(unzipdir, md, fmi_type=kind)
+        except Exception as exc:     # fmpy raises plain exceptions for a library it cannot load
+            raise FMUError(f"cannot load or instantiate: {exc}") from None
+        instance.freeInstance()
+    finally:
+        shutil.rmtree(unzipdir, ignore_errors=True)
+
+
+def _binary_problems(path: Path) -> list[str]:
+    """Load and instantiate the platform binary in a child process: a truncated or foreign
+    shared library passes every XML check but crashes (SIGBUS, SIGSEGV) or fails on first use."""
+    from twin.isolation import run_isolated
+
+    try:
+        run_isolated(_instantiate_only, str(path), timeout=60.0, what=f"the instantiation of {path.name}")
+    except (FMUError, SimulationError) as exc:      # WorkerCrashError is a SimulationError
+        return [f"The binary for this platform cannot be loaded and instantiated: {exc}"]
+    return []
 
 
 def xml_schema(kind: str, name: str) -> Path:

@@ -2,6 +2,7 @@
 errors) end one task, never the run, and are reported with their signal or exit status."""
 from __future__ import annotations
 
+import re
 import tempfile
 from pathlib import Path
 
@@ -101,6 +102,14 @@ def test_null_instance_reports_the_fmu_message_not_a_crash(faulty_fmus):
 def test_truncated_binary_is_reported_with_its_signal_or_load_error(faulty_fmus):
     with pytest.raises((WorkerCrashError, FMUError), match="SIGBUS|SIGSEGV|cannot load"):
         run_isolated(simulate_faulty, (str(faulty_fmus["truncated"]), 0))
+
+
+def test_validate_loads_the_binary_and_names_a_truncated_one(faulty_fmus):
+    # every XML check passes on a cut shared library; only loading it shows the fault
+    from twin.fmu import validate
+    problems = validate(faulty_fmus["truncated"])
+    assert len(problems) == 1 and "cannot be loaded" in problems[0], problems
+    assert re.search("SIGBUS|SIGSEGV|cannot load", problems[0]), problems
 
 
 @pytest.mark.parametrize("code, text", [(-11, "SIGSEGV (Segmentation fault)"), (-9, "SIGKILL"), (3, "status 3"),
