@@ -22,6 +22,13 @@ def gearbox_fmu(fmu_dir) -> Path:
 
 
 @pytest.fixture(scope="session")
+def measured_fmu(fmu_dir) -> Path:
+    """The gearbox as its casing accelerometers measure it (GearTwin.Gearbox21Measured)."""
+    from fmu_build import build_fmu
+    return build_fmu("GearTwin.Gearbox21Measured", MODELICA, fmu_dir)
+
+
+@pytest.fixture(scope="session")
 def wheel_fmu(fmu_dir) -> Path:
     """The variant with the gear's own tooth errors (GearTwin.Variants.Gearbox21WheelErrors)."""
     from fmu_build import build_fmu

@@ -42,12 +42,6 @@ def check_dir(tmp_path_factory):
     return root
 
 
-@pytest.fixture(scope="session")
-def measured_fmu(fmu_dir):
-    from fmu_build import build_fmu
-    return build_fmu("GearTwin.Gearbox21Measured", REPO / "modelica", fmu_dir)
-
-
 def _roughness_reference(angle, rms, slope, seed):
     j, k = np.arange(1, 17), np.arange(1, 9)
     p = (16.0 * j) ** (-slope)

@@ -132,6 +132,17 @@ class ModelModes:
     visible: np.ndarray           # (m,) bool
     shapes: np.ndarray            # (n, m) complex
     gain_db: np.ndarray           # (m,) peak gain of the mode alone, dB re the most visible
+    classes: tuple = ()           # (m,) ModeClass of each mode (twin.calibration.mode_classes)
+    sensor_shapes: np.ndarray | None = None   # (k, m) complex residue of each mode at each channel (mesh)
+    channels: tuple[str, ...] = ()
+
+    def sensor_shape(self, i: int, channels: Sequence[str]) -> np.ndarray:
+        """Mode i's residues at ``channels`` (those it was linearised with; 0 for others), (len,)."""
+        out = np.zeros(len(channels), complex)
+        for j, c in enumerate(channels):
+            if self.sensor_shapes is not None and c in self.channels:
+                out[j] = self.sensor_shapes[self.channels.index(c), i]
+        return out
 
 
 def model_modes(fmu_path, parameters: Mapping[str, float], *, speed_hz: float, load_nm: float,
@@ -169,7 +180,10 @@ def model_modes(fmu_path, parameters: Mapping[str, float], *, speed_hz: float, l
                         i = np.flatnonzero(near)[np.argmax(gain[near])]
                         visible[i] = True
     top = gain[visible].max() if visible.any() else (gain.max() if gain.size else 1.0)
-    return ModelModes(freq, damp, visible, shapes, 20 * np.log10(np.maximum(gain, 1e-300) / top))
+    from twin.calibration.mode_classes import classify, dof_table, mass_values
+    table = dof_table(lm.state_names, {**mass_values(fmu_path, parameters), **parameters})
+    return ModelModes(freq, damp, visible, shapes, 20 * np.log10(np.maximum(gain, 1e-300) / top),
+                      tuple(classify(shapes, table)), mm.residues[:, 0, keep], tuple(channels))
 
 
 def match_measured(model: ModelModes, measured: np.ndarray, rel_sd: np.ndarray | None = None) -> np.ndarray:

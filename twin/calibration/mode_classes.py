@@ -1,0 +1,132 @@
+"""What moves in each model mode: its class, from the share of kinetic energy of each part.
+
+A linearised GearTwin model's right eigenvector holds the velocity of every degree of freedom.
+Weighted by the masses and inertias (read from the FMU's parameters), ``m |v|^2`` is each part's
+share of the mode's kinetic energy; the part with the largest share names the mode:
+
+| class | degrees of freedom (velocity states) | mass |
+|---|---|---|
+| ``torsion`` | ``omegaN`` | ``IN`` |
+| ``pinion lateral x`` / ``y`` | ``vx5`` / ``vy5`` | ``m5`` |
+| ``gear lateral x`` / ``y`` | ``vx10`` / ``vy10`` | ``m10`` |
+| ``input pedestals x`` / ``y`` | ``vx4``, ``vx6`` / ``vy4``, ``vy6`` | ``m4``, ``m6`` |
+| ``output pedestals x`` / ``y`` | ``vx9``, ``vx11`` / ``vy9``, ``vy11`` | ``m9``, ``m11`` |
+| ``casing`` | ``casing.qd[k]`` (GearTwin.Housing.ModalCasing) | 1 (its states carry sqrt of the modal mass) |
+| ``sensor path`` | a sensor's panel or mount modes (massless: only when nothing else moves) | |
+
+A mode whose energy is split (a torsional mode that drags the pinion sideways through the mesh)
+carries every share, so a calibration can ask "mostly lateral?" as well as "which class?".
+"""
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+#: (velocity-state pattern, class, mass parameter template); the first match applies.
+DOF_RULES: tuple[tuple[str, str, str | None], ...] = (
+    (r"^omega(\d+)$", "torsion", r"I\1"),
+    (r"^vx5$", "pinion lateral x", "m5"),
+    (r"^vy5$", "pinion lateral y", "m5"),
+    (r"^vx10$", "gear lateral x", "m10"),
+    (r"^vy10$", "gear lateral y", "m10"),
+    (r"^vx(4|6)$", "input pedestals x", r"m\1"),
+    (r"^vy(4|6)$", "input pedestals y", r"m\1"),
+    (r"^vx(9|11)$", "output pedestals x", r"m\1"),
+    (r"^vy(9|11)$", "output pedestals y", r"m\1"),
+    (r"^casing\.qd\[(\d+)\]$", "casing", None),
+    (r"^sensor_\w+\.(panel_rate\[\d+\]|deflection_rate)$", "sensor path", None),
+)
+#: The classes, in the order reports list them.
+CLASSES = ("torsion", "pinion lateral x", "pinion lateral y", "gear lateral x", "gear lateral y",
+           "input pedestals x", "input pedestals y", "output pedestals x", "output pedestals y", "casing",
+           "sensor path")
+#: A mode counts as the sensor path's own when the structure carries less than this share of the
+#: velocity (unweighted) of the mode: the path's modes do not act back, so the structure is still.
+SENSOR_PATH_SHARE = 1e-6
+
+
+@dataclass(frozen=True)
+class ModeClass:
+    """The class of one mode and the kinetic-energy share of every class in it."""
+
+    name: str                       # the class with the largest share
+    shares: Mapping[str, float]     # class -> share of the kinetic energy, summing to 1
+
+    @property
+    def lateral(self) -> float:
+        """Share of the lateral classes (shafts and pedestals, both planes)."""
+        return float(sum(v for k, v in self.shares.items() if k.endswith((" x", " y"))))
+
+    @property
+    def plane(self) -> str:
+        """'x' or 'y' when the lateral motion is mostly in one plane, else ''."""
+        x = sum(v for k, v in self.shares.items() if k.endswith(" x"))
+        y = sum(v for k, v in self.shares.items() if k.endswith(" y"))
+        if x + y <= 0:
+            return ""
+        return "x" if x >= 0.7 * (x + y) else "y" if y >= 0.7 * (x + y) else ""
+
+
+def dof_table(state_names: Sequence[str], values: Mapping[str, float]) -> list[tuple[int, str, float]]:
+    """(state index, class, mass) of every velocity state the rules know; mass 0 for the sensor path.
+
+    ``values`` maps parameter names to values (those missing default to 1, which only matters
+    for a model outside the GearTwin naming).
+    """
+    out = []
+    for i, name in enumerate(state_names):
+        for pattern, cls, mass in DOF_RULES:
+            m = re.match(pattern, name)
+            if m is None:
+                continue
+            if cls == "sensor path":
+                w = 0.0
+            elif mass is None:
+                w = 1.0
+            else:
+                w = float(values.get(m.expand(mass), 1.0))
+            out.append((i, cls, w))
+            break
+    return out
+
+
+def classify(shapes: np.ndarray, table: Sequence[tuple[int, str, float]]) -> list[ModeClass]:
+    """The class of each mode (column) of ``shapes`` (n_states, m) from a :func:`dof_table`."""
+    out = []
+    idx = np.array([i for i, _, _ in table], dtype=int)
+    cls = [c for _, c, _ in table]
+    w = np.array([m for _, _, m in table], float)
+    sensor = np.array([c == "sensor path" for c in cls])
+    for k in range(shapes.shape[1]):
+        v2 = np.abs(shapes[idx, k]) ** 2
+        if v2[~sensor].sum() <= SENSOR_PATH_SHARE * max(v2.sum(), 1e-300):
+            out.append(ModeClass("sensor path", {"sensor path": 1.0}))
+            continue
+        energy: dict[str, float] = {}
+        for c, e in zip(cls, w * v2):
+            if c != "sensor path":
+                energy[c] = energy.get(c, 0.0) + float(e)
+        total = sum(energy.values()) or 1.0
+        shares = {c: e / total for c, e in energy.items() if e > 0}
+        out.append(ModeClass(max(shares, key=shares.get) if shares else "sensor path", shares))
+    return out
+
+
+def mass_values(fmu_path, parameters: Mapping[str, float]) -> dict[str, float]:
+    """Masses and inertias of the model (``I*``, ``m*`` parameters) at ``parameters``."""
+    from pathlib import Path
+
+    from twin.fmu import FMU
+
+    key = (str(fmu_path), Path(fmu_path).stat().st_mtime_ns)
+    if key not in _STARTS:
+        with FMU(fmu_path) as fmu:
+            _STARTS[key] = {v.name: float(v.start if v.start is not None else 1.0) for v in fmu.parameters
+                            if re.match(r"^(I|m)\d+$", v.name)}
+    return {n: float(parameters.get(n, v)) for n, v in _STARTS[key].items()}
+
+
+_STARTS: dict = {}
