@@ -541,6 +541,9 @@ def write_archive(archive: Archive, path: Path, scenario: Scenario, run=None) ->
             f.attrs["sample_rate"] = archive.sample_rate
             f.attrs["damage_kind"] = archive.damage_kind
             f.attrs["stages"] = np.asarray(archive.stages)
+            # the test's operating point, which the assessor's window length and its checks of rig
+            # records follow (twin.transfer.settings)
+            f.attrs["nominal_speed"], f.attrs["nominal_load"] = nominal_operating_point(scenario)
             f.attrs["scenario"] = json.dumps(scenario.raw, default=str)
             f.attrs["seed"] = scenario.seed
             recs = f.create_group("records", track_order=True)

@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from twin.archive import build_archive, interpolate_parameters, read_archive
+from twin.archive import TOOTH_ERROR_KEYS, build_archive, interpolate_parameters, read_archive
 from twin.errors import SimulationError
 from twin.scenario import load_scenario
 
@@ -17,7 +17,8 @@ def _small(seed=0, workers=1, executor=None):
     sc = load_scenario(REPO / "scenarios" / "lubricated.yaml")
     deg = dict(sc.degradation)
     deg.update({"stop": {"pitting_density": 0.07}, "load_window": 0.05, "record_duration": 0.0})
-    arc = dict(sc.archive)
+    # the shipped archive's pinions have errors of their own; these tests start from perfect ones
+    arc = {k: v for k, v in sc.archive.items() if k not in TOOTH_ERROR_KEYS}
     arc.update({"stages": [0.0, 0.03, 0.06], "records_per_stage": 2, "record_duration": 0.01, "settle_time": 0.01})
     return sc.with_overrides(degradation=deg, archive=arc, seed=seed,
                              executor=executor or {"type": "local", "workers": workers})
