@@ -51,3 +51,44 @@ def tiny_assessor(method: str, pre: Preprocessing, seed: int = 0, epochs: int = 
     from twin.transfer import Assessor
     return Assessor(method, preprocessing=pre, epochs=epochs, seed=seed, batch_size=20, progress=False,
                     augmentation=Augmentation(noise=0.05, gain=0.05, speed_jitter=0.0), warmup_epochs=2, **kw)
+
+
+# ---- archives for the ensemble: the settings follow from the archive's test (2048-sample windows) ----
+ARCHIVE_FS = 20480.0        # the lubricated test's rate: 1024 x 20 Hz, so nothing is resampled
+
+
+def stage_signal(k: int, n: int, rng, *, fs: float = ARCHIVE_FS, gain: float = 1.0, mesh: float = 380.0):
+    """A 'mesh' tone and harmonic growing with stage k, plus noise."""
+    t = np.arange(n) / fs
+    x = (1 + 0.5 * k) * np.sin(2 * np.pi * mesh * t) + 0.4 * k * np.sin(2 * np.pi * 2 * mesh * t + 0.3)
+    return gain * (x + rng.normal(0, 0.2, n))
+
+
+def write_tiny_archive(path, stages: int = 3, per_stage: int = 4, n: int = 6144, seed: int = 0,
+                       scenario: str = "lubricated.yaml"):
+    """A gear-twin archive of the shipped scenario's test with synthetic signals; returns its path."""
+    from pathlib import Path
+
+    from twin.archive import Archive, write_archive
+    from twin.scenario import load_scenario
+    sc = load_scenario(Path(__file__).resolve().parents[3] / "scenarios" / scenario)
+    rng = np.random.default_rng(seed)
+    labels = np.repeat(np.arange(stages), per_stage)
+    bounds = tuple(float(b) for b in np.linspace(0.0, 0.03 * stages, stages + 1))
+    sig = np.stack([stage_signal(int(k), n, rng) for k in labels]).astype(np.float32)
+    speed = 20.0 if scenario == "lubricated.yaml" else 10.0
+    arc = Archive(labels, labels * 0.03 + 0.01, np.full(labels.size, speed), np.full(labels.size, 20.0),
+                  {CH: sig}, ARCHIVE_FS, bounds, "pitting_density" if scenario == "lubricated.yaml" else "wear_depth")
+    write_archive(arc, Path(path), sc)
+    return Path(path)
+
+
+def rig_records(stages: int = 3, per_stage: int = 3, n: int = 12500, seed: int = 1, *, fs: float = 25000.0,
+                speed: float = 20.0, load: float = 20.0, timed: bool = False, labelled: bool = True,
+                order=None) -> list[Record]:
+    """A rig's records of the same stages at another rate, gain and mesh frequency (1 % off)."""
+    rng = np.random.default_rng(seed)
+    ks = np.repeat(np.arange(stages), per_stage) if order is None else np.asarray(order)
+    return [Record(f"rec{i:02d}", {CH: stage_signal(int(k), n, rng, fs=fs, gain=2.5, mesh=383.8)}, {CH: "m/s2"}, fs,
+                   nominal_speed=speed, load=load, label=int(k) if labelled else None,
+                   time_start=float(3600 * i) if timed else 0.0) for i, k in enumerate(ks)]
