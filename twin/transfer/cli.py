@@ -17,30 +17,61 @@ def _lib(name: str):
 
 
 def _cmd_train_assessor(args: argparse.Namespace) -> int:
-    transfer = _lib("twin.transfer")
     from twin.errors import OutputPathError
+    from twin.measurements import load_measurements
+    from twin.transfer.ensemble import train_ensemble
     out = Path(args.out)
     if not out.parent.is_dir():    # before minutes of training, not after
         raise OutputPathError(f"output directory '{out.parent}' does not exist (for '{out}')")
-    settings = {"remove_level": args.remove_level, "channel": args.channel, "target_channel": args.target_channel}
-    pre = (transfer.Preprocessing(**settings) if args.shaft_speed is None
-           else transfer.Preprocessing.for_shaft_speed(args.shaft_speed, **settings))
-    a = transfer.Assessor(args.method, epochs=args.epochs, seed=args.seed, preprocessing=pre,
-                          progress=not args.no_progress, class_prior=None if args.no_class_prior else args.class_prior,
-                          pairs=args.pairs, contrastive_reduction=args.contrastive_reduction)
-    from twin.transfer.errors import class_prior_notes
-    with class_prior_notes() as notes:
-        a.fit(Path(args.source), Path(args.target))
-    a.save(out)
-    from twin.transfer.report import plot_learning_curves
-    curves = plot_learning_curves({args.method: a.history_}, out / "learning_curves.png",
-                                  f"{args.method}, seed {args.seed}: {args.source} -> {args.target}")
-    last = a.history_[-1]
-    print(f"{args.method}: {a.n_classes_} stages, {a.n_source_windows_} source / {a.n_target_windows_} target "
-          f"windows, {len(a.history_)} epochs in {a.fit_time_:.0f} s; last epoch: loss {last['loss']:.3f}, "
-          f"source accuracy {100 * last['source_acc']:.1f} % -> {out} (learning curves: {curves})")
-    _print_match(a, notes)
+    source = Path(args.source)
+    rig = load_measurements(Path(args.target), channels=[args.target_channel or args.channel])
+    skip = {n.strip() for n in (args.exclude or "").split(",") if n.strip()}
+    unknown = sorted(skip - set(rig.names))
+    if unknown:
+        from twin.transfer.errors import AssessorError
+        raise AssessorError(f"--exclude: no record(s) {', '.join(unknown)} in {args.target}")
+    records = [r for r in rig.records if r.name not in skip]
+    if source.suffix.lower() in (".yaml", ".yml", ".json"):
+        # a scenario (a calibrated one, say): its archive first, at the rig's operating point
+        from twin._atomic import check_output_dir
+        from twin.pipeline.run import archive_for_records
+        from twin.scenario import load_scenario
+        check_output_dir(out, "assessor ensemble", create=True)
+        arc = out / "archive.h5"
+        print(f"archive of {source} at the rig's operating point -> {arc}")
+        archive_for_records(load_scenario(source), records, arc, jobs=args.jobs, progress=not args.no_progress)
+        source = arc
+    ens = train_ensemble(source, records, out, members=args.members, method=args.method, epochs=args.epochs,
+                         first_seed=args.first_seed, jobs=args.jobs, channel=args.channel,
+                         target_channel=args.target_channel, progress=not args.no_progress)
+    f, pre = ens.facts, ens.preprocessing
+    print(f"{args.method} ensemble of {len(ens.members)} (seeds {args.first_seed}-{args.first_seed + args.members - 1}) "
+          f"trained in {ens.train_time_:.0f} s on {source} -> {out}")
+    print(f"settings from the archive: {f.damage_kind} in {f.n_stages} stages at {f.nominal_speed:g} Hz / "
+          f"{f.nominal_load:g} N.m; windows of two pinion revolutions ({pre.sample_rate:g} Hz), level "
+          f"{'removed' if pre.remove_level else 'kept'}, class prior {ens.rule}")
+    res = ens.assess(records)
+    print(f"on its {len(records)} rig records: {res.verdict()}")
+    print(res.order.message())
     return 0
+
+
+def _print_ensemble(res) -> None:
+    """The ensemble's verdict per record, then how far to trust it."""
+    for r in res.records:
+        lab = "" if r.label is None else f"  (label {r.label})"
+        ordered = "" if r.ordered_stage is None else f", {r.ordered_stage} in time order"
+        print(f"{r.name}: stage {r.stage}{ordered}, confidence {r.confidence:.2f}, members "
+              f"{'/'.join(map(str, r.member_stages))} ({100 * r.agreement:.0f} % of windows alike){lab}")
+    for n in res.notes:
+        print(f"note: {n}")
+    if res.records[0].ordered_stage is not None:
+        print(f"time order ({res.time_order}): {res.moved_by_time_order} of {len(res.records)} records moved")
+    scores = res.scores()
+    if scores:
+        print("accuracy: " + ", ".join(f"{k.replace('_', ' ')} {100 * v:.1f} %" for k, v in scores.items()))
+    print(res.order.message())
+    print(res.verdict())
 
 
 def _print_match(a, notes) -> None:
@@ -88,6 +119,8 @@ def _cmd_assess(args: argparse.Namespace) -> int:
     if args.report:
         from twin._atomic import check_output_dir
         check_output_dir(args.report, "report")     # before the assessment, not after
+    if (Path(args.assessor) / "ensemble.json").is_file():
+        return _assess_ensemble(args)
     a = transfer.Assessor.load(Path(args.assessor))
     res = a.assess(Path(args.measurements))
     for r in res.records:
@@ -103,6 +136,28 @@ def _cmd_assess(args: argparse.Namespace) -> int:
     if args.report:
         from twin.transfer.report import write_assessment_report
         page = write_assessment_report(res, args.report, f"{args.assessor} on {args.measurements}")
+        print(f"report -> {page}")
+    return 0
+
+
+def _assess_ensemble(args: argparse.Namespace) -> int:
+    from twin.transfer.ensemble import Ensemble
+    ens = Ensemble.load(Path(args.assessor))
+    res = ens.assess(Path(args.measurements), time_ordered={"auto": None, "yes": True, "no": False}[args.time_order])
+    _print_ensemble(res)
+    if args.json:
+        from twin._atomic import atomic_path
+        with atomic_path(Path(args.json)) as tmp:
+            Path(tmp).write_text(json.dumps(res.to_dict(), indent=1))
+        print(f"stages -> {args.json}")
+    if args.report:
+        from twin.pipeline.run import _plot_stages
+        from twin.transfer.report import write_html
+        d = Path(args.report)
+        d.mkdir(exist_ok=True)
+        png = _plot_stages(res, d / "stages.png")
+        page = write_html(d / "report.html", f"{args.assessor} on {args.measurements}",
+                          [("Verdict", res.verdict() + "\n" + res.order.message()), ("Stages", png.name)])
         print(f"report -> {page}")
     return 0
 
@@ -164,40 +219,28 @@ def _cmd_benchmark_transfer(args: argparse.Namespace) -> int:
 def add_subcommands(sub) -> None:
     """Register ``train-assessor``, ``rematch``, ``assess``, ``agreement`` and ``benchmark-transfer`` on
     ``sub`` (the object returned by ``parser.add_subparsers``)."""
-    p = sub.add_parser("train-assessor", help="train the transfer-learning wear assessor (twin -> rig)")
-    p.add_argument("--source", required=True, help="labelled source archive HDF5 (twin archive)")
-    p.add_argument("--target", required=True, help="unlabelled rig measurements HDF5 (labels are ignored)")
-    p.add_argument("--out", required=True, help="directory to save the assessor in")
+    p = sub.add_parser("train-assessor", help="train an ensemble of transfer-learning assessors (twin -> rig); "
+                                               "every setting follows from the archive")
+    p.add_argument("--source", required=True,
+                   help="the twin's labelled archive (twin archive), or a scenario (the calibrated.yaml of twin "
+                        "calibrate, say), whose archive is then simulated first at the rig's operating point")
+    p.add_argument("--target", required=True, help="the rig's unlabelled records, HDF5 (labels are never read)")
+    p.add_argument("--out", required=True, help="directory to save the ensemble in (rerun to resume)")
+    p.add_argument("--members", type=int, default=5,
+                   help="assessors in the ensemble, seeds FIRST_SEED.. (default: 5; the cost is that many trainings, "
+                        "run --jobs at a time)")
     p.add_argument("--method", choices=("proposed", "mmd", "cnn", "coral"), default="proposed",
                    help="proposed (MMD + class contrastive, default), mmd, cnn (source only), coral")
-    p.add_argument("--pairs", choices=("all", "diagonal"), default="all",
-                   help="source/target pairs of the class-contrastive loss: every pair of the batch (default) or "
-                        "the paper's i-th with i-th")
-    p.add_argument("--contrastive-reduction", choices=("mean", "sum"), default="mean",
-                   help="mean over the pairs (default) or the paper's sum over the batch (Eq. 18), 20 times the "
-                        "weight at batch 20; measured in docs/experiments.md and not the default")
-    p.add_argument("--seed", type=int, default=0, help="seed of initialisation, batches, augmentation")
     p.add_argument("--epochs", type=int, default=80, help="passes over the source windows (default: 80)")
-    p.add_argument("--shaft-speed", type=float, metavar="HZ",
-                   help="nominal pinion speed of the test [Hz]: records are resampled so a 2048-sample window "
-                        "spans two pinion revolutions (default: 20 kHz, about two revolutions at 20 Hz)")
-    p.add_argument("--remove-level", action="store_true",
-                   help="remove each window's level and keep only the spectral shape: for pitting, whose early "
-                        "stages differ in level by less than the rig's gain scatter (the default keeps the level, "
-                        "which carries deep wear)")
+    p.add_argument("--first-seed", type=int, default=0, help="seed of the first member (default: 0)")
+    p.add_argument("--jobs", type=int, default=2, help="members trained in parallel (default: 2)")
+    p.add_argument("--exclude", metavar="RECORDS", help="comma-separated records of the target file not to adapt to "
+                                                      "(its healthy run-up, say)")
     p.add_argument("--channel", default="accel_pinion_casing",
                    help="acceleration channel of the source archive (default: accel_pinion_casing)")
     p.add_argument("--target-channel", metavar="NAME",
                    help="the rig's name for that channel, if it differs; saved with the assessor, so `twin assess` "
                         "reads new rig files from it too")
-    match = p.add_mutually_exclusive_group()
-    match.add_argument("--class-prior", choices=("source", "ordinal"), default="source",
-                   help="how the rig's stage proportions are matched to the archive's: per-stage logit offsets "
-                        "(source, default) or boundaries along the expected stage, which keep only the order of "
-                        "the windows (ordinal; the benchmark's pitting rule, docs/transfer.md)")
-    match.add_argument("--no-class-prior", action="store_true",
-                   help="do not match the rig's stage proportions to the archive's after training (use it when the "
-                        "rig data are mostly one stage, e.g. a run-to-failure history; default: match them)")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bars")
     p.set_defaults(handler=_cmd_train_assessor)
 
@@ -219,6 +262,9 @@ def add_subcommands(sub) -> None:
     p.add_argument("--report", metavar="DIR",
                    help="write stages.png (stage probabilities per record), confusion.png (when every record has "
                         "a label) and report.html into DIR")
+    p.add_argument("--time-order", choices=("auto", "yes", "no"), default="auto",
+                   help="an ensemble's use of the records' time order (damage does not heal): auto (default) when "
+                        "they carry time stamps (time_start, cycles), yes for records given in time order, no never")
     p.set_defaults(handler=_cmd_assess)
 
     p = sub.add_parser("agreement", help="how often assessors trained with other seeds agree on measurements "

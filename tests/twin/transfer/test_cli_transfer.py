@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 
 from twin.measurements import Record, load_measurements, write_measurements
-from twin.transfer.assessor import CLASS_PRIOR_WARN_DROP
 from twin.transfer.cli import add_subcommands
 
 
@@ -28,6 +27,26 @@ def _file(path, shifted, labelled):
             recs.append(Record(f"s{k}r{i}", {"accel_pinion_casing": (2.0 if shifted else 1.0) * x},
                                {"accel_pinion_casing": "m/s2"}, 20000.0, label=k if labelled else None))
     return write_measurements(recs, path)
+
+
+def _single(out, src, tgt, method="mmd", seed=0, class_prior="source", epochs=1):
+    """One assessor trained through the API (train-assessor trains ensembles): what rematch and
+    agreement take."""
+    import warnings
+
+    from twin.transfer import Assessor
+    from twin.transfer.errors import ClassPriorWarning
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ClassPriorWarning)
+        Assessor(method, epochs=epochs, seed=seed, progress=False, class_prior=class_prior).fit(src, tgt).save(out)
+    return out
+
+
+def _archive_and_rig(tmp_path, channel="accel_pinion_casing"):
+    from .conftest import rig_records, write_tiny_archive
+    recs = [Record(r.name, {channel: r["accel_pinion_casing"]}, {channel: "m/s2"}, r.sample_rate,
+                   nominal_speed=r.nominal_speed, load=r.load, label=r.label) for r in rig_records(per_stage=2)]
+    return write_tiny_archive(tmp_path / "arc.h5"), write_measurements(recs, tmp_path / "rig.h5")
 
 
 def test_rig_choices_are_the_benchmarks_rigs():
@@ -53,23 +72,37 @@ def test_registers_three_commands():
         p.parse_args(["train-assessor", "--source", "s.h5", "--target", "t.h5", "--out", "o", "--method", "dann"])
 
 
-def test_train_then_assess(tmp_path, capsys):
-    src = _file(tmp_path / "src.h5", False, True)
-    tgt = _file(tmp_path / "tgt.h5", True, True)
+def test_train_assessor_with_no_options_trains_an_ensemble_with_the_archives_settings(tmp_path, capsys):
+    arc, rig = _archive_and_rig(tmp_path)
     p = _parser()
-    args = p.parse_args(["train-assessor", "--source", str(src), "--target", str(tgt), "--out",
-                         str(tmp_path / "model"), "--epochs", "1", "--method", "mmd", "--no-progress"])
+    args = p.parse_args(["train-assessor", "--source", str(arc), "--target", str(rig), "--out", str(tmp_path / "ens"),
+                         "--members", "2", "--epochs", "1", "--no-progress"])
+    assert (args.members, args.method, args.first_seed) == (2, "proposed", 0)
     assert args.handler(args) == 0
-    args = p.parse_args(["assess", str(tmp_path / "model"), str(tgt), "--json", str(tmp_path / "stages.json")])
-    assert args.handler(args) == 0
-    out = json.loads((tmp_path / "stages.json").read_text())
-    assert out["n_stages"] == 2 and len(out["records"]) == 6
-    r = out["records"][0]
-    assert {"name", "stage", "confidence", "windows", "label"} <= set(r)
-    assert len(r["windows"]) == (6000 - 2048) // 1024 + 1      # 0.3 s at 20 kHz, hop 1024
     out = capsys.readouterr().out
-    assert "accuracy" in out and f"learning curves: {tmp_path / 'model' / 'learning_curves.png'}" in out
-    assert (tmp_path / "model" / "learning_curves.png").read_bytes()[:4] == b"\x89PNG"
+    assert "proposed ensemble of 2 (seeds 0-1)" in out
+    assert "pitting_density in 3 stages at 20 Hz / 20 N.m" in out and "level removed, class prior ordinal" in out
+    assert "resampled from 25000 Hz to 20480 Hz" in out
+    assert ("reliable" in out or "NOT RELIABLE" in out) and "stage order" in out
+    cfg = json.loads((tmp_path / "ens" / "ensemble.json").read_text())
+    assert cfg["members"] == ["member_0", "member_1"]
+    assert json.loads((tmp_path / "ens" / "member_0" / "config.json").read_text())["preprocessing"][
+        "sample_rate"] == pytest.approx(20480.0)
+    args = p.parse_args(["assess", str(tmp_path / "ens"), str(rig), "--json", str(tmp_path / "stages.json"),
+                         "--report", str(tmp_path / "rep")])
+    assert args.handler(args) == 0
+    saved = json.loads((tmp_path / "stages.json").read_text())
+    assert saved["n_members"] == 2 and len(saved["records"]) == 6 and "verdict" in saved and saved["scores"]
+    out = capsys.readouterr().out
+    assert "members" in out and "accuracy:" in out and "report ->" in out
+    assert (tmp_path / "rep" / "stages.png").read_bytes()[:4] == b"\x89PNG"
+    # records of another test are refused by name, and --exclude names only records that exist
+    from twin.transfer.errors import AssessorError
+    args = p.parse_args(["train-assessor", "--source", str(arc), "--target", str(rig), "--out", str(tmp_path / "x"),
+                         "--exclude", "rec00,nothere", "--no-progress"])
+    with pytest.raises(AssessorError, match="nothere"):
+        args.handler(args)
+    assert not (tmp_path / "x").exists()
 
 
 def test_assess_writes_a_report_and_refuses_a_bad_report_path_before_any_work(tmp_path, capsys):
@@ -77,10 +110,7 @@ def test_assess_writes_a_report_and_refuses_a_bad_report_path_before_any_work(tm
     src = _file(tmp_path / "src.h5", False, True)
     tgt = _file(tmp_path / "tgt.h5", True, True)
     p = _parser()
-    args = p.parse_args(["train-assessor", "--source", str(src), "--target", str(tgt), "--out",
-                         str(tmp_path / "model"), "--epochs", "1", "--method", "cnn", "--no-progress"])
-    assert args.handler(args) == 0
-    capsys.readouterr()
+    _single(tmp_path / "model", src, tgt, method="cnn", class_prior=None)
     args = p.parse_args(["assess", str(tmp_path / "model"), str(tgt), "--report", str(tmp_path / "rep")])
     assert args.handler(args) == 0
     assert f"report -> {tmp_path / 'rep' / 'report.html'}" in capsys.readouterr().out
@@ -92,23 +122,6 @@ def test_assess_writes_a_report_and_refuses_a_bad_report_path_before_any_work(tm
         with pytest.raises(OutputPathError, match=match):
             args.handler(args)
     assert capsys.readouterr().out == "" and (tmp_path / "afile").read_text() == "keep"
-
-
-def test_shaft_speed_and_remove_level_reach_the_saved_preprocessing(tmp_path):
-    src = _file(tmp_path / "src.h5", False, True)
-    tgt = _file(tmp_path / "tgt.h5", True, True)
-    p = _parser()
-    args = p.parse_args(["train-assessor", "--source", str(src), "--target", str(tgt), "--out",
-                         str(tmp_path / "model"), "--epochs", "1", "--method", "cnn", "--shaft-speed", "10",
-                         "--remove-level", "--no-progress"])
-    assert args.handler(args) == 0
-    cfg = json.loads((tmp_path / "model" / "config.json").read_text())
-    assert cfg["preprocessing"]["sample_rate"] == 10240.0               # 2048 samples = 0.2 s = 2 revolutions
-    assert cfg["preprocessing"]["remove_level"] is True
-    args = p.parse_args(["assess", str(tmp_path / "model"), str(tgt), "--json", str(tmp_path / "stages.json")])
-    assert args.handler(args) == 0
-    out = json.loads((tmp_path / "stages.json").read_text())
-    assert len(out["records"][0]["windows"]) == (3072 - 2048) // 1024 + 1   # 0.3 s at 10.24 kHz
 
 
 def test_train_to_missing_directory_fails_early(tmp_path):
@@ -132,89 +145,16 @@ def test_assess_checks_its_json_path_before_it_loads_or_prints_anything(tmp_path
     assert not (tmp_path / "no").exists()
 
 
-def test_class_prior_choice_reaches_the_saved_assessor(tmp_path, capsys):
-    src = _file(tmp_path / "src.h5", False, True)
-    tgt = _file(tmp_path / "tgt.h5", True, True)
+def test_target_channel_reaches_the_saved_ensemble_and_assess(tmp_path):
+    arc, rig = _archive_and_rig(tmp_path, channel="acc_rig")
     p = _parser()
-    saved = {}
-    for name, flag in (("source", []), ("none", ["--no-class-prior"]), ("ordinal", ["--class-prior", "ordinal"])):
-        out = tmp_path / name
-        args = p.parse_args(["train-assessor", "--source", str(src), "--target", str(tgt), "--out", str(out),
-                             "--epochs", "1", "--method", "mmd", "--no-progress", *flag])
-        assert args.handler(args) == 0
-        saved[name] = json.loads((out / "config.json").read_text())
-    assert saved["source"]["params"]["class_prior"] == "source"
-    assert any(w != 0 for w in saved["source"]["target_log_weights"]) and saved["source"]["ordinal_anchors"] is None
-    assert saved["none"]["params"]["class_prior"] is None
-    assert saved["none"]["target_log_weights"] == [0.0, 0.0]
-    assert saved["ordinal"]["params"]["class_prior"] == "ordinal"
-    assert saved["ordinal"]["target_log_weights"] == [0.0, 0.0] and len(saved["ordinal"]["ordinal_anchors"]) == 3
-    assert "ordinal class-prior match: rig adaptation windows per stage" in capsys.readouterr().out
-    with pytest.raises(SystemExit):
-        p.parse_args(["train-assessor", "--source", str(src), "--target", str(tgt), "--out", "x",
-                      "--class-prior", "median"])
-    with pytest.raises(SystemExit):      # one or the other, not a silent winner
-        p.parse_args(["train-assessor", "--source", str(src), "--target", str(tgt), "--out", "x",
-                      "--class-prior", "ordinal", "--no-class-prior"])
-
-
-def test_train_assessor_reports_the_class_prior_match_and_warns_on_one_stage_rig_data(tmp_path, capsys):
-    """A rig file holding only stage 0 breaks the match's assumption; the CLI says so on stdout, as
-    one 'warning:' line naming the switch, not as a Python traceback-style warning.  20 epochs, so the
-    network reads the stage with confidence and the match has to take it away (after 2 epochs it is
-    unsure, and moving its windows costs too little confidence to warn)."""
-    src = _file(tmp_path / "src.h5", False, True)
-    one_stage = [r for r in load_measurements(_file(tmp_path / "all.h5", True, False)).records if r.name.startswith("s0")]
-    tgt = write_measurements(one_stage, tmp_path / "tgt.h5")
-    p = _parser()
-    args = p.parse_args(["train-assessor", "--source", str(src), "--target", str(tgt), "--out",
-                         str(tmp_path / "model"), "--epochs", "20", "--method", "mmd", "--no-progress"])
+    args = p.parse_args(["train-assessor", "--source", str(arc), "--target", str(rig), "--out", str(tmp_path / "ens"),
+                         "--members", "2", "--epochs", "1", "--target-channel", "acc_rig", "--no-progress"])
     assert args.handler(args) == 0
-    out, err = capsys.readouterr()
-    assert "class-prior match: rig adaptation windows per stage" in out
-    assert "changed stage; mean confidence -" in out
-    assert "warning: the class-prior match lowered the mean confidence" in out and "--no-class-prior" in out
-    assert "ClassPriorWarning" not in err
-    cfg = json.loads((tmp_path / "model" / "config.json").read_text())
-    assert cfg["class_prior_confidence_drop"] > CLASS_PRIOR_WARN_DROP
-    args = p.parse_args(["train-assessor", "--source", str(src), "--target", str(tgt), "--out",
-                         str(tmp_path / "plain"), "--epochs", "2", "--method", "mmd", "--no-progress",
-                         "--no-class-prior"])
-    assert args.handler(args) == 0
-    out = capsys.readouterr().out
-    assert "class-prior match" not in out and "warning" not in out
-
-
-def test_the_papers_contrastive_pairing_and_weighting_reach_the_saved_assessor(tmp_path):
-    src = _file(tmp_path / "src.h5", False, True)
-    tgt = _file(tmp_path / "tgt.h5", True, False)
-    p = _parser()
-    base = ["train-assessor", "--source", str(src), "--target", str(tgt), "--epochs", "1", "--no-progress"]
-    args = p.parse_args(base + ["--out", str(tmp_path / "default")])
-    assert (args.pairs, args.contrastive_reduction) == ("all", "mean")
-    args = p.parse_args(base + ["--out", str(tmp_path / "paper"), "--pairs", "diagonal",
-                                "--contrastive-reduction", "sum"])
-    assert args.handler(args) == 0
-    params = json.loads((tmp_path / "paper" / "config.json").read_text())["params"]
-    assert (params["pairs"], params["contrastive_reduction"]) == ("diagonal", "sum")
-    with pytest.raises(SystemExit):
-        p.parse_args(base + ["--out", "x", "--contrastive-reduction", "median"])
-
-
-def test_target_channel_reaches_the_saved_assessor_and_assess(tmp_path):
-    src = _file(tmp_path / "src.h5", False, True)
-    recs = [Record(r.name, {"acc_rig": r["accel_pinion_casing"]}, {"acc_rig": "m/s2"}, r.sample_rate, label=r.label)
-            for r in load_measurements(_file(tmp_path / "tgt0.h5", True, True)).records]
-    tgt = write_measurements(recs, tmp_path / "tgt.h5")
-    p = _parser()
-    args = p.parse_args(["train-assessor", "--source", str(src), "--target", str(tgt), "--out",
-                         str(tmp_path / "model"), "--epochs", "1", "--method", "cnn", "--target-channel", "acc_rig",
-                         "--no-progress"])
-    assert args.handler(args) == 0
-    cfg = json.loads((tmp_path / "model" / "config.json").read_text())
+    cfg = json.loads((tmp_path / "ens" / "member_1" / "config.json").read_text())
     assert cfg["preprocessing"]["channel"] == "accel_pinion_casing"
     assert cfg["preprocessing"]["target_channel"] == "acc_rig"
-    args = p.parse_args(["assess", str(tmp_path / "model"), str(tgt), "--json", str(tmp_path / "stages.json")])
+    args = p.parse_args(["assess", str(tmp_path / "ens"), str(rig), "--json", str(tmp_path / "stages.json")])
     assert args.handler(args) == 0
     assert len(json.loads((tmp_path / "stages.json").read_text())["records"]) == 6
 
@@ -226,11 +166,7 @@ def test_agreement_of_two_seeds_and_its_refusals(tmp_path, capsys):
     tgt = _file(tmp_path / "tgt.h5", True, False)
     p = _parser()
     for seed in (0, 1):
-        args = p.parse_args(["train-assessor", "--source", str(src), "--target", str(tgt), "--out",
-                             str(tmp_path / f"seed{seed}"), "--epochs", "1", "--method", "cnn", "--seed", str(seed),
-                             "--no-progress"])
-        assert args.handler(args) == 0
-    capsys.readouterr()
+        _single(tmp_path / f"seed{seed}", src, tgt, method="cnn", seed=seed, class_prior=None)
     out = tmp_path / "agree.json"
     args = p.parse_args(["agreement", str(tmp_path / "seed0"), str(tmp_path / "seed1"), str(tgt), "--json", str(out),
                          "--worst", "2"])
@@ -268,11 +204,8 @@ def test_rematch_stages_the_rig_by_another_rule_without_retraining(tmp_path, cap
     src = _file(tmp_path / "src.h5", False, True)
     tgt = _file(tmp_path / "tgt.h5", True, False)
     p = _parser()
-    base = ["--source", str(src), "--target", str(tgt), "--epochs", "1", "--method", "mmd", "--no-progress"]
-    for name, flag in (("source", []), ("ordinal", ["--class-prior", "ordinal"])):
-        args = p.parse_args(["train-assessor", *base, "--out", str(tmp_path / name), *flag])
-        assert args.handler(args) == 0
-    capsys.readouterr()
+    for name in ("source", "ordinal"):
+        _single(tmp_path / name, src, tgt, class_prior=name)
     args = p.parse_args(["rematch", str(tmp_path / "source"), str(tgt), "--class-prior", "ordinal",
                          "--out", str(tmp_path / "re")])
     assert args.handler(args) == 0
