@@ -665,6 +665,9 @@ def build_parser() -> argparse.ArgumentParser:
     from twin.rul import add_subcommands as add_rul
     add_rul(sub)
 
+    from twin.pipeline import add_subcommands as add_pipeline
+    add_pipeline(sub)
+
     p = sub.add_parser("schema", help="print the JSON Schema of scenario files")
     p.set_defaults(handler=_cmd_schema)
 
