@@ -42,7 +42,8 @@ def main() -> None:
     same = np.array_equal(archives[0].signals["accel_pinion_casing"], archives[1].signals["accel_pinion_casing"])
     cpu = next((ln.split(":", 1)[1].strip() for ln in open("/proc/cpuinfo") if ln.startswith("model name")), "?")
     print(f"Machine: {cpu}, {len(os.sched_getaffinity(0))} cores, Python {platform.python_version()}")
-    print(f"Archive: 6 stages x {args.records_per_stage} records x 0.2 s at 100 kHz; identical archives: {same}\n")
+    print(f"Archive: {len(arc['stages']) - 1} stages x {args.records_per_stage} records x {arc['record_duration']:g} s "
+          f"at 100 kHz; identical archives: {same}\n")
     print("| local workers | records | wall time [s] | speed-up |")
     print("|---|---|---|---|")
     for w, wall, n in rows:
