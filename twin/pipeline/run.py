@@ -8,8 +8,10 @@ The paper's chain, one stage after the other, each writing into ``DIR``:
 
 1. **calibrate** (``DIR/calibration/``): the scenario's twin calibrated on the rig's healthy records
    (:func:`twin.calibration.run.run_calibration`): the modes read from the run-up (or hammer) record,
-   the parameters they identify chosen automatically, the steady record for the spectrum;
-   ``calibrated.yaml`` is the calibrated twin;
+   the parameters they identify chosen automatically, the steady record for the spectrum.  The model
+   is the gearbox as its accelerometers measure it (``GearTwin.Gearbox21Measured`` for
+   ``GearTwin.Gearbox21``: flank roughness, process force, sensor path), whose sensor gain and
+   broadband levels the calibration fits; ``calibrated.yaml`` is the calibrated twin;
 2. **archive** (``DIR/archive.h5``): the calibrated twin's degradation run and its labelled archive
    (:func:`twin.archive.build_archive`), at the operating point of the rig's records;
 3. **train** (``DIR/assessor/``): an ensemble of assessors on the archive and the rig's other records,
@@ -43,6 +45,12 @@ from twin.errors import ParameterError, ScenarioError
 __all__ = ["PipelinePlan", "STAGES", "run_pipeline"]
 
 STAGES = ("calibrate", "archive", "train", "assess", "rul", "report")
+# The gearbox as its casing accelerometers measure it: the same model with flank roughness and a process
+# force (broadband) and a sensor path, whose levels and gain the calibration fits to the steady record.
+MEASURED = {"GearTwin.Gearbox21": "GearTwin.Gearbox21Measured"}
+# The calibration block when the scenario has none: the parameters the run-up's modes identify, and a
+# search sized for the pipeline's time budget (bench/calibration_rigs.py measured it on the rigs).
+CALIBRATION = {"parameters": "auto", "pop_size": 12, "n_gen": 6}
 MANIFEST = "pipeline.json"
 
 
@@ -213,9 +221,10 @@ def run_pipeline(plan: PipelinePlan, *, progress: bool = True, log=print) -> dic
             from twin.calibration.run import run_calibration
             log(f"[1/6] calibrate: modes from '{modes_rec}', spectrum from '{steady_rec}'")
             t = time.perf_counter()
-            block = {**(scenario.raw.get("calibration") or {"parameters": "auto"}), "modes_from": modes_rec,
+            block = {**(scenario.raw.get("calibration") or CALIBRATION), "modes_from": modes_rec,
                      "record": steady_rec}
-            cal_sc = scenario.with_overrides(raw={**scenario.raw, "calibration": block},
+            model = MEASURED.get(scenario.fmu, scenario.fmu)
+            cal_sc = scenario.with_overrides(fmu=model, raw={**scenario.raw, "fmu": model, "calibration": block},
                                              executor={"type": "local", "workers": plan.jobs})
             report = run_calibration(cal_sc, meas, cal_dir, progress=progress)
             for w in report.warnings:

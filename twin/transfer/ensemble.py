@@ -366,10 +366,13 @@ class Ensemble:
     def _raw(self, data, what: str = "assess"):
         """Members' raw network probabilities on the windows of ``data``: (members, n, K), record
         index (n,), labels (n,), prepared records."""
-        out, rec, lab, prepared = [], None, None, None
+        from twin.transfer.preprocess import windows_of
+        first = self.members[0]
+        prepared = first._prepared(data, None, what, "target")
+        raw, rec, lab = windows_of(prepared, self.preprocessing, what)       # represented once for all members
+        out = []
         for m in self.members:
-            x, rec, lab, prepared, _ = m._windows(data, what, "target")
-            out.append(m._forward(x)[1])
+            out.append(m._forward(m.target_normaliser_(raw))[1])
         return np.stack(out), rec, lab, prepared
 
     def _match(self, p: np.ndarray) -> np.ndarray:
