@@ -449,6 +449,10 @@ class Ensemble:
         notes = check_records(recs, self.facts, "assess")
         note = resampling_note([r.sample_rate for r in recs], pre.sample_rate, "assess")
         notes += [note] if note else []
+        if self.anchors_ is not None:
+            notes.append(f"stage boundaries placed along the expected stage of the rig's adaptation records (the "
+                         f"ordinal rule), which assumes those records covered the {self.n_classes_} stages in about "
+                         "the archive's equal shares")
         raw, rec, lab, prepared = self._raw(recs)
         p = self._match(raw.mean(0))
         members = self._member_stages(raw)
