@@ -633,8 +633,8 @@ class Assessor:
                 f"proportions {', '.join(f'{v:.2f}' for v in prior)}. It had to push windows the network was sure "
                 f"of into other stages. Either the rig's data do not cover the stages in those proportions (a "
                 f"run-to-failure history, say): stage them without the match, no retraining needed "
-                f"(rematch(rig, class_prior=None); twin rematch ASSESSOR RIG --class-prior none --out DIR; "
-                f"or twin train-assessor --no-class-prior); or the rig's records do not fall into the twin's "
+                f"(rematch(rig, class_prior=None); twin rematch ASSESSOR RIG --class-prior none --out DIR); "
+                f"or the rig's records do not fall into the twin's "
                 f"stages, and no setting here fixes that: compare the model with the rig (twin compare, "
                 f"twin diagnose).",
                 ClassPriorWarning, stacklevel=4)

@@ -18,7 +18,7 @@ class ClassPriorWarning(UserWarning):
     """The class-prior match moved an unusual share of the rig's adaptation windows to another
     stage: either the rig shifts the stage boundaries far, or its data do not cover the stages in
     the twin's proportions (a run-to-failure history), which the match assumes.  The message gives
-    the share and the switch (``class_prior=None``, ``--no-class-prior``)."""
+    the share and the switch (``class_prior=None``, ``twin rematch ... --class-prior none``)."""
 
 
 @contextmanager

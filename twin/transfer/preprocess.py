@@ -11,7 +11,7 @@ model, so ``assess`` windows new data exactly as training did):
    :func:`twin.measurements.resample_record` (polyphase FIR, anti-aliased, flat to 80 % of the
    new Nyquist frequency).  The rule is a window of two pinion revolutions,
    ``sample_rate = 1024 x shaft speed`` (:meth:`Preprocessing.for_shaft_speed`, ``twin
-   train-assessor --shaft-speed``): 20.48 kHz for the lubricated test at 20 Hz, 10.24 kHz for the
+   train-assessor`` sets it from the archive's test): 20.48 kHz for the lubricated test at 20 Hz, 10.24 kHz for the
    dry test at 10 Hz.  Every tooth is then in every window twice, and the spectrum holds the
    same ~26 mesh harmonics at either speed.  At 20 kHz the dry test's window would hold one
    revolution, and its wear stages were told apart 4 points worse (trials of 2026-11-22).

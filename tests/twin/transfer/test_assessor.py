@@ -359,7 +359,7 @@ def test_class_prior_diagnostics_and_the_warning(tiny_pre, tiny_data, fitted):
     assert fitted.class_prior_moved_ > 0.2
     assert fitted.class_prior_confidence_drop_ > CLASS_PRIOR_WARN_DROP
     with pytest.warns(ClassPriorWarning, match=r"lowered the mean confidence of the \d+ rig adaptation windows by "
-                                               r"\d+\.\d points.*moved \d+\.\d %.*--no-class-prior"):
+                                               r"\d+\.\d points.*moved \d+\.\d %.*--class-prior none"):
         tiny_assessor("mmd", tiny_pre, seed=3).fit(src, adapt)
     with warnings.catch_warnings():
         warnings.simplefilter("error", ClassPriorWarning)
