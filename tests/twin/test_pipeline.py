@@ -70,7 +70,7 @@ def test_pipeline_runs_every_stage_and_resumes(tmp_path, gearbox_fmu):
     import shutil
     shutil.copy(gearbox_fmu, tmp_path / "gearbox.fmu")
     rig, scen = _rig(tmp_path / "rig.h5"), _scenario(tmp_path / "scenario.yaml")
-    plan = PipelinePlan(rig, ("runup", "steady"), scen, tmp_path / "out", members=2, epochs=1, jobs=2,
+    plan = PipelinePlan(rig, ("runup", "steady"), scen, tmp_path / "out", members=2, epochs=1, jobs=1,
                         calibrate=False)
     lines = []
     summary = run_pipeline(plan, progress=False, log=lines.append)

@@ -231,7 +231,8 @@ def train_ensemble(source, target, out, *, members: int = DEFAULT_MEMBERS, metho
     members : int
         Number of members (seeds ``first_seed .. first_seed + members - 1``), at least 2.
     jobs : int
-        Members trained in parallel (processes, one torch thread each).
+        Members trained in parallel (processes, one torch thread each); 1 trains them one after the
+        other in this process.
     log : callable
         Where the notes go (resampling, records without a speed, progress of the members).
 
@@ -285,7 +286,13 @@ def train_ensemble(source, target, out, *, members: int = DEFAULT_MEMBERS, metho
         log(f"ensemble: {len(seeds) - len(todo)} of {len(seeds)} members already trained in {out}")
     t0 = time.perf_counter()
     bar = progress_bar(len(todo), progress, f"ensemble {method}", "member")
-    if todo:
+    if todo and min(jobs, len(todo)) == 1:
+        # one at a time: in this process (a worker would pay torch's and scipy's imports again)
+        for s in todo:
+            _fit_member(str(source), str(adaptation), str(out / f"member_{s}"), method, s, epochs, pre_dict, rule)
+            (out / f"member_{s}" / "ensemble_key").write_text(keys[s])
+            bar.update(1)
+    elif todo:
         with ProcessPoolExecutor(max_workers=min(jobs, len(todo)), mp_context=mp.get_context("spawn")) as pool:
             futures = {s: pool.submit(_fit_member, str(source), str(adaptation), str(out / f"member_{s}"), method,
                                       s, epochs, pre_dict, rule) for s in todo}

@@ -76,7 +76,7 @@ def test_train_assessor_with_no_options_trains_an_ensemble_with_the_archives_set
     arc, rig = _archive_and_rig(tmp_path)
     p = _parser()
     args = p.parse_args(["train-assessor", "--source", str(arc), "--target", str(rig), "--out", str(tmp_path / "ens"),
-                         "--members", "2", "--epochs", "1", "--no-progress"])
+                         "--members", "2", "--epochs", "1", "--jobs", "1", "--no-progress"])
     assert (args.members, args.method, args.first_seed) == (2, "proposed", 0)
     assert args.handler(args) == 0
     out = capsys.readouterr().out
@@ -149,7 +149,8 @@ def test_target_channel_reaches_the_saved_ensemble_and_assess(tmp_path):
     arc, rig = _archive_and_rig(tmp_path, channel="acc_rig")
     p = _parser()
     args = p.parse_args(["train-assessor", "--source", str(arc), "--target", str(rig), "--out", str(tmp_path / "ens"),
-                         "--members", "2", "--epochs", "1", "--target-channel", "acc_rig", "--no-progress"])
+                         "--members", "2", "--epochs", "1", "--target-channel", "acc_rig", "--jobs", "1",
+                         "--no-progress"])
     assert args.handler(args) == 0
     cfg = json.loads((tmp_path / "ens" / "member_1" / "config.json").read_text())
     assert cfg["preprocessing"]["channel"] == "accel_pinion_casing"

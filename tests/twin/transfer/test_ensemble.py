@@ -20,7 +20,7 @@ def trained(tmp_path_factory):
     arc = write_tiny_archive(d / "arc.h5")
     rig = write_measurements(rig_records(labelled=False), d / "rig.h5")
     lines = []
-    ens = train_ensemble(arc, rig, d / "ensemble", members=2, epochs=2, jobs=2, progress=False, log=lines.append)
+    ens = train_ensemble(arc, rig, d / "ensemble", members=2, epochs=2, jobs=1, progress=False, log=lines.append)
     return d, arc, rig, ens, lines
 
 
