@@ -54,3 +54,35 @@ def two_mass_fmu3(fmu_dir) -> Path:
     """GearTwin.Examples.TwoMassOscillator built as an FMI 3.0 FMU."""
     from fmu_build import build_fmu
     return build_fmu("GearTwin.Examples.TwoMassOscillator", MODELICA, fmu_dir / "fmi3", fmi_version=3)
+
+
+def _thirdparty_builder():
+    import importlib.util
+    spec = importlib.util.spec_from_file_location("build_thirdparty", REPO / "tests" / "thirdparty" / "build_thirdparty.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _needs_gcc() -> None:
+    import shutil
+    if shutil.which("gcc") is None:
+        pytest.skip("gcc is not available")
+
+
+@pytest.fixture(scope="session")
+def vanderpol_fmu(tmp_path_factory) -> Path:
+    """The hand-written Van der Pol FMU of tests/thirdparty/vanderpol (FMI 2.0), built with gcc."""
+    _needs_gcc()
+    return _thirdparty_builder().build_vanderpol(tmp_path_factory.mktemp("thirdparty"))
+
+
+@pytest.fixture(scope="session")
+def typecov_fmus(tmp_path_factory) -> dict[tuple[str, int], Path]:
+    """The hand-written type-coverage FMUs of tests/thirdparty/typecov, built with gcc for FMI 2.0
+    and FMI 3.0: {(model, version): path} for AllTypes, Staircase and Ball."""
+    _needs_gcc()
+    builder = _thirdparty_builder()
+    root = tmp_path_factory.mktemp("typecov")
+    return {(model, version): builder.build_typecov(model, version, root / f"fmi{version}")
+            for version in (2, 3) for model in builder.TYPECOV_MODELS}

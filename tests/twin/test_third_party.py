@@ -7,8 +7,6 @@ generic path of :mod:`twin.fmu`: one ``fmi2DoStep`` + ``fmi2GetReal`` per output
 """
 from __future__ import annotations
 
-import importlib.util
-import shutil
 from pathlib import Path
 
 import h5py
@@ -31,20 +29,6 @@ SCENARIO = REPO / "scenarios" / "third_party.yaml"
 # compilers/libm while still catching a lower-order method (forward Euler at 1 ms is off by
 # ~1e-2) or an input/parameter change applied one sample early or late (~1e-3 or more).
 TOL = 1e-8
-
-
-def _load_builder():
-    spec = importlib.util.spec_from_file_location("build_thirdparty", REPO / "tests" / "thirdparty" / "build_thirdparty.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-@pytest.fixture(scope="module")
-def vanderpol_fmu(tmp_path_factory) -> Path:
-    if shutil.which("gcc") is None:
-        pytest.skip("gcc is not available")
-    return _load_builder().build_vanderpol(tmp_path_factory.mktemp("thirdparty"))
 
 
 def _reference(times: np.ndarray, t_u: float = 10.0, t_mu: float = 15.0) -> np.ndarray:
