@@ -163,3 +163,61 @@ def test_read_rejects_foreign_hdf5(tmp_path):
         f["x"] = np.arange(3)
     with pytest.raises(OutputPathError, match="not a gear-twin-result"):
         read_hdf5(path)
+
+
+@pytest.fixture
+def typed() -> SimulationResult:
+    t = np.arange(5) * 0.1
+    text = np.empty(5, dtype=object)
+    text[:] = ["a", "b,c", 'say "hi"', "", "ünïcode"]
+    return SimulationResult(
+        time=t,
+        signals={"x": np.linspace(0, 1, 5), "f32": np.array([0.1, 0.2, 1e-30, 3.0, -1.5], dtype=np.float32),
+                 "i8": np.array([-128, 0, 1, 2, 127], dtype=np.int8),
+                 "u64": np.array([0, 1, 2**63, 2**64 - 2, 2**64 - 1], dtype=np.uint64),
+                 "flag": np.array([True, False, True, True, False]), "mode": np.array([1, 2, 3, 1, 2], dtype=np.int32),
+                 "label": text},
+        units={"x": "m"}, sample_rate=10.0,
+        parameters={"gain": 2.0, "step": 3, "invert": True, "label": "gear", "big": 2**64 - 1},
+        types={"x": "Real", "f32": "Float32", "i8": "Int8", "u64": "UInt64", "flag": "Boolean",
+               "mode": "Enumeration", "label": "String"},
+        enumerations={"mode": {"off": 1, "slow": 2, "fast": 3}},
+        ended_by_fmu=True, end_reason="fmi2DoStep returned fmi2Discard with fmi2Terminated at t=0.4 s")
+
+
+@pytest.mark.parametrize("suffix", [".h5", ".csv"])
+def test_every_type_round_trips_with_its_dtype(tmp_path, typed, suffix):
+    back = read_result(write_result(typed, tmp_path / f"typed{suffix}"))
+    _assert_same(typed, back)
+    for name in typed.channels:
+        assert back[name].dtype == typed[name].dtype, name
+    assert list(back["label"]) == ["a", "b,c", 'say "hi"', "", "ünïcode"]
+    assert back.types == typed.types and back.enumerations == typed.enumerations
+    assert back.ended_by_fmu and back.end_reason == typed.end_reason
+    assert back.parameters["invert"] is True and back.parameters["big"] == 2**64 - 1
+
+
+def test_typed_hdf5_layout(tmp_path, typed):
+    path = write_result(typed, tmp_path / "typed.h5")
+    with h5py.File(path, "r") as f:
+        assert f["signals/u64"].dtype == np.uint64 and f["signals/flag"].dtype == bool
+        assert h5py.check_string_dtype(f["signals/label"].dtype).encoding == "utf-8"
+        assert f["signals/mode"].attrs["fmi_type"] == "Enumeration"
+        assert json.loads(f["signals/mode"].attrs["items"]) == {"off": 1, "slow": 2, "fast": 3}
+        assert f.attrs["ended_by_fmu"] and "fmi2Terminated" in f.attrs["end_reason"]
+    sidecar = json.loads((write_result(typed, tmp_path / "typed.csv").parent / "typed.csv.json").read_text())
+    assert sidecar["types"]["label"] == "String" and sidecar["dtypes"]["u64"] == "uint64"
+    assert sidecar["ended_by_fmu"] is True
+
+
+def test_csv_with_a_bad_field_is_refused_by_name(tmp_path, typed):
+    import csv
+    path = write_result(typed, tmp_path / "typed.csv")
+    with open(path, newline="", encoding="utf-8") as fh:
+        rows = list(csv.reader(fh))
+    assert rows[0][3] == "i8[]"
+    rows[2][3] = "1.5"                              # an Int8 field that is not whole
+    with open(path, "w", newline="", encoding="utf-8") as fh:
+        csv.writer(fh, lineterminator="\n").writerows(rows)
+    with pytest.raises(OutputPathError, match="channel 'i8'"):
+        read_result(path)
