@@ -24,6 +24,10 @@ class TwinError(Exception):
         return (_rebuild, (type(self), self.args, dict(self.__dict__)))
 
 
+class TwinWarning(UserWarning):
+    """Something the user should know that does not stop the work (the CLI prints it on one line)."""
+
+
 class BuildError(TwinError):
     """The Modelica -> FMU export failed (compiler, code generation or gcc)."""
 

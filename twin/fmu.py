@@ -1,10 +1,16 @@
 """The only module of ``twin`` that talks to FMUs (through fmpy).
 
-It turns value references into names, FMI status codes into :class:`SimulationError`, and
-captures high-rate outputs without a Python call per sample: FMUs built by ``fmu_build``
-buffer their outputs inside each ``doStep`` (parameter ``solver.output_interval``) and the
-buffer is read with one C call per communication step.  Any other FMI 2.0 Co-Simulation
-FMU works too, at one ``doStep`` + ``getReal`` per output sample.
+It runs FMI 2.0 and FMI 3.0 Co-Simulation FMUs: it turns names into value references,
+values into the variable's FMI type (every scalar type, see :mod:`twin.variables`), FMI status
+codes into :class:`SimulationError`, and an FMU that ends the run itself (FMI 2.0
+``fmi2Discard`` with ``fmi2Terminated``, FMI 3.0 ``terminateSimulation``) into a result that
+stops at the FMU's last valid time, marked ``ended_by_fmu``.
+
+High-rate outputs are captured without a Python call per sample where the FMU allows it: FMUs
+built by ``fmu_build`` buffer their outputs inside each ``doStep`` (parameter
+``solver.output_interval``) and the buffer is read with one C call per communication step.
+Any other FMU works at one ``doStep`` and one get per type per output sample, on the grid
+``start + k * output_interval`` that ``fmpy.simulate_fmu`` uses, so both give the same samples.
 
 Typical use::
 
@@ -17,30 +23,47 @@ from __future__ import annotations
 import ctypes
 import hashlib
 import itertools
+import math
 import shutil
 import tempfile
+import warnings
 import weakref
 import zipfile
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from twin._progress import progress_bar
-from twin.errors import FMUError, ParameterError, SimulationError
+from twin.errors import FMUError, ParameterError, SimulationError, TwinWarning
 from twin.results import SimulationResult
+from twin.variables import Variable, variables_from_description
 
-_STATUS = ["fmi2OK", "fmi2Warning", "fmi2Discard", "fmi2Error", "fmi2Fatal", "fmi2Pending"]
+__all__ = ["FMU", "Variable", "DefaultExperiment", "RunEnd", "Block", "simulate_fmu", "describe",
+           "is_gearbox_model", "STEP_SIZE", "OUTPUT_INTERVAL"]
+
+_STATUS = ["OK", "Warning", "Discard", "Error", "Fatal", "Pending"]
 STEP_SIZE = "solver.step_size"
 OUTPUT_INTERVAL = "solver.output_interval"
 
+# fmpy getter/setter per FMI type (an enumeration is an Integer in FMI 2.0, an Int64 in FMI 3.0)
+_ACCESS = {
+    2: {"Real": "Real", "Integer": "Integer", "Enumeration": "Integer", "Boolean": "Boolean", "String": "String"},
+    3: {t: t for t in ("Float32", "Float64", "Int8", "UInt8", "Int16", "UInt16", "Int32", "UInt32",
+                       "Int64", "UInt64", "Boolean", "String")} | {"Enumeration": "Int64"},
+}
+_FMI2_TERMINATED = 3          # fmi2StatusKind fmi2Terminated
+_FMI2_LAST_SUCCESSFUL_TIME = 2  # fmi2StatusKind fmi2LastSuccessfulTime
 
-# fmpy's logger proxy (which formats the printf arguments of FMU messages) keeps ONE target
+
+# fmpy's logger proxy (which formats the printf arguments of FMI 2.0 messages) keeps ONE target
 # logger per process. Registering a proxy per instance would redirect every other FMU's messages,
 # fmpy's own included, to that instance's callback, and to freed memory once it is closed. So one
 # proxy is registered, once, for a dispatcher that forwards by componentEnvironment to the live
-# instance, and prints like fmpy for anything else.
+# instance, and prints like fmpy for anything else.  (FMI 3.0 messages arrive formatted, through
+# a callback per instance.)
 _LOG_KEYS = itertools.count(1)
 _LOG_TARGETS: dict[int, "weakref.WeakMethod"] = {}
 _SHARED: dict[str, object] = {}
@@ -50,7 +73,7 @@ def _dispatch_log(env, instance, status, category, message):
     target = _LOG_TARGETS.get(int(env)) if env else None
     method = target() if target is not None else None
     if method is not None:
-        method(env, instance, status, category, message)
+        method(status, message)
     else:
         from fmpy.fmi1 import printLogMessage
         printLogMessage(env, instance, status, category, message)
@@ -74,17 +97,29 @@ def _shared_logger():
 
 
 @dataclass(frozen=True)
-class Variable:
-    """One scalar variable of an FMU, as declared in its modelDescription.xml."""
+class DefaultExperiment:
+    """The model's ``DefaultExperiment`` (None where it gives no value); times in s."""
 
-    name: str
-    value_reference: int
-    type: str               # Real, Integer, Boolean, String, Enumeration
-    causality: str          # parameter, calculatedParameter, input, output, local, independent
-    variability: str        # constant, fixed, tunable, discrete, continuous
-    unit: str
-    description: str
-    start: float | None
+    start_time: float | None = None
+    stop_time: float | None = None
+    step_size: float | None = None
+    tolerance: float | None = None
+
+
+@dataclass(frozen=True)
+class RunEnd:
+    """The FMU ended the run itself at ``time`` [s]; ``reason`` says how (and its message)."""
+
+    time: float
+    reason: str
+
+
+@dataclass(frozen=True)
+class Block:
+    """Samples from one capture: ``time`` shape (m,), one column per name, each (m,) of its dtype."""
+
+    time: np.ndarray
+    columns: tuple[np.ndarray, ...]
 
 
 def _sha256(path: Path) -> str:
@@ -95,13 +130,30 @@ def _sha256(path: Path) -> str:
     return h.hexdigest()
 
 
+def _float_or_none(value) -> float | None:
+    try:
+        f = float(value)
+    except (TypeError, ValueError):
+        return None
+    return f if math.isfinite(f) else None
+
+
 class FMU:
-    """An FMI 2.0 Co-Simulation FMU opened for simulation.
+    """An FMI 2.0 or FMI 3.0 Co-Simulation FMU opened for simulation.
 
     Parameters
     ----------
     path : path of the ``.fmu`` file.
-    instance_name : name passed to ``fmi2Instantiate``.
+    instance_name : name passed to ``fmi2Instantiate`` / ``fmi3InstantiateCoSimulation``.
+
+    Attributes
+    ----------
+    fmi_version : 2 or 3.
+    variables : name -> :class:`~twin.variables.Variable`.
+    default_experiment : the model's :class:`DefaultExperiment`.
+    initial_parameters : every parameter's value right after initialisation (set by :meth:`setup`);
+        this is what results record as their parameters.
+    ended : a :class:`RunEnd` once the FMU has ended the run itself, else None.
     """
 
     def __init__(self, path: str | Path, *, instance_name: str = "twin"):
@@ -118,20 +170,20 @@ class FMU:
         except Exception as exc:
             raise FMUError(f"{self.path}: invalid modelDescription.xml: {exc}") from exc
         md = self.model_description
-        if md.fmiVersion != "2.0":
-            raise FMUError(f"{self.path}: FMI version {md.fmiVersion} is not supported (need 2.0)")
+        if md.fmiVersion == "2.0":
+            self.fmi_version = 2
+        elif str(md.fmiVersion).startswith("3."):
+            self.fmi_version = 3
+        else:
+            raise FMUError(f"{self.path}: FMI version {md.fmiVersion} is not supported (2.0 and 3.0 are)")
         if md.coSimulation is None:
-            raise FMUError(f"{self.path}: the FMU does not support Co-Simulation")
+            raise FMUError(f"{self.path}: the FMU does not support Co-Simulation (it is Model Exchange only)")
         self.sha256 = _sha256(self.path)
-        self.variables: dict[str, Variable] = {}
-        for v in md.modelVariables:
-            start = v.start
-            try:
-                start = float(start) if start is not None else None
-            except (TypeError, ValueError):
-                start = None
-            self.variables[v.name] = Variable(v.name, int(v.valueReference), v.type, v.causality,
-                                              v.variability, v.unit or "", v.description or "", start)
+        self.variables: dict[str, Variable] = variables_from_description(md)
+        de = md.defaultExperiment
+        self.default_experiment = DefaultExperiment(
+            *(_float_or_none(getattr(de, a, None)) if de is not None else None
+              for a in ("startTime", "stopTime", "stepSize", "tolerance")))
         self._unzip = tempfile.mkdtemp(prefix="twin_fmu_")
         try:
             fmpy.extract(str(self.path), self._unzip)
@@ -149,6 +201,8 @@ class FMU:
         self._initialized = False
         self._fatal = False
         self._t_start = 0.0
+        self.initial_parameters: dict[str, Any] = {}
+        self.ended: RunEnd | None = None
 
     # -- description -----------------------------------------------------------------------
     @property
@@ -157,21 +211,26 @@ class FMU:
 
     @property
     def guid(self) -> str:
+        """The FMI 2.0 ``guid`` or FMI 3.0 ``instantiationToken``."""
         return self.model_description.guid
 
-    def _by(self, causality: str) -> list[Variable]:
-        return sorted((v for v in self.variables.values() if v.causality == causality),
+    @property
+    def description(self) -> str:
+        return self.model_description.description or ""
+
+    @property
+    def rebuildable(self) -> bool:
+        """True for FMUs built by ``fmu_build``, whose structural constants ``twin build --set`` changes."""
+        return str(self.model_description.generationTool or "").startswith("gear-twin fmu_build")
+
+    def _by(self, *causalities: str) -> list[Variable]:
+        return sorted((v for v in self.variables.values() if v.causality in causalities),
                       key=lambda v: v.value_reference)
 
     @property
     def parameters(self) -> list[Variable]:
-        return self._by("parameter")
-
-    def structural_values(self) -> dict[str, int]:
-        """The model's Integer constants (``z1``, ``z2``, ``n_profile``, ...): fixed when the FMU
-        was built, so read from its model description."""
-        return {v.name: int(v.start) for v in self.variables.values()
-                if v.type == "Integer" and v.variability == "constant" and v.start is not None}
+        """Parameters (FMI 3.0 structural parameters included), by value reference."""
+        return self._by("parameter", "structuralParameter")
 
     @property
     def inputs(self) -> list[Variable]:
@@ -179,6 +238,7 @@ class FMU:
 
     @property
     def outputs(self) -> list[Variable]:
+        """Every output, of any type, by value reference."""
         return self._by("output")
 
     @property
@@ -195,6 +255,25 @@ class FMU:
         return out
 
     @property
+    def recordable_outputs(self) -> list[Variable]:
+        """The outputs twin can record (scalars of every type but Binary and Clock)."""
+        return [v for v in self.outputs if v.unsupported_reason is None]
+
+    def warn_unrecorded_outputs(self) -> None:
+        """Warn (:class:`~twin.errors.TwinWarning`) about outputs that recording every output leaves out."""
+        skipped = [v for v in self.outputs if v.unsupported_reason is not None]
+        if skipped:
+            listed = ", ".join(f"{v.name} ({v.type}{list(v.shape) if v.shape else ''})" for v in skipped)
+            warnings.warn(TwinWarning(f"{self.model_name}: not recorded: {listed}; twin records scalar variables "
+                                      "of every type but Binary and Clock"), stacklevel=2)
+
+    def structural_values(self) -> dict[str, int]:
+        """The model's Integer constants (``z1``, ``z2``, ``n_profile``, ...): fixed when the FMU
+        was built, so read from its model description."""
+        return {v.name: int(v.start) for v in self.variables.values()
+                if v.kind == "integer" and v.variability == "constant" and v.start is not None}
+
+    @property
     def supports_output_buffer(self) -> bool:
         return OUTPUT_INTERVAL in self.variables
 
@@ -206,8 +285,35 @@ class FMU:
             hint = f"; similar: {', '.join(close)}" if close else ""
             raise ParameterError(f"{self.model_name} has no variable {name!r}{hint}") from None
 
+    def experiment(self, start_time: float | None = None, stop_time: float | None = None,
+                   output_interval: float | None = None) -> tuple[float, float, float]:
+        """(start, stop, output interval) [s]: the values given, else the model's default experiment.
+
+        Start: ``startTime``, else 0.  Stop: ``stopTime``, else start + 1 s.  Output interval:
+        ``stepSize``, else the FMI 3.0 ``fixedInternalStepSize``, else fmpy's automatic interval
+        (500 to 1000 samples over the run).  Unlike fmpy, a model's ``stepSize`` is never
+        coarsened.
+        """
+        de = self.default_experiment
+        start = float(start_time) if start_time is not None else (de.start_time if de.start_time is not None else 0.0)
+        stop = float(stop_time) if stop_time is not None else (de.stop_time if de.stop_time is not None else start + 1.0)
+        if not stop > start:
+            raise SimulationError(f"stop_time ({stop} s) must be after start_time ({start} s)")
+        if output_interval is not None:
+            interval = float(output_interval)
+        elif de.step_size is not None and de.step_size > 0:
+            interval = de.step_size
+        elif _float_or_none(getattr(self.model_description.coSimulation, "fixedInternalStepSize", None)):
+            interval = float(self.model_description.coSimulation.fixedInternalStepSize)
+        else:
+            from fmpy.util import auto_interval
+            interval = float(auto_interval(stop - start))
+        if not interval > 0:
+            raise SimulationError(f"output_interval must be > 0 s, got {interval!r}")
+        return start, stop, interval
+
     # -- lifecycle -------------------------------------------------------------------------
-    def _logger(self, component, instance, status, category, message):
+    def _logger(self, status, message):
         text = message.decode("utf-8", "replace") if isinstance(message, bytes) else str(message)
         if status >= 2:
             self._messages.append(text)
@@ -227,87 +333,137 @@ class FMU:
         cb.componentEnvironment = ctypes.c_void_p(key)
         return cb
 
+    def _log3(self):
+        """An FMI 3.0 logMessage callback that reaches this instance without keeping it alive."""
+        target = weakref.WeakMethod(self._logger)
+
+        def log_message(env, status, category, message):
+            method = target()
+            if method is not None:
+                method(status, message)
+        return log_message
+
+    def _status_name(self, status) -> str | None:
+        if isinstance(status, int) and 0 <= status < len(_STATUS):
+            return f"fmi{self.fmi_version}{_STATUS[status]}"
+        return None
+
     def _call(self, what: str, fn, *args):
         try:
             return fn(*args)
         except Exception as exc:
-            status = getattr(exc, "status", None)
-            name = _STATUS[status] if isinstance(status, int) and 0 <= status < len(_STATUS) else None
-            self._fatal = self._fatal or name == "fmi2Fatal"
+            name = self._status_name(getattr(exc, "status", None))
+            self._fatal = self._fatal or getattr(exc, "status", None) == 4   # fmiFatal
             detail = "; ".join(self._messages[-3:]) or str(exc)
             self._messages.clear()
             raise SimulationError(f"{self.model_name}: {what} failed: {detail}", time=self.time,
                                   status=name) from exc
 
+    def _fn(self, name: str) -> str:
+        """An FMI function name for this FMU's version (``Reset`` -> ``fmi2Reset``)."""
+        if self.fmi_version == 2:
+            name = name.replace("FMUState", "FMUstate")
+        return f"fmi{self.fmi_version}{name}"
+
     def instantiate(self) -> None:
         """Load the binary and instantiate (idempotent)."""
         if self._slave is not None:
             return
-        from fmpy.fmi2 import FMU2Slave
         md = self.model_description
+        kwargs = dict(guid=md.guid, unzipDirectory=self._unzip, modelIdentifier=md.coSimulation.modelIdentifier,
+                      instanceName=self._instance_name)
         try:
-            self._slave = FMU2Slave(guid=md.guid, unzipDirectory=self._unzip,
-                                    modelIdentifier=md.coSimulation.modelIdentifier,
-                                    instanceName=self._instance_name)
+            if self.fmi_version == 2:
+                from fmpy.fmi2 import FMU2Slave
+                self._slave = FMU2Slave(**kwargs)
+            else:
+                from fmpy.fmi3 import FMU3Slave
+                self._slave = FMU3Slave(**kwargs)
         except Exception as exc:
             raise FMUError(f"{self.path}: cannot load the binary for this platform: {exc}") from exc
-        self._callbacks = self._make_callbacks()
         try:
-            self._slave.instantiate(callbacks=self._callbacks)
+            if self.fmi_version == 2:
+                self._callbacks = self._make_callbacks()
+                self._slave.instantiate(callbacks=self._callbacks)
+            else:
+                self._slave.instantiate(logMessage=self._log3())
         except Exception as exc:
             detail = "; ".join(self._messages) or str(exc)
-            # fmi2Instantiate returned NULL: there is no instance to terminate or free (an FMU
-            # given a NULL component may crash), only the library to unload
+            # the instance was not created: there is nothing to terminate or free (an FMU given a
+            # NULL instance may crash), only the library to unload
             slave, self._slave = self._slave, None
             try:
                 slave.freeLibrary()
             except Exception:  # the error below is the one the user needs
                 pass
-            raise FMUError(f"{self.path}: fmi2Instantiate failed: {detail}") from exc
-        fn = getattr(self._slave.dll, "twin_fmi2GetOutputBuffer", None)
+            raise FMUError(f"{self.path}: {self._fn('Instantiate')} failed: {detail}") from exc
+        fn = getattr(self._slave.dll, f"twin_fmi{self.fmi_version}GetOutputBuffer", None)
         if fn is not None:
             fn.restype = ctypes.c_size_t
             fn.argtypes = [ctypes.c_void_p, ctypes.POINTER(ctypes.c_double), ctypes.c_size_t]
         self._buffer_fn = fn
 
-    def setup(self, start_time: float = 0.0, *, parameters: Mapping[str, float] | None = None,
-              inputs: Mapping[str, float] | None = None) -> None:
-        """Instantiate, set parameters/inputs, and run the initialization mode."""
+    def setup(self, start_time: float = 0.0, *, parameters: Mapping[str, Any] | None = None,
+              inputs: Mapping[str, Any] | None = None, stop_time: float | None = None,
+              tolerance: float | None = None) -> None:
+        """Instantiate, set parameters, inputs and start values, and run the initialisation mode.
+
+        Values are converted to each variable's type (text is parsed; an enumeration takes an
+        item name); every bad name or value is refused before the FMU is touched.  As fmpy does,
+        values that may be set while instantiated are set before initialisation, the others
+        during it.  ``stop_time`` [s], if given, is passed on to the FMU.  Afterwards
+        :attr:`initial_parameters` holds every parameter's value.
+        """
+        values = {**(parameters or {}), **(inputs or {})}
+        typed = self._typed(values, initialised=False)
         self.instantiate()
         self.time = float(start_time)
         self._t_start = float(start_time)
-        self._call("fmi2SetupExperiment", self._slave.setupExperiment, None, float(start_time))
-        self._call("fmi2EnterInitializationMode", self._slave.enterInitializationMode)
-        if parameters:
-            self.set(parameters)
-        if inputs:
-            self.set(inputs)
-        self._call("fmi2ExitInitializationMode", self._slave.exitInitializationMode)
+        self.ended = None
+        early = {n: x for n, x in typed.items()
+                 if self.variables[n].causality == "input"
+                 or (self.variables[n].variability != "constant" and self.variables[n].initial in ("exact", "approx"))}
+        late = {n: x for n, x in typed.items() if n not in early}
+        if self.fmi_version == 2:
+            self._call("fmi2SetupExperiment", self._slave.setupExperiment, tolerance, self.time, stop_time)
+            self._write(early)
+            self._call("fmi2EnterInitializationMode", self._slave.enterInitializationMode)
+        else:
+            self._write(early)
+            self._call("fmi3EnterInitializationMode", self._slave.enterInitializationMode, tolerance,
+                       self.time, stop_time)
+        self._write(late)
+        self._call(self._fn("ExitInitializationMode"), self._slave.exitInitializationMode)
         self._initialized = True
+        self.initial_parameters = self.parameter_values()
 
     def reset(self) -> None:
         """Return to the state right after instantiation (parameters back to defaults)."""
         if self._slave is not None:
-            self._call("fmi2Reset", self._slave.reset)
+            self._call(self._fn("Reset"), self._slave.reset)
         self.time = 0.0
         self._buffer_interval = None
         self._initialized = False
+        self.ended = None
 
     def close(self) -> None:
         if self._slave is not None:
-            # fmi2Terminate only for an initialised instance, and nothing after fmi2Fatal
-            # (FMI 2.0, section 4.2.4); fmi2FreeInstance for any instance that exists
+            # fmiTerminate only for an initialised instance, and nothing after fmiFatal (FMI 2.0,
+            # section 4.2.4); fmiFreeInstance for any instance that exists
             if self._initialized and not self._fatal:
                 try:
                     self._slave.terminate()
                 except Exception:  # terminating a failed instance may fail again; it is freed anyway
                     pass
+            unloaded = False
             if not self._fatal and getattr(self._slave, "component", None):
                 self._slave.freeInstance()
-            try:
-                self._slave.freeLibrary() if hasattr(self._slave, "freeLibrary") else None
-            except Exception:
-                pass
+                unloaded = self.fmi_version == 3       # fmpy's FMI 3.0 freeInstance unloads the library too
+            if not unloaded:
+                try:
+                    self._slave.freeLibrary()
+                except Exception:
+                    pass
             self._slave = None
         shutil.rmtree(self._unzip, ignore_errors=True)
 
@@ -324,73 +480,214 @@ class FMU:
             pass
 
     # -- values ----------------------------------------------------------------------------
-    def set(self, values: Mapping[str, float]) -> None:
-        """Set Real parameters or inputs by name. Non-finite values and read-only names are refused."""
-        self.instantiate()
-        vrs, vals = [], []
+    def _typed(self, values: Mapping[str, Any], *, initialised: bool) -> dict[str, Any]:
+        """``values`` converted to their variables' types; every problem in one ParameterError."""
+        out, problems = {}, []
         for name, value in values.items():
-            v = self.variable(name)
-            if v.variability == "constant" and v.type in ("Integer", "Boolean"):
-                from twin.variants import rebuild_hint
-                raise ParameterError(rebuild_hint(self.model_name, name, value))
-            if v.type != "Real":
-                raise ParameterError(f"{name!r} is a {v.type} variable; only Real variables can be set here")
-            if v.causality not in ("parameter", "input"):
-                raise ParameterError(f"{name!r} has causality {v.causality!r} and cannot be set "
-                                     "(only parameters and inputs)")
-            if v.causality == "parameter" and v.variability != "tunable" and self._initialized:
-                raise ParameterError(f"{name!r} is a {v.variability} parameter and cannot change during a run")
             try:
-                f = float(value)
-            except (TypeError, ValueError):
-                raise ParameterError(f"value of {name!r} must be a number, got {value!r}") from None
-            if not np.isfinite(f):
-                raise ParameterError(f"value of {name!r} must be finite, got {value!r}")
-            vrs.append(v.value_reference)
-            vals.append(f)
-        if vrs:
-            self._call("fmi2SetReal", self._slave.setReal, vrs, vals)
+                v = self.variable(name)
+                if v.variability == "constant" and v.kind in ("integer", "boolean") and self.rebuildable:
+                    from twin.variants import rebuild_hint
+                    raise ParameterError(rebuild_hint(self.model_name, name, value))
+                reason = v.read_only_reason(self.model_name)
+                if reason:
+                    raise ParameterError(reason)
+                if initialised:
+                    if v.causality not in ("parameter", "input"):
+                        raise ParameterError(f"'{name}' is a start value of {self.model_name}; it can only be "
+                                             "set before the run starts")
+                    if v.causality == "parameter" and v.variability != "tunable":
+                        raise ParameterError(f"'{name}' is a {v.variability} parameter and cannot change "
+                                             "during a run")
+                out[name] = v.coerce(value)
+            except ParameterError as exc:
+                problems.append(str(exc))
+        if problems:
+            raise ParameterError(problems[0] if len(problems) == 1 else
+                                 f"{len(problems)} bad values:\n  " + "\n  ".join(problems))
+        return out
 
-    def get(self, names: str | Sequence[str]) -> float | np.ndarray:
-        """Current values of Real variables by name (a float for one name, else an array).
+    def _groups(self, variables: Iterable[Variable]) -> dict[str, list[int]]:
+        """fmpy accessor suffix -> positions in ``variables``."""
+        access = _ACCESS[self.fmi_version]
+        groups: dict[str, list[int]] = {}
+        for i, v in enumerate(variables):
+            reason = v.unsupported_reason
+            if reason:
+                raise ParameterError(reason)
+            kind = access.get(v.type)
+            if kind is None:
+                raise ParameterError(f"'{v.name}' has type {v.type}, which FMI {self.fmi_version}.0 does not define")
+            groups.setdefault(kind, []).append(i)
+        return groups
 
-        A structural Integer or Boolean (``z1``, ``z2``, ``n_profile``) has no Real value: read it
-        with :meth:`structural_values`.  Value references are unique per type only, so reading
-        one as a Real would return another variable's value; it is a ParameterError instead."""
+    def _write(self, values: Mapping[str, Any]) -> None:
+        """Set already typed values, one FMI call per type."""
+        if not values:
+            return
+        names = list(values)
+        variables = [self.variables[n] for n in names]
+        for kind, idx in self._groups(variables).items():
+            vrs = [variables[i].value_reference for i in idx]
+            vals = [values[names[i]] for i in idx]
+            self._call(self._fn(f"Set{kind}"), getattr(self._slave, f"set{kind}"), vrs, vals)
+
+    def _read(self, variables: Sequence[Variable]) -> list:
+        """Current values of ``variables`` as Python values of their types, one FMI call per type."""
+        out: list = [None] * len(variables)
+        for kind, idx in self._groups(variables).items():
+            vrs = [variables[i].value_reference for i in idx]
+            vals = self._call(self._fn(f"Get{kind}"), getattr(self._slave, f"get{kind}"), vrs)
+            for i, x in zip(idx, vals):
+                if kind == "String":
+                    x = x.decode("utf-8", "replace") if isinstance(x, bytes) else ("" if x is None else str(x))
+                elif kind == "Boolean":
+                    x = bool(x)
+                out[i] = x
+        return out
+
+    def set(self, values: Mapping[str, Any]) -> None:
+        """Set parameters, inputs or (before the run) start values by name.
+
+        Values are converted to each variable's type (see :meth:`twin.variables.Variable.coerce`).
+        Constants, structural and calculated parameters, and fixed parameters during a run are
+        refused by name, all problems in one :class:`ParameterError`.
+        """
+        typed = self._typed(values, initialised=self._initialized)
+        self.instantiate()
+        self._write(typed)
+
+    def get(self, names: str | Sequence[str]):
+        """Current values by name: one value for one name (float, int, bool or str), else a
+        float array when every name is a float variable and a list otherwise.
+
+        Variables of every type are read (value references are unique per type only, so each is
+        read with its own type's call); Binary, Clock and array variables are refused by name.
+        """
         self.instantiate()
         single = isinstance(names, str)
         names = [names] if single else list(names)
         variables = [self.variable(n) for n in names]
-        not_real = [v.name for v in variables if v.type != "Real"]
-        if not_real:
-            raise ParameterError(f"{', '.join(repr(n) for n in not_real)} of {self.model_name} "
-                                 f"{'is not a Real' if len(not_real) == 1 else 'are not Reals'}; "
-                                 "read structural Integers with structural_values()")
-        vrs = [v.value_reference for v in variables]
-        vals = np.array(self._call("fmi2GetReal", self._slave.getReal, vrs))
-        return float(vals[0]) if single else vals
+        vals = self._read(variables)
+        if single:
+            return vals[0]
+        if all(v.kind == "float" for v in variables):
+            return np.array(vals, dtype=float)
+        return vals
+
+    def get_values(self, names: Sequence[str]) -> list:
+        """Current values of ``names`` as a list of Python values of their types (float, int,
+        bool, str; an enumeration's integer value)."""
+        self.instantiate()
+        return self._read([self.variable(n) for n in names])
+
+    def parameter_values(self) -> dict[str, Any]:
+        """Current value of every parameter of a supported type, by name."""
+        params = [v for v in self.parameters if v.unsupported_reason is None]
+        if not params:
+            return {}
+        return dict(zip((v.name for v in params), self._read(params)))
+
+    # -- stepping --------------------------------------------------------------------------
+    def _do_step(self, h: float) -> bool:
+        """One doStep of ``h`` s from :attr:`time`. True when completed; False when the FMU ended
+        the run (then :attr:`ended` says where and why and :attr:`time` is that time)."""
+        t = self.time
+        if self.ended is not None:
+            raise SimulationError(f"{self.model_name} ended the run at t={self.ended.time:.6g} s; "
+                                  "it cannot step further", time=self.time)
+        if self.fmi_version == 2:
+            try:
+                self._slave.doStep(t, h)
+                return True
+            except Exception as exc:
+                if getattr(exc, "status", None) != 2:
+                    return self._call("fmi2DoStep", self._raise, exc)
+            terminated = self._status(self._slave.getBooleanStatus, _FMI2_TERMINATED)
+            last = self._status(self._slave.getRealStatus, _FMI2_LAST_SUCCESSFUL_TIME)
+            how = "fmi2DoStep returned fmi2Discard" + (" with fmi2Terminated" if terminated else "")
+            return self._end(t, h, last, how)
+        from fmpy.fmi3 import fmi3Boolean, fmi3Float64
+        event, terminate, early, last = fmi3Boolean(), fmi3Boolean(), fmi3Boolean(), fmi3Float64()
+        try:
+            self._slave.fmi3DoStep(self._slave.component, t, h, fmi3Boolean(True), ctypes.byref(event),
+                                   ctypes.byref(terminate), ctypes.byref(early), ctypes.byref(last))
+        except Exception as exc:
+            if getattr(exc, "status", None) != 2:
+                return self._call("fmi3DoStep", self._raise, exc)
+            return self._end(t, h, last.value, "fmi3DoStep returned fmi3Discard")
+        if terminate.value:
+            return self._end(t, h, last.value, "fmi3DoStep set terminateSimulation")
+        if early.value:
+            raise SimulationError(f"{self.model_name}: fmi3DoStep returned early although early return "
+                                  "was not allowed", time=t, status="fmi3OK")
+        return True
+
+    @staticmethod
+    def _raise(exc):
+        raise exc
+
+    def _status(self, fn, kind):
+        try:
+            return fn(kind)
+        except Exception:       # an FMU may not provide the status; the step start is used then
+            return None
+
+    def _end(self, t: float, h: float, last, how: str) -> bool:
+        """Record that the FMU ended the run within the step [t, t + h]."""
+        last = _float_or_none(last)
+        tol = 1e-9 * max(1.0, abs(t + h))
+        if last is None or not t - tol <= last <= t + h + tol:
+            last = t                 # not reported (or nonsense): the step start is the last valid time
+        message = "; ".join(self._messages[-3:])
+        self._messages.clear()
+        self.ended = RunEnd(min(max(last, t), t + h), f"{how} at t={last:.9g} s" + (f": {message}" if message else ""))
+        self.time = self.ended.time
+        return False
 
     def step(self, dt: float) -> None:
-        """Advance one communication step of ``dt`` seconds."""
+        """Advance one communication step of ``dt`` seconds (or less, if the FMU ends the run:
+        then :attr:`ended` is set)."""
         if not dt > 0:
             raise SimulationError(f"communication step must be > 0 s, got {dt!r}", time=self.time)
-        self._call("fmi2DoStep", self._slave.doStep, self.time, dt)
-        self.time += dt
+        if self._do_step(dt):
+            self.time += dt
 
     def get_state(self):
-        """Opaque snapshot of the FMU (fmi2GetFMUstate); restore it with :meth:`set_state`."""
-        return self._call("fmi2GetFMUstate", self._slave.getFMUstate), self.time
+        """Opaque snapshot of the FMU (fmiGetFMUstate); restore it with :meth:`set_state`."""
+        return self._call(self._fn("GetFMUState"), self._slave.getFMUState), self.time
 
     def set_state(self, state) -> None:
         handle, t = state
-        self._call("fmi2SetFMUstate", self._slave.setFMUstate, handle)
+        self._call(self._fn("SetFMUState"), self._slave.setFMUState, handle)
         self.time = t
+        self.ended = None
         self._buffer_interval = self.get(OUTPUT_INTERVAL) if self.supports_output_buffer else None
 
     def free_state(self, state) -> None:
-        self._call("fmi2FreeFMUstate", self._slave.freeFMUstate, state[0])
+        self._call(self._fn("FreeFMUState"), self._slave.freeFMUState, state[0])
 
     # -- capture ---------------------------------------------------------------------------
+    def _recorded(self, names: Iterable[str] | None) -> list[Variable]:
+        """The variables to record: ``names`` (checked: they exist and have a supported type),
+        or every output of a supported type."""
+        if names is None:
+            return self.recordable_outputs
+        variables, problems = [], []
+        for n in names:
+            try:
+                v = self.variable(n)
+                if v.unsupported_reason:
+                    raise ParameterError(v.unsupported_reason + "; it cannot be recorded")
+                if v.causality == "independent":
+                    raise ParameterError(f"'{n}' is the independent variable; it is the result's time axis")
+                variables.append(v)
+            except ParameterError as exc:
+                problems.append(str(exc))
+        if problems:
+            raise ParameterError(problems[0] if len(problems) == 1 else "\n  ".join(problems))
+        return variables
+
     def run(self, stop_time: float, output_interval: float, *, outputs: Iterable[str] | None = None,
             communication_step: float | None = None, progress: bool = False, callback=None) -> SimulationResult:
         """Simulate from the current time to ``stop_time`` and return the sampled outputs.
@@ -399,101 +696,150 @@ class FMU:
         ----------
         stop_time : end time [s].
         output_interval : output sample period [s] (1e-5 for 100 kHz).
-        outputs : names to record (default: every output).
-        communication_step : doStep size [s]; default 0.1 s (one Python call per 10,000 samples at 100 kHz).
+        outputs : names to record (default: every output of a supported type).
+        communication_step : how often ``callback`` runs [s]; default 0.1 s (one Python call per
+            10,000 samples at 100 kHz for buffered FMUs).
         callback : ``callback(fmu, t)`` called after every communication step (events, hooks).
 
         Returns a :class:`SimulationResult` whose ``time`` has shape (n,) with
-        n = round((stop_time - start) / output_interval) + 1.
+        n = round((stop_time - start) / output_interval) + 1, or fewer samples when the FMU ends
+        the run itself (``ended_by_fmu``; the last sample is at the FMU's last valid time).  Its
+        parameters are :attr:`initial_parameters`.
         """
-        if self._slave is None:
-            self.setup(self.time)
+        if not self._initialized:
+            self.setup(self.time, stop_time=stop_time)
         if not output_interval > 0:
             raise SimulationError(f"output_interval must be > 0 s, got {output_interval!r}", time=self.time)
-        t0 = self.time
-        n_samples = int(round((stop_time - t0) / output_interval))
+        variables = self._recorded(outputs)
+        k0 = round((self.time - self._t_start) / output_interval)
+        n_samples = int(round((stop_time - self._t_start) / output_interval)) - k0
         if n_samples < 1:
-            raise SimulationError(f"stop_time {stop_time} s leaves no output sample after t={t0} s", time=t0)
-        names = [v.name for v in self.outputs] if outputs is None else list(outputs)
-        for n in names:
-            self.variable(n)
+            raise SimulationError(f"stop_time {stop_time} s leaves no output sample after t={self.time} s",
+                                  time=self.time)
         per_step = max(1, int(round((communication_step or 0.1) / output_interval)))
-        out = np.empty((n_samples + 1, len(names)))
-        out[0] = self.get(names) if names else []
+        names = [v.name for v in variables]
+        blocks = [Block(np.array([self.time]), tuple(np.array([x], dtype=v.dtype)
+                                                     for v, x in zip(variables, self._read(variables))))]
         bar = progress_bar(n_samples, progress, self.model_name, "samples")
         k = 0
         try:
-            while k < n_samples:
+            while k < n_samples and self.ended is None:
                 m = min(per_step, n_samples - k)
-                out[k + 1:k + 1 + m] = self.capture(t0 + (k + m) * output_interval, output_interval, names)
+                block = self.capture_block(self._t_start + (k0 + k + m) * output_interval, output_interval, names)
+                blocks.append(block)
                 k += m
-                if callback is not None:
+                if callback is not None and self.ended is None:
                     callback(self, self.time)
                 bar.update(m)
         finally:
             bar.close()
-        time = t0 + output_interval * np.arange(n_samples + 1)
-        bad = ~np.isfinite(out)
-        if bad.any():
-            i = int(np.argmax(bad.any(axis=1)))
-            raise SimulationError(f"output {names[int(np.argmax(bad[i]))]} is not finite", time=float(time[i]))
-        params = self.parameter_values()
+        return self._result(variables, blocks, output_interval)
+
+    def _result(self, variables: Sequence[Variable], blocks: Sequence[Block], output_interval: float) -> SimulationResult:
+        time = np.concatenate([b.time for b in blocks])
+        columns = [np.concatenate([b.columns[j] for b in blocks]) for j in range(len(variables))]
+        for v, col in zip(variables, columns):
+            if v.kind == "float":
+                bad = ~np.isfinite(col)
+                if bad.any():
+                    i = int(np.argmax(bad))
+                    raise SimulationError(f"output {v.name} is not finite", time=float(time[i]))
         return SimulationResult(
-            time=time, signals={n: out[:, j].copy() for j, n in enumerate(names)},
-            units={n: self.variables[n].unit for n in names}, sample_rate=1.0 / output_interval,
-            parameters=params, model_name=self.model_name, guid=self.guid, fmu_sha256=self.sha256)
+            time=time, signals={v.name: c for v, c in zip(variables, columns)},
+            units={v.name: v.unit for v in variables}, sample_rate=1.0 / output_interval,
+            parameters=dict(self.initial_parameters), model_name=self.model_name, guid=self.guid,
+            fmu_sha256=self.sha256, types={v.name: v.type for v in variables},
+            enumerations={v.name: dict(v.items) for v in variables if v.items},
+            ended_by_fmu=self.ended is not None, end_reason=self.ended.reason if self.ended else "")
 
     def capture(self, t_end: float, output_interval: float, names: Sequence[str]) -> np.ndarray:
-        """Advance to ``t_end`` and return the outputs sampled every ``output_interval``.
+        """Advance to ``t_end`` and return float outputs sampled every ``output_interval``.
 
         Returns shape (m, len(names)): the samples at t + output_interval, ..., t_end, where
-        m = round((t_end - t) / output_interval). FMUs built by fmu_build fill an internal
-        buffer during one doStep; other FMUs get one doStep + getReal per sample.
+        m = round((t_end - t) / output_interval).  For variables of other types, or FMUs that may
+        end the run themselves, use :meth:`capture_block`; here such an end is a SimulationError.
+        """
+        variables = [self.variable(n) for n in names]
+        not_float = [v.name for v in variables if v.kind != "float"]
+        if not_float:
+            raise ParameterError(f"capture() returns floats; {', '.join(not_float)} "
+                                 f"{'is not a float variable' if len(not_float) == 1 else 'are not float variables'} "
+                                 "(capture_block returns every type)")
+        block = self.capture_block(t_end, output_interval, names)
+        if self.ended is not None:
+            raise SimulationError(f"{self.model_name} ended the run itself before t={t_end:.6g} s: "
+                                  f"{self.ended.reason}", time=self.time)
+        out = np.empty((block.time.size, len(names)))
+        for j, c in enumerate(block.columns):
+            out[:, j] = c
+        return out
+
+    def capture_block(self, t_end: float, output_interval: float, names: Sequence[str]) -> Block:
+        """Advance to ``t_end`` and return the samples of ``names`` every ``output_interval``.
+
+        Samples are at the grid points start + k * output_interval after the current time up to
+        ``t_end``; FMUs built by fmu_build fill an internal buffer during one doStep, other FMUs
+        get one doStep and one get per type per sample.  If the FMU ends the run itself, the block
+        stops there: its last sample is at the FMU's last valid time (on the grid when within
+        1e-9 of a grid point) and :attr:`ended` is set.
         """
         # snap to the sample grid t_start + k*interval, which is where the FMU samples, so float
         # drift over many captures cannot drop or add a sample
         k_now = round((self.time - self._t_start) / output_interval)
         k_end = round((t_end - self._t_start) / output_interval)
-        t_end = self._t_start + k_end * output_interval
         m = int(k_end - k_now)
         if m < 1:
             raise SimulationError(f"capture to t={t_end} s leaves no sample after t={self.time} s", time=self.time)
-        block = np.empty((m, len(names)))
-        if self._buffer_fn is not None:
-            all_outputs = [v.name for v in self.outputs]
-            try:
-                cols = [all_outputs.index(n) for n in names]
-            except ValueError:
-                extra = [n for n in names if n not in all_outputs]
-                raise ParameterError(f"only outputs can be recorded from the buffer; not outputs: {extra}") from None
-            if self._buffer_interval != output_interval:
-                self.set({OUTPUT_INTERVAL: output_interval})
-                self._buffer_interval = output_interval
-            if self._scratch is None or self._scratch.shape[0] < m + 2:
-                self._scratch = np.empty((m + 2, max(len(all_outputs), 1)))
-            self._call("fmi2DoStep", self._slave.doStep, self.time, t_end - self.time)
+        variables = self._recorded(names)
+        if self._buffer_fn is not None and all(v.type in ("Real", "Float64") for v in variables):
+            return self._capture_buffered(k_now, m, output_interval, variables)
+        times = np.empty(m)
+        columns = [np.empty(m, dtype=v.dtype) for v in variables]
+        n = 0
+        for j in range(m):
+            t_next = self._t_start + (k_now + j + 1) * output_interval
+            if not self._do_step(t_next - self.time):
+                t_last = self.ended.time
+                if abs(t_last - t_next) <= 1e-9 * output_interval:
+                    t_last = t_next
+                previous = self._t_start + (k_now + j) * output_interval
+                if t_last > previous + 1e-9 * output_interval:     # a sample the grid does not have yet
+                    times[n] = t_last
+                    for c, x in zip(columns, self._read(variables)):
+                        c[n] = x
+                    n += 1
+                break
+            self.time = t_next
+            times[n] = t_next
+            for c, x in zip(columns, self._read(variables)):
+                c[n] = x
+            n += 1
+        return Block(times[:n], tuple(c[:n] for c in columns))
+
+    def _capture_buffered(self, k_now: int, m: int, output_interval: float, variables: Sequence[Variable]) -> Block:
+        all_outputs = [v.name for v in self.outputs]
+        try:
+            cols = [all_outputs.index(v.name) for v in variables]
+        except ValueError:
+            extra = [v.name for v in variables if v.name not in all_outputs]
+            raise ParameterError(f"only outputs can be recorded from the buffer; not outputs: {extra}") from None
+        if self._buffer_interval != output_interval:
+            self.set({OUTPUT_INTERVAL: output_interval})
+            self._buffer_interval = output_interval
+        if self._scratch is None or self._scratch.shape[0] < m + 2:
+            self._scratch = np.empty((m + 2, max(len(all_outputs), 1)))
+        t_end = self._t_start + (k_now + m) * output_interval
+        completed = self._do_step(t_end - self.time)
+        got = self._buffer_fn(self._slave.component,
+                              self._scratch.ctypes.data_as(ctypes.POINTER(ctypes.c_double)),
+                              self._scratch.shape[0])
+        if completed:
             self.time = t_end
-            got = self._buffer_fn(self._slave.component,
-                                  self._scratch.ctypes.data_as(ctypes.POINTER(ctypes.c_double)),
-                                  self._scratch.shape[0])
             if got != m:
                 raise SimulationError(f"output buffer held {got} samples, expected {m}", time=self.time)
-            block[:] = self._scratch[:m, cols]
-        else:
-            start = self.time
-            for j in range(m):
-                t_next = t_end if j == m - 1 else start + (j + 1) * output_interval
-                self._call("fmi2DoStep", self._slave.doStep, self.time, t_next - self.time)
-                self.time = t_next
-                block[j] = self.get(names) if names else []
-        return block
-
-    def parameter_values(self) -> dict[str, float]:
-        """Current values of every Real parameter."""
-        reals = [v.name for v in self.parameters if v.type == "Real"]
-        if not reals:
-            return {}
-        return dict(zip(reals, (float(x) for x in self.get(reals))))
+        got = min(int(got), m)
+        times = self._t_start + (k_now + 1 + np.arange(got)) * output_interval
+        return Block(times, tuple(self._scratch[:got, c].copy() for c in cols))
 
     # -- Model Exchange view for linearisation -------------------------------------------------
     def state_derivative_function(self, parameters: Mapping[str, float] | None = None,
@@ -503,10 +849,13 @@ class FMU:
         ``x0`` (n,) holds the initial states; the caller must call ``f.close()`` when done.
         ``f.outputs(x, names)`` gives variables (outputs) at state ``x``; ``f.set({name: value})``
         changes parameters or inputs for the following evaluations (calculated parameters follow).
+        Linearisation uses FMI 2.0 Model Exchange.
         """
         md = self.model_description
         if md.modelExchange is None:
             raise FMUError(f"{self.path}: no Model Exchange interface, cannot linearise")
+        if self.fmi_version != 2:
+            raise FMUError(f"{self.path}: linearisation uses FMI 2.0 Model Exchange; this FMU is FMI 3.0")
         from fmpy.fmi2 import FMU2Model
         model = FMU2Model(guid=md.guid, unzipDirectory=self._unzip,
                           modelIdentifier=md.modelExchange.modelIdentifier, instanceName="linearize")
@@ -563,24 +912,41 @@ class FMU:
         return var.derivative.name if getattr(var, "derivative", None) is not None else var.name
 
 
-def simulate_fmu(path: str | Path, *, stop_time: float, start_time: float = 0.0, output_interval: float = 1e-5,
-                 outputs: Sequence[str] | None = None, parameters: Mapping[str, float] | None = None,
-                 inputs: Mapping[str, float] | None = None, progress: bool = False,
-                 step_size: float | None = None) -> SimulationResult:
+def simulate_fmu(path: str | Path, *, stop_time: float | None = None, start_time: float | None = None,
+                 output_interval: float | None = None, outputs: Sequence[str] | None = None,
+                 parameters: Mapping[str, Any] | None = None, inputs: Mapping[str, Any] | None = None,
+                 progress: bool = False, step_size: float | None = None) -> SimulationResult:
     """Simulate an FMU with constant inputs and return its sampled outputs (like ``fmpy.simulate_fmu``).
 
-    ``step_size`` [s] sets the internal solver step of FMUs built by ``fmu_build``.
+    Times left out come from the model's default experiment (see :meth:`FMU.experiment`).
+    Values may be of any variable type, or text to be parsed.  ``step_size`` [s] sets the
+    internal solver step of FMUs built by ``fmu_build``.  If the FMU ends the run before
+    ``stop_time``, the result stops there and is marked ``ended_by_fmu``.
     """
-    if stop_time <= start_time:
-        raise SimulationError(f"stop_time ({stop_time} s) must be after start_time ({start_time} s)")
     params = dict(parameters or {})
     with FMU(path) as fmu:
+        start, stop, interval = fmu.experiment(start_time, stop_time, output_interval)
         if step_size is not None:
             if STEP_SIZE not in fmu.variables:
                 raise ParameterError(f"{fmu.model_name} has no {STEP_SIZE} parameter (not built by fmu_build)")
             params[STEP_SIZE] = step_size
-        fmu.setup(start_time, parameters=params, inputs=inputs)
-        return fmu.run(stop_time, output_interval, outputs=outputs, progress=progress)
+        fmu._recorded(outputs)            # refuse bad output names before running
+        if outputs is None:
+            fmu.warn_unrecorded_outputs()
+        fmu.setup(start, parameters=params, inputs=inputs, stop_time=stop)
+        return fmu.run(stop, interval, outputs=outputs, progress=progress)
+
+
+def is_gearbox_model(path: str | Path) -> bool:
+    """True for the spur-gearbox models built from ``modelica/`` (``GearTwin.*`` with the casing
+    accelerometers), whose natural frequencies the paper measured."""
+    from fmpy.model_description import read_model_description
+    try:
+        md = read_model_description(str(path))
+    except Exception as exc:
+        raise FMUError(f"{path}: invalid modelDescription.xml: {exc}") from exc
+    return (str(md.modelName).startswith("GearTwin.")
+            and any(v.name == "accel_pinion_casing" for v in md.modelVariables))
 
 
 def validate(path: str | Path) -> list[str]:
@@ -642,46 +1008,8 @@ def xml_schema(kind: str, name: str) -> Path:
 
 
 def describe(path: str | Path) -> str:
-    """Human-readable summary of an FMU: identity, interfaces and variables with units."""
+    """Human-readable summary of an FMU: identity, description, default experiment, interfaces
+    and variables with types, start values and units (see :mod:`twin.fmu_info`)."""
+    from twin.fmu_info import describe_fmu
     with FMU(path) as fmu:
-        md = fmu.model_description
-        lines = [f"Model        {fmu.model_name}",
-                 f"Description  {md.description or ''}",
-                 f"FMI          {md.fmiVersion}  ({', '.join(k for k, v in (('Co-Simulation', md.coSimulation), ('Model Exchange', md.modelExchange)) if v is not None)})",
-                 f"GUID         {fmu.guid}",
-                 f"SHA-256      {fmu.sha256}",
-                 f"Generated by {md.generationTool or 'unknown'}",
-                 f"States       {md.numberOfContinuousStates}",
-                 f"Output buffer {'yes (' + OUTPUT_INTERVAL + ')' if fmu.supports_output_buffer else 'no'}"]
-        structural = {k: v for k, v in fmu.structural_values().items() if "[" not in k}
-        if structural:
-            lines.append(f"\nStructural ({len(structural)}, fixed when built; change with twin build --set):")
-            for k, v in structural.items():
-                var = fmu.variables[k]
-                lines.append(f"  {k:32s} {v:>14d} {'':10s} {var.description}")
-        for title, group in (("Inputs", fmu.inputs), ("Outputs", fmu.outputs), ("Parameters", fmu.parameters)):
-            lines.append(f"\n{title} ({len(group)}):")
-            arrays: dict[str, list[Variable]] = {}
-            for v in group:
-                base, bracket, _ = v.name.partition("[")
-                if bracket:
-                    arrays.setdefault(base, []).append(v)
-            shown = set()
-            for v in group:
-                base, bracket, _ = v.name.partition("[")
-                if bracket:
-                    if base in shown:
-                        continue
-                    shown.add(base)
-                    items = arrays[base]
-                    starts = [x.start for x in items if x.start is not None]
-                    rng = f"{min(starts):.4g}..{max(starts):.4g}" if starts else ""
-                    lines.append(f"  {base + f'[1..{len(items)}]':32s} {rng:>14s} {v.unit:10s} {v.description}")
-                    continue
-                start = f"{v.start:.6g}" if v.start is not None else ""
-                lines.append(f"  {v.name:32s} {start:>14s} {v.unit:10s} {v.description}")
-        from twin.variants import geometry_summary
-        geometry = geometry_summary(fmu)
-        if geometry:
-            lines += ["", *geometry]
-        return "\n".join(lines)
+        return describe_fmu(fmu)
