@@ -6,6 +6,10 @@ override, bias or reset parameters and inputs (after the Open Simulation Platfor
 files), an optional ``degradation:`` block, an optional ``archive:`` block and an optional
 ``executor:``.  The format is versioned and published as a JSON Schema (``twin schema``).
 
+Values may be of any FMI variable type: numbers, booleans, strings, and enumeration items by
+name; they are checked against the FMU's variables when the scenario runs.  A start time, stop
+time or output sample rate left out comes from the model's default experiment.
+
 Reading a file validates it completely: every problem is collected and raised at once as a
 :class:`~twin.errors.ScenarioError` with the file, the key path and the reason.  Unknown keys
 are errors.
@@ -30,27 +34,39 @@ _NUM = {"type": "number"}
 _POS = {"type": "number", "exclusiveMinimum": 0}
 _NONNEG = {"type": "number", "minimum": 0}
 _NAME_MAP = {"type": "object", "additionalProperties": {"type": "number"}}
+#: a value of any FMI variable type: a number (Real/Float, Integer), a boolean, or a string
+#: (String, or an enumeration item by name)
+_VALUE = {"type": ["number", "boolean", "string"]}
+_VALUE_MAP = {"type": "object", "additionalProperties": _VALUE}
 
-_PROFILE = {
-    "description": "A scalar signal over time: constant, ramp, steps or a CSV table.",
-    "oneOf": [
-        {"type": "number"},
-        {"type": "object", "additionalProperties": False, "required": ["constant"],
-         "properties": {"constant": _NUM}},
-        {"type": "object", "additionalProperties": False, "required": ["ramp"],
-         "properties": {"ramp": {"type": "object", "additionalProperties": False,
-                                 "required": ["from", "to", "duration"],
-                                 "properties": {"from": _NUM, "to": _NUM, "start": _NONNEG, "duration": _POS}}}},
-        {"type": "object", "additionalProperties": False, "required": ["steps"],
-         "properties": {"steps": {"type": "array", "minItems": 1,
-                                  "items": {"type": "array", "prefixItems": [_NONNEG, _NUM],
-                                            "minItems": 2, "maxItems": 2}}}},
-        {"type": "object", "additionalProperties": False, "required": ["table"],
-         "properties": {"table": {"type": "object", "additionalProperties": False, "required": ["file", "column"],
-                                  "properties": {"file": {"type": "string"}, "column": {"type": "string"},
-                                                 "time_column": {"type": "string"}}}}},
-    ],
-}
+
+def _profile_schema(value: dict, what: str) -> dict:
+    return {
+        "description": what,
+        "oneOf": [
+            value,
+            {"type": "object", "additionalProperties": False, "required": ["constant"],
+             "properties": {"constant": value}},
+            {"type": "object", "additionalProperties": False, "required": ["ramp"],
+             "properties": {"ramp": {"type": "object", "additionalProperties": False,
+                                     "required": ["from", "to", "duration"],
+                                     "properties": {"from": _NUM, "to": _NUM, "start": _NONNEG, "duration": _POS}}}},
+            {"type": "object", "additionalProperties": False, "required": ["steps"],
+             "properties": {"steps": {"type": "array", "minItems": 1,
+                                      "items": {"type": "array", "prefixItems": [_NONNEG, value],
+                                                "minItems": 2, "maxItems": 2}}}},
+            {"type": "object", "additionalProperties": False, "required": ["table"],
+             "properties": {"table": {"type": "object", "additionalProperties": False, "required": ["file", "column"],
+                                      "properties": {"file": {"type": "string"}, "column": {"type": "string"},
+                                                     "time_column": {"type": "string"}}}}},
+        ],
+    }
+
+
+_PROFILE = _profile_schema(_NUM, "A scalar signal over time: constant, ramp, steps or a CSV table.")
+_INPUT_PROFILE = _profile_schema(
+    _VALUE, "An input over time: constant, ramp, steps or a CSV table; constants and steps may also be "
+            "booleans or strings (String inputs, enumeration items by name) for inputs of those types.")
 
 CALIBRATION_SCHEMA: dict[str, Any] = {
     "type": "object", "additionalProperties": False, "required": ["parameters"],
@@ -86,7 +102,7 @@ SCHEMA: dict[str, Any] = {
     "title": "gear-twin scenario",
     "type": "object",
     "additionalProperties": False,
-    "required": ["version", "name", "fmu", "stop_time"],
+    "required": ["version", "name", "fmu"],
     "properties": {
         "version": {"const": FORMAT_VERSION, "description": "Scenario format version."},
         "name": {"type": "string", "minLength": 1},
@@ -94,16 +110,19 @@ SCHEMA: dict[str, Any] = {
         "fmu": {"type": "string", "minLength": 1,
                 "description": "Path of an .fmu or of an .ssp with one FMU component and its parameter bindings "
                                "(relative to the scenario file), or a Modelica model name built from modelica/."},
-        "start_time": {**_NONNEG, "description": "s"},
-        "stop_time": {**_POS, "description": "s"},
-        "communication_step": {**_POS, "description": "s, default 0.01"},
+        "start_time": {**_NONNEG, "description": "s; default: the model's default experiment, else 0"},
+        "stop_time": {**_POS, "description": "s; default: the model's default experiment"},
+        "communication_step": {**_POS, "description": "s; default: the whole number of output samples "
+                                                      "nearest 0.01 s (at least one)"},
         "seed": {"type": "integer", "minimum": 0},
         "output": {
             "type": "object", "additionalProperties": False,
-            "properties": {"sample_rate": {**_POS, "description": "Hz, default 100000"},
+            "properties": {"sample_rate": {**_POS, "description": "Hz; default: 1 / the model's default "
+                                                                  "experiment step (see twin info)"},
                            "variables": {"type": "array", "items": {"type": "string"}, "minItems": 1}},
         },
-        "parameters": {**_NAME_MAP, "description": "Parameter values by FMU variable name."},
+        "parameters": {**_VALUE_MAP, "description": "Parameter (and start) values by FMU variable name: numbers, "
+                                                     "booleans, strings, enumeration items by name."},
         "structural": {**_NAME_MAP,
                        "description": "Build options of the model named in 'fmu': structural parameters (z1, z2, "
                                       "n_profile) and build-time defaults; the variant is built and cached "
@@ -118,14 +137,14 @@ SCHEMA: dict[str, Any] = {
                            "load": {**_PROFILE, "description": "Load torque, N.m"},
                            "speed_input": {"type": "string", "description": "FMU input that receives 2*pi*speed (rad/s)"},
                            "load_input": {"type": "string", "description": "FMU input that receives the load (N.m)"},
-                           "inputs": {"type": "object", "additionalProperties": _PROFILE,
+                           "inputs": {"type": "object", "additionalProperties": _INPUT_PROFILE,
                                       "description": "Other FMU inputs by name, in their own units"}},
         },
         "events": {
             "type": "array",
             "items": {"type": "object", "additionalProperties": False, "required": ["time"],
                       "minProperties": 2,
-                      "properties": {"time": _NONNEG, "override": _NAME_MAP, "bias": _NAME_MAP,
+                      "properties": {"time": _NONNEG, "override": _VALUE_MAP, "bias": _NAME_MAP,
                                      "reset": {"type": "array", "items": {"type": "string"}}}},
         },
         "degradation": {
@@ -198,25 +217,44 @@ SCHEMA: dict[str, Any] = {
 
 @dataclass(frozen=True)
 class Profile:
-    """A piecewise-linear signal ``value(t)`` (times in s) holding its last value."""
+    """A piecewise-linear signal ``value(t)`` (times in s) holding its last value.
+
+    Values are numbers, or (held, never interpolated) booleans and strings for inputs of
+    those types."""
 
     times: tuple[float, ...]
-    values: tuple[float, ...]
+    values: tuple[Any, ...]
     hold: bool = False          # True: steps (zero-order hold); False: linear interpolation
 
-    def __call__(self, t: float) -> float:
+    def __call__(self, t: float) -> Any:
         if self.hold:
             i = int(np.searchsorted(self.times, t, side="right")) - 1
-            return float(self.values[max(i, 0)])
+            v = self.values[max(i, 0)]
+            return v if isinstance(v, (bool, str, int)) else float(v)
         return float(np.interp(t, self.times, self.values))
+
+    @property
+    def interpolated(self) -> bool:
+        """True when values between the given points are interpolated (ramps and tables)."""
+        return not self.hold and len(self.times) > 1
 
 
 @dataclass(frozen=True)
 class Event:
     time: float
-    override: Mapping[str, float] = field(default_factory=dict)
+    override: Mapping[str, Any] = field(default_factory=dict)
     bias: Mapping[str, float] = field(default_factory=dict)
     reset: tuple[str, ...] = ()
+
+
+def scenario_value(value: Any) -> Any:
+    """A value from YAML/JSON as given to an FMU variable: booleans and strings as they are,
+    numbers as floats (integers beyond 2**53, which a float cannot hold, stay integers)."""
+    if isinstance(value, (bool, str)):
+        return value
+    if isinstance(value, int) and abs(value) > 2**53:
+        return value
+    return float(value)
 
 
 @dataclass(frozen=True)
@@ -232,7 +270,7 @@ class Scenario:
     communication_step: float = 0.01
     sample_rate: float = 100_000.0
     outputs: tuple[str, ...] | None = None
-    parameters: Mapping[str, float] = field(default_factory=dict)
+    parameters: Mapping[str, Any] = field(default_factory=dict)
     structural: Mapping[str, float] = field(default_factory=dict)
     inputs: Mapping[str, Profile] = field(default_factory=dict)
     events: tuple[Event, ...] = ()
@@ -398,7 +436,7 @@ def scenario_from_dict(data: Any, source: Path | None = None) -> Scenario:
         if err.validator == "oneOf" and list(err.absolute_path)[:2] == ["calibration", "parameters"]:
             msg = "must be 'auto' or a mapping of parameter name to [lower, upper]"
         elif err.validator == "oneOf":
-            msg = ("must be a number or one of {constant: v}, {ramp: {from, to, start, duration}}, "
+            msg = ("must be a value or one of {constant: v}, {ramp: {from, to, start, duration}}, "
                    "{steps: [[t, v], ...]}, {table: {file, column, time_column}}")
         elif err.validator == "additionalProperties":
             msg = msg.replace("Additional properties are not allowed", "unknown key(s)")
@@ -407,13 +445,19 @@ def scenario_from_dict(data: Any, source: Path | None = None) -> Scenario:
     if problems:
         raise ScenarioError(problems)
 
-    start = float(data.get("start_time", 0.0))
-    stop = float(data["stop_time"])
+    out = data.get("output", {})
+    defaults = None
+    if "stop_time" not in data or "sample_rate" not in out:
+        defaults = _model_experiment(data, source, where, problems)
+        if defaults is None:
+            raise ScenarioError(problems)
+    start = float(data["start_time"]) if "start_time" in data else (defaults[0] if defaults else 0.0)
+    stop = float(data["stop_time"]) if "stop_time" in data else defaults[1]
     if stop <= start:
         problems.append((where, "stop_time", f"must be after start_time ({start} s), got {stop} s"))
-    comm = float(data.get("communication_step", 0.01))
-    out = data.get("output", {})
-    rate = float(out.get("sample_rate", 100_000.0))
+    rate = float(out["sample_rate"]) if "sample_rate" in out else 1.0 / defaults[2]
+    comm = (float(data["communication_step"]) if "communication_step" in data
+            else max(1, round(0.01 * rate)) / rate)
     if comm * rate < 1 - 1e-9:
         problems.append((where, "communication_step",
                          f"{comm} s is shorter than one output sample (1/{rate:g} Hz)"))
@@ -447,7 +491,7 @@ def scenario_from_dict(data: Any, source: Path | None = None) -> Scenario:
             params.update(read_parameter_file(p, fmu=locator.fmu_path))
         except ScenarioError as exc:
             problems += [(where, f"parameter_files[{i}]", r) for _, _, r in exc.problems]
-    params.update({k: float(v) for k, v in data.get("parameters", {}).items()})
+    params.update({k: scenario_value(v) for k, v in data.get("parameters", {}).items()})
     structural = {k: int(v) if float(v).is_integer() else float(v) for k, v in data.get("structural", {}).items()}
     for k in sorted(set(structural) & set(params)):
         problems.append((where, f"parameters.{k}", f"{k!r} is also in 'structural'; give it in one place"))
@@ -459,7 +503,7 @@ def scenario_from_dict(data: Any, source: Path | None = None) -> Scenario:
             name = op.get(f"{key}_input", default_input)
             prof = _profile(op[key], f"operating.{key}", source, problems, where)
             if prof is not None:
-                inputs[name] = Profile(prof.times, tuple(v * unit_scale for v in prof.values), prof.hold)
+                inputs[name] = Profile(prof.times, tuple(float(v) * unit_scale for v in prof.values), prof.hold)
     for name, spec in op.get("inputs", {}).items():
         prof = _profile(spec, f"operating.inputs.{name}", source, problems, where)
         if prof is not None:
@@ -476,7 +520,8 @@ def scenario_from_dict(data: Any, source: Path | None = None) -> Scenario:
         if abs(start + k * comm - t) > 1e-9 * max(1.0, abs(t)):
             problems.append((where, f"events[{i}].time",
                              f"{t} s is not on a communication step boundary (step {comm} s)"))
-        events.append(Event(t, dict(e.get("override", {})), dict(e.get("bias", {})), tuple(e.get("reset", ()))))
+        events.append(Event(t, {n: scenario_value(v) for n, v in e.get("override", {}).items()},
+                            {n: float(v) for n, v in e.get("bias", {}).items()}, tuple(e.get("reset", ()))))
     if any(b.time < a.time for a, b in zip(events, events[1:])):
         problems.append((where, "events", "events must be in ascending time order"))
 
@@ -510,17 +555,45 @@ def scenario_from_dict(data: Any, source: Path | None = None) -> Scenario:
                     seed=int(data.get("seed", 0)), raw=data)
 
 
+def _model_experiment(data, source, where, problems) -> tuple[float, float, float] | None:
+    """(start, stop, output interval) of the scenario's FMU for what the scenario leaves out, or
+    None (with the problem recorded) when the model cannot give them."""
+    from twin.errors import TwinError
+    missing = [k for k, given in (("stop_time", "stop_time" in data),
+                                  ("output.sample_rate", "sample_rate" in data.get("output", {}))) if not given]
+    try:
+        draft = Scenario(name=str(data.get("name", "")), fmu=str(data["fmu"]), stop_time=1.0, source=source,
+                         structural=dict(data.get("structural", {})))
+        from twin.fmu import FMU
+        with FMU(draft.fmu_path()) as fmu:
+            if "stop_time" not in data and fmu.default_experiment.stop_time is None:
+                problems.append((where, "stop_time", f"not given, and {fmu.model_name} has no default "
+                                                     "experiment stop time"))
+                return None
+            return fmu.experiment(data.get("start_time"), data.get("stop_time"), None)
+    except ScenarioError as exc:
+        problems.extend((where, k, f"{' and '.join(missing)} not given, and the model's default experiment "
+                                   f"cannot be read: {r}") for _, k, r in exc.problems)
+    except TwinError as exc:
+        problems.append((where, "fmu", f"{' and '.join(missing)} not given, and the model's default experiment "
+                                       f"cannot be read: {exc}"))
+    return None
+
+
 def _profile(spec, key, source, problems, where) -> Profile | None:
+    if isinstance(spec, (bool, str)):
+        return Profile((0.0,), (spec,), hold=True)
     if isinstance(spec, (int, float)):
-        return Profile((0.0,), (float(spec),))
+        return Profile((0.0,), (scenario_value(spec),))
     if "constant" in spec:
-        return Profile((0.0,), (float(spec["constant"]),))
+        value = scenario_value(spec["constant"])
+        return Profile((0.0,), (value,), hold=isinstance(value, (bool, str)))
     if "ramp" in spec:
         r = spec["ramp"]
         t0 = float(r.get("start", 0.0))
         return Profile((t0, t0 + float(r["duration"])), (float(r["from"]), float(r["to"])))
     if "steps" in spec:
-        steps = sorted((float(t), float(v)) for t, v in spec["steps"])
+        steps = sorted(((float(t), scenario_value(v)) for t, v in spec["steps"]), key=lambda tv: tv[0])
         return Profile(tuple(t for t, _ in steps), tuple(v for _, v in steps), hold=True)
     tab = spec["table"]
     p = Path(tab["file"])
@@ -554,8 +627,9 @@ def _profile(spec, key, source, problems, where) -> Profile | None:
     return Profile(tuple(t), tuple(v))
 
 
-def read_parameter_file(path: str | Path, *, fmu=None) -> dict[str, float]:
-    """Parameter set from JSON (``{name: value}`` or ``{"parameters": {...}}``) or SSP ``.ssv``.
+def read_parameter_file(path: str | Path, *, fmu=None) -> dict[str, Any]:
+    """Parameter set from JSON (``{name: value}`` or ``{"parameters": {...}}``; values are numbers,
+    booleans or strings) or SSP ``.ssv``.
 
     An ``.ssv`` entry with a unit is converted into the unit of the FMU variable; ``fmu`` is the
     FMU's path, or a function returning it (called only when some entry has a unit). Without an
@@ -592,6 +666,7 @@ def read_parameter_file(path: str | Path, *, fmu=None) -> dict[str, float]:
         raise ScenarioError([(str(path), "", f"not valid JSON: {exc}")]) from None
     if isinstance(data, dict) and "parameters" in data and isinstance(data["parameters"], dict):
         data = data["parameters"]
-    if not isinstance(data, dict) or not all(isinstance(v, (int, float)) for v in data.values()):
-        raise ScenarioError([(str(path), "", "expected a JSON object of parameter name -> number")])
-    return {k: float(v) for k, v in data.items()}
+    if not isinstance(data, dict) or not all(isinstance(v, (int, float, bool, str)) for v in data.values()):
+        raise ScenarioError([(str(path), "", "expected a JSON object of parameter name -> value "
+                                             "(number, boolean or string)")])
+    return {k: scenario_value(v) for k, v in data.items()}

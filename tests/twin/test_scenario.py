@@ -30,7 +30,7 @@ colour: blue
 operating:
   speed: {ramp: {from: 1}}
 events:
-  - {time: 0.5, override: {k1: fast}}
+  - {time: 0.5, override: {k1: [1, 2]}}
 """)
     with pytest.raises(ScenarioError) as info:
         load_scenario(bad)
@@ -57,7 +57,7 @@ def test_semantic_problems_are_all_listed():
 
 def test_profiles_ramp_steps_table(tmp_path):
     (tmp_path / "prof.csv").write_text("time,load\n0,5\n1,15\n")
-    data = {"version": 1, "name": "p", "fmu": "m.fmu", "stop_time": 2.0,
+    data = {"version": 1, "name": "p", "fmu": "m.fmu", "stop_time": 2.0, "output": {"sample_rate": 1e5},
             "operating": {"speed": {"ramp": {"from": 2, "to": 22, "start": 1.0, "duration": 10}},
                           "load": {"table": {"file": "prof.csv", "column": "load"}},
                           "inputs": {"drive_torque": {"steps": [[0, 0.0], [0.5, 1.0]]}}}}
@@ -71,7 +71,7 @@ def test_profiles_ramp_steps_table(tmp_path):
 
 def test_missing_table_and_bad_columns(tmp_path):
     (tmp_path / "p.csv").write_text("t,x\n0,1\n")
-    data = {"version": 1, "name": "p", "fmu": "m.fmu", "stop_time": 2.0,
+    data = {"version": 1, "name": "p", "fmu": "m.fmu", "stop_time": 2.0, "output": {"sample_rate": 1e5},
             "operating": {"load": {"table": {"file": "missing.csv", "column": "load"}},
                           "speed": {"table": {"file": "p.csv", "column": "speed"}}}}
     with pytest.raises(ScenarioError) as info:
@@ -87,12 +87,12 @@ def test_parameter_files_json_and_ssv(tmp_path):
         'version="1.0" name="b"><ssv:Parameters><ssv:Parameter name="k1"><ssv:Real value="5.0"/></ssv:Parameter>'
         '</ssv:Parameters></ssv:ParameterSet>')
     assert read_parameter_file(tmp_path / "b.ssv") == {"k1": 5.0}
-    data = {"version": 1, "name": "p", "fmu": "m.fmu", "stop_time": 1.0,
+    data = {"version": 1, "name": "p", "fmu": "m.fmu", "stop_time": 1.0, "output": {"sample_rate": 1e5},
             "parameter_files": ["a.json", "b.ssv"], "parameters": {"m1": 4.0}}
     sc = scenario_from_dict(data, source=tmp_path / "p.yaml")
     assert sc.parameters == {"k1": 5.0, "m1": 4.0}
     (tmp_path / "c.json").write_text("[1, 2]")
-    with pytest.raises(ScenarioError, match="parameter name -> number"):
+    with pytest.raises(ScenarioError, match="parameter name -> value"):
         read_parameter_file(tmp_path / "c.json")
 
 
