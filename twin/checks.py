@@ -40,12 +40,27 @@ def sample_budget_problem(span: float, interval: float, channels: int) -> str | 
     return None
 
 
-def check_times(start_time: float, stop_time: float, output_interval: float, *, n_channels: int | None = None,
-                fmu: Path | None = None) -> None:
+def check_times(start_time: float | None, stop_time: float | None, output_interval: float | None, *,
+                n_channels: int | None = None, fmu: Path | None = None) -> None:
     """Refuse non-finite or absurd times before a simulation (``twin simulate``).
 
-    ``n_channels`` defaults to the number of outputs of ``fmu`` (read from its description).
+    A time left out (None) is the model's default experiment's (read from ``fmu``'s
+    description); ``n_channels`` defaults to the number of outputs of ``fmu``.
     """
+    given = None not in (start_time, stop_time, output_interval)
+    if not given:
+        if fmu is None:
+            return
+        from twin.errors import SimulationError
+        from twin.fmu import FMU
+        for name, v in (("--start-time", start_time), ("--stop-time", stop_time), ("--output-interval", output_interval)):
+            if v is not None and not math.isfinite(v):
+                raise ParameterError(f"{name} must be a finite number of seconds, got {v!r}")
+        try:
+            with FMU(fmu) as f:
+                start_time, stop_time, output_interval = f.experiment(start_time, stop_time, output_interval)
+        except SimulationError as exc:
+            raise ParameterError(str(exc)) from None
     for name, v in (("--start-time", start_time), ("--stop-time", stop_time), ("--output-interval", output_interval)):
         if not math.isfinite(v):
             raise ParameterError(f"{name} must be a finite number of seconds, got {v!r}")
@@ -57,7 +72,7 @@ def check_times(start_time: float, stop_time: float, output_interval: float, *, 
     if span < output_interval * (1 - 1e-9):
         raise ParameterError(f"--stop-time {stop_time:g} s leaves no output sample after {start_time:g} s at an "
                              f"interval of {output_interval:g} s")
-    if not whole_multiple(span, output_interval):
+    if given and not whole_multiple(span, output_interval):   # a model's own default experiment is taken as it is
         raise ParameterError(f"the run of {span:.10g} s is not a whole number of output intervals "
                              f"({output_interval:g} s); use --stop-time "
                              f"{start_time + math.floor(span / output_interval) * output_interval:.10g} or "
@@ -79,27 +94,40 @@ def _count_outputs(fmu: Path) -> int:
         return 1
 
 
-def check_assignments(fmu: Path, parameters: dict[str, float], inputs: dict[str, float], *,
-                      values: dict[str, float] | None = None) -> None:
-    """Refuse ``--param`` names that are not parameters, ``--input`` names that are not inputs,
-    and values that make no physical sense (of ``values`` too: start values from other
-    sources), before the FMU is loaded."""
+def check_assignments(fmu: Path, parameters: dict[str, object], inputs: dict[str, object], *,
+                      values: dict[str, object] | None = None) -> None:
+    """Refuse ``--param`` names that are not parameters (or start values), ``--input`` names that
+    are not inputs, read-only variables (constants, structural and calculated parameters, with the
+    reason), values that do not fit their variable's type, and values that make no physical sense
+    (of ``values`` too: start values from other sources), before the FMU is loaded."""
     from twin.fmu import FMU
     from twin.plausibility import physical_problems
     with FMU(fmu) as f:
         problems = []
         for option, values, causality in (("--param", parameters, "parameter"), ("--input", inputs, "input")):
-            for name in values:
+            for name, value in values.items():
                 v = f.variables.get(name)
                 if v is None:
                     close = [n for n in f.variables if name.lower() in n.lower()][:5]
                     problems.append(f"{option} {name}: {f.model_name} has no variable {name!r}"
                                     + (f" (similar: {', '.join(close)})" if close else ""))
-                elif v.causality != causality:
+                elif v.variability == "constant" and v.kind in ("integer", "boolean") and f.rebuildable:
+                    from twin.variants import rebuild_hint
+                    problems.append(f"{option} {name}: {rebuild_hint(f.model_name, name, value)}")
+                elif v.read_only_reason(f.model_name) and (v.variability == "constant" or v.causality in (
+                        "structuralParameter", "calculatedParameter", "independent")):
+                    problems.append(f"{option} {name}: {v.read_only_reason(f.model_name)}")
+                elif v.causality != causality and not (causality == "parameter" and v.causality != "input"
+                                                       and v.initial in ("exact", "approx")):
                     problems.append(f"{option} {name}: {name!r} is a{'n' if v.causality[0] in 'aeiou' else ''} "
                                     f"{v.causality}, not a{'n' if causality == 'input' else ''} {causality}"
                                     + (" (use --input)" if v.causality == "input" else
                                        " (use --param)" if v.causality == "parameter" else ""))
+                else:
+                    try:
+                        v.coerce(value)        # the variable's type: a number, true/false, text, an item
+                    except ParameterError as exc:
+                        problems.append(f"{option} {name}: {exc}")
         problems += physical_problems({**(values or {}), **parameters, **inputs},
                                       {n: v.unit for n, v in f.variables.items()})
     if problems:

@@ -8,13 +8,13 @@ from __future__ import annotations
 
 import argparse
 import importlib
-import math
 import sys
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 from types import ModuleType
 
-from twin.errors import ParameterError, TwinError, WorkerCrashError
+from twin.errors import ParameterError, TwinError, TwinWarning, WorkerCrashError
 
 DEFAULT_MODEL = "GearTwin.Gearbox21"
 #: Measured natural frequencies [Hz] of the test rig (paper, Table 2).
@@ -26,30 +26,29 @@ def _lib(name: str) -> ModuleType:
     return importlib.import_module(name)
 
 
-def parse_assignments(tokens: Sequence[str] | None, option: str) -> dict[str, float]:
-    """Parse ``NAME=VALUE`` tokens into ``{name: float}``.
+def parse_assignments(tokens: Sequence[str] | None, option: str) -> dict[str, str]:
+    """Parse ``NAME=VALUE`` tokens into ``{name: text}``.
+
+    The text is converted to the variable's type by the FMU (a number, ``true``/``false``, a
+    string, an enumeration item by name), which refuses values that do not fit, by name.
 
     Raises
     ------
     ParameterError
-        Missing ``=``, empty or blank-containing name, a value that is not a
-        finite float, or a name given twice; the message names the token.
+        Missing ``=``, empty or blank-containing name, an empty value, or a name given twice;
+        the message names the token.
     """
-    out: dict[str, float] = {}
+    out: dict[str, str] = {}
     for token in tokens or ():
         name, sep, text = token.partition("=")
         name = name.strip()
         if not sep or not name or any(c.isspace() for c in name):
             raise ParameterError(f"bad {option} '{token}': expected NAME=VALUE")
-        try:
-            value = float(text)
-        except ValueError:
-            raise ParameterError(f"bad {option} '{token}': '{text}' is not a number") from None
-        if not math.isfinite(value):
-            raise ParameterError(f"bad {option} '{token}': value must be finite")
+        if not text:
+            raise ParameterError(f"bad {option} '{token}': no value after '='")
         if name in out:
             raise ParameterError(f"bad {option} '{token}': '{name}' given more than once")
-        out[name] = value
+        out[name] = text
     return out
 
 
@@ -74,11 +73,14 @@ def _cmd_build(args: argparse.Namespace) -> int:
 
 
 def _cmd_info(args: argparse.Namespace) -> int:
-    print(_lib("twin.fmu").describe(Path(args.fmu)))
+    fmu = _lib("twin.fmu")
+    print(fmu.describe(Path(args.fmu)))
     if args.measurements:
         return _info_against_measurements(args)
     if not args.modes:
         return 0                       # fast by default: no linearisation
+    if not fmu.is_gearbox_model(Path(args.fmu)):
+        return _info_model_modes(args)  # the paper's Table 2 belongs to the gearbox models only
     freqs = _lib("twin.linearize").natural_frequencies(Path(args.fmu), n=len(MEASURED_MODES_HZ))
     print()
     print("natural frequencies (linearised model vs. measured, paper Table 2)")
@@ -90,6 +92,17 @@ def _cmd_info(args: argparse.Namespace) -> int:
                   f"{100.0 * (model - measured) / measured:>+8.1f}")
         else:
             print(f"{i + 1:>4}  {'-':>11}  {measured:>13.0f}  {'-':>8}")
+    return 0
+
+
+def _info_model_modes(args: argparse.Namespace, n: int = 8) -> int:
+    """``twin info FMU --modes`` for a model other than the gearbox: its lowest natural frequencies."""
+    freqs = _lib("twin.linearize").natural_frequencies(Path(args.fmu), n=n)
+    print()
+    print("natural frequencies (linearised model)")
+    print(f"{'mode':>4}  {'model [Hz]':>11}")
+    for i, f in enumerate(freqs):
+        print(f"{i + 1:>4}  {float(f):>11.4g}")
     return 0
 
 
@@ -171,7 +184,8 @@ def _simulate_in_child(args: argparse.Namespace, fmu: Path, options: dict, targe
         result = inputs_lib.simulate_with_inputs(fmu, inputs_lib.InputTable.read(args.input_file), **options)
     else:
         result = _lib("twin.fmu").simulate_fmu(fmu, **options)
-    _lib("twin.plausibility").check_result(result, load=options["inputs"].get("load_torque"),
+    load = options["inputs"].get("load_torque")     # text from --input, taken as a number by the FMU
+    _lib("twin.plausibility").check_result(result, load=float(load) if load is not None else None,
                                            constant_inputs=not args.input_file)
     written = results.write_result(result, target)
     lines = []
@@ -184,6 +198,8 @@ def _simulate_in_child(args: argparse.Namespace, fmu: Path, options: dict, targe
     span = f"t=[{result.time[0]:.6g}, {result.time[-1]:.6g}] s" if n else "no samples"
     lines.append(f"wrote {written}: {n} samples x {len(result.signals)} channels, "
                  f"{span}, {result.sample_rate:.6g} Hz")
+    if result.ended_by_fmu:
+        lines.append(f"the FMU ended the run itself: {result.end_reason}")
     return "\n".join(lines)
 
 
@@ -233,7 +249,9 @@ def _run_in_child(scenario, out: Path, progress: bool, resume: bool) -> tuple[st
         state = "complete" if run.complete else "not complete, kept for --resume"
         return f"{scenario.name}: {len(run.stages)} stages ({state}), {run.summary()} -> {where}", 0 if run.complete else 130
     rec = _lib("twin.orchestrator").run_scenario(scenario, out, progress=progress)
-    state = "complete" if rec.complete else f"interrupted; partial result kept beside, {out} unchanged"
+    state = ("complete" if rec.complete and not rec.result.ended_by_fmu
+             else f"ended by the FMU: {rec.result.end_reason}" if rec.complete
+             else f"interrupted; partial result kept beside, {out} unchanged")
     return (f"{scenario.name}: {rec.result.time.size} samples of {len(rec.result.signals)} channels "
             f"({state}) -> {rec.path}", 0 if rec.complete else 130)
 
@@ -552,7 +570,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("info", help="describe an FMU (fast); --modes or --measurements add its natural frequencies")
     p.add_argument("fmu", metavar="FMU", help="path to the .fmu file")
     p.add_argument("--modes", action="store_true",
-                   help="linearise and compare the natural frequencies with the paper's Table 2")
+                   help="linearise: the natural frequencies, compared with the paper's Table 2 for the gearbox models")
     p.add_argument("--measurements", metavar="MEAS",
                    help="linearise and compare with the modes of a record (run-up or hammer test, see twin modes)")
     p.add_argument("--record", help="record of --measurements (default: the first)")
@@ -564,14 +582,15 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("simulate", help="run an FMU (or an .ssp with one FMU) and write its outputs")
     p.add_argument("fmu", metavar="FMU", help="path to the .fmu file, or an .ssp with one FMU component and "
                                               "its parameter bindings")
-    p.add_argument("--stop-time", type=float, required=True, help="stop time [s]")
-    p.add_argument("--start-time", type=float, default=0.0, help="start time [s] (default: 0)")
-    p.add_argument("--output-interval", type=float, default=1e-5,
-                   help="output sample interval [s] (default: 1e-5)")
+    p.add_argument("--stop-time", type=float, help="stop time [s] (default: the model's default experiment)")
+    p.add_argument("--start-time", type=float, help="start time [s] (default: the model's default experiment, else 0)")
+    p.add_argument("--output-interval", type=float,
+                   help="output sample interval [s] (default: the model's default experiment step)")
     p.add_argument("--output", "--output-file", default="out.h5", help="result file, .h5/.hdf5 or .csv")
-    p.add_argument("--outputs", help="comma-separated output variables (default: all)")
+    p.add_argument("--outputs", help="comma-separated variables to record (default: every output)")
     p.add_argument("--param", action="append", metavar="NAME=VALUE",
-                   help="set a parameter (repeatable)")
+                   help="set a parameter or start value (repeatable): a number, true/false, a string, "
+                        "an enumeration item")
     p.add_argument("--input", action="append", metavar="NAME=VALUE",
                    help="hold an input at a constant value (repeatable)")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
@@ -583,7 +602,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("run", help="run a scenario file through the co-simulation orchestrator")
     p.add_argument("scenario", metavar="SCENARIO", help="scenario .yaml file, or an .ssp (its FMU, bindings and "
                                                         "default experiment)")
-    p.add_argument("--output", help="result HDF5 file (default: <scenario name>.h5)")
+    p.add_argument("--output", help="result file, .h5/.hdf5 or .csv (default: <scenario name>.h5)")
     p.add_argument("--stop-time", type=float, help="override the scenario's stop time [s]")
     p.add_argument("--resume", action="store_true", help="degradation runs: continue from the last completed stage")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
@@ -726,7 +745,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     debug = bool(getattr(args, "debug", False)) or os.environ.get("TWIN_DEBUG", "") not in ("", "0")
     _interrupt.install()
     try:
-        code = args.handler(args)
+        with warnings.catch_warnings():
+            _one_line_warnings()          # set before the FMU's child process forks, which inherits it
+            code = args.handler(args)
     except KeyboardInterrupt:
         if debug:
             import traceback
@@ -764,6 +785,20 @@ def main(argv: Sequence[str] | None = None) -> int:
         print("twin: interrupted", file=sys.stderr)
         return 130
     return code
+
+
+def _one_line_warnings() -> None:
+    """Show the library's own warnings (:class:`TwinWarning`) as one line each, every time; any
+    other warning as Python shows it.  Call inside ``warnings.catch_warnings()``."""
+    shown = warnings.showwarning
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        if issubclass(category, TwinWarning):
+            print(f"twin: warning: {message}", file=sys.stderr)
+        else:
+            shown(message, category, filename, lineno, file, line)
+    warnings.showwarning = show
+    warnings.simplefilter("always", TwinWarning)
 
 
 if __name__ == "__main__":

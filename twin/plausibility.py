@@ -155,8 +155,8 @@ def check_parameters(fmu, values: Mapping[str, float]) -> None:
 
 def check_result(result, *, load: float | None = None, constant_inputs: bool = True,
                  limits: Limits = DEFAULT_LIMITS) -> None:
-    """:func:`check_block` on a :class:`~twin.results.SimulationResult` (its channels and units)."""
-    names = list(result.signals)
+    """:func:`check_block` on a :class:`~twin.results.SimulationResult` (its float channels and units)."""
+    names = [n for n, v in result.signals.items() if v.dtype.kind == "f"]
     if not names:
         return
     block = np.column_stack([result.signals[n] for n in names])

@@ -22,14 +22,15 @@ def fake_fmu(monkeypatch):
 
     def simulate_fmu(path, **kwargs):
         calls.append(((path,), kwargs))
-        t = np.arange(11) * kwargs["output_interval"]
+        interval = kwargs["output_interval"] or 0.1
+        t = np.arange(11) * interval
         return SimulationResult(time=t, signals={"a": np.cos(t)}, units={"a": "m/s2"},
-                                sample_rate=1.0 / kwargs["output_interval"],
-                                parameters=kwargs["parameters"])
+                                sample_rate=1.0 / interval, parameters=kwargs["parameters"])
 
     module = types.ModuleType("twin.fmu")
     module.simulate_fmu = simulate_fmu
     module.describe = lambda path: f"FMU {path.name}: fake"
+    module.is_gearbox_model = lambda path: path.name.startswith("GearTwin")
     monkeypatch.setitem(sys.modules, "twin.fmu", module)
     # in process (the call list above must see the calls) and without opening a real FMU
     monkeypatch.setattr("twin.isolation.run_isolated", lambda fn, *a, what="", timeout=None, **k: fn(*a, **k))
@@ -52,11 +53,11 @@ def test_help_subprocess_is_lazy():
 
 
 def test_usage_error_exit_code(capsys):
-    assert main(["simulate", "x.fmu"]) == 2  # --stop-time missing
+    assert main(["simulate", "x.fmu", "--stop-time", "soon"]) == 2
     assert "--stop-time" in capsys.readouterr().err
 
 
-@pytest.mark.parametrize("token", ["k_mesh", "=3", "k_mesh=abc", "k mesh=1", "k=nan", "k="])
+@pytest.mark.parametrize("token", ["k_mesh", "=3", "k mesh=1", "k="])
 def test_bad_param_token(tmp_path, capsys, fake_fmu, token):
     code = main(["simulate", "m.fmu", "--stop-time", "1", "--output", str(tmp_path / "r.h5"),
                  "--param", "ok=1", "--param", token])
@@ -72,7 +73,9 @@ def test_bad_input_token(tmp_path, capsys, fake_fmu):
 
 
 def test_parse_assignments_duplicate():
-    assert parse_assignments(["a=1", "b=-2.5e3"], "--param") == {"a": 1.0, "b": -2500.0}
+    """Values stay text: the FMU converts them to each variable's type (and refuses what does not fit)."""
+    assert parse_assignments(["a=1", "b=-2.5e3", "c=fast", "d=x=y"], "--param") == \
+        {"a": "1", "b": "-2.5e3", "c": "fast", "d": "x=y"}
     with pytest.raises(ParameterError, match="'a=2'"):
         parse_assignments(["a=1", "a=2"], "--param")
 
@@ -85,10 +88,9 @@ def test_simulate_writes_result(tmp_path, capsys, fake_fmu):
     assert code == 0
     (path,), kwargs = fake_fmu[0]
     assert path.name == "m.fmu"
-    assert kwargs == {"stop_time": 0.5, "start_time": 0.0, "output_interval": 0.01,
-                      "outputs": ["a", "b"], "parameters": {"k": 2e8},
-                      "inputs": {"torque": 10.0}, "progress": False}
-    assert read_hdf5(out).parameters == {"k": 2e8}
+    assert kwargs == {"stop_time": 0.5, "start_time": None, "output_interval": 0.01,
+                      "outputs": ["a", "b"], "parameters": {"k": "2e8"},
+                      "inputs": {"torque": "10"}, "progress": False}
     assert f"wrote {out}: 11 samples x 1 channels" in capsys.readouterr().out
 
 
@@ -111,10 +113,20 @@ def test_info_prints_mode_table(monkeypatch, capsys, fake_fmu):
     module = types.ModuleType("twin.linearize")
     module.natural_frequencies = lambda path, n: np.array([22.0, 88.74])
     monkeypatch.setitem(sys.modules, "twin.linearize", module)
+    assert main(["info", "GearTwin.Gearbox21.fmu", "--modes"]) == 0
+    out = capsys.readouterr().out
+    assert "FMU GearTwin.Gearbox21.fmu: fake" in out
+    assert "+2.0" in out and "1927" in out  # 88.74 vs 87 Hz; mode 8 listed without model value
+
+
+def test_info_of_another_model_has_no_paper_table(monkeypatch, capsys, fake_fmu):
+    module = types.ModuleType("twin.linearize")
+    module.natural_frequencies = lambda path, n: np.array([3.5, 12.25])
+    monkeypatch.setitem(sys.modules, "twin.linearize", module)
     assert main(["info", "m.fmu", "--modes"]) == 0
     out = capsys.readouterr().out
-    assert "FMU m.fmu: fake" in out
-    assert "+2.0" in out and "1927" in out  # 88.74 vs 87 Hz; mode 8 listed without model value
+    assert "natural frequencies (linearised model)" in out and "12.25" in out
+    assert "paper" not in out and "1927" not in out
 
 
 def test_info_no_modes_skips_linearize(monkeypatch, capsys, fake_fmu):
