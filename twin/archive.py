@@ -452,8 +452,8 @@ def build_archive(scenario: Scenario, output: str | Path | None = None, *, progr
         raise ScenarioError([(str(scenario.source), "archive", "the scenario has no archive block")])
     path = Path(output) if output is not None else None
     if path is not None:
-        from twin.results import check_output_path
-        check_output_path(path)
+        from twin.results import check_hdf5_path
+        check_hdf5_path(path, "an archive")
     fmu_file = fmu_path or scenario.fmu_path()
     # the gear checks come before the degradation run, which takes a while
     gear_bounds = tooth_error_bounds(scenario)

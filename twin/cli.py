@@ -266,6 +266,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
         scenario = _lib("twin.checks").override_stop_time(scenario, args.stop_time)
     out = Path(args.output) if args.output else Path(f"{scenario.name}.h5")
     _lib("twin.results").check_output_path(out)
+    if scenario.degradation is not None:      # before its FMU is built: a degradation run is HDF5 only
+        _lib("twin.results").check_hdf5_path(out, "a degradation run")
     if args.resume and scenario.degradation is None:
         raise _lib("twin.errors").ResumeError("--resume continues degradation runs only; a plain run starts "
                                               "from its start time (its partial output is kept for inspection)")

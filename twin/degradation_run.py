@@ -143,8 +143,8 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
     model = _model(spec)
     path = Path(output) if output is not None else None
     if path is not None:
-        from twin.results import check_output_path
-        check_output_path(path)
+        from twin.results import check_hdf5_path
+        check_hdf5_path(path, "a degradation run")
     dn_cap = float(spec.get("cycles_per_update", 1e7))
     max_increment = float(spec.get("max_increment", 3e-6 if model_name == "wear" else 0.01))
     max_updates = int(spec.get("max_updates", 1000))

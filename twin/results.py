@@ -215,6 +215,16 @@ def check_output_path(path: str | os.PathLike[str]) -> Path:
     return check_parent(target)
 
 
+def check_hdf5_path(path: str | os.PathLike[str], what: str) -> Path:
+    """Like :func:`check_output_path` for files that only exist as HDF5 (``what`` names them:
+    "a degradation run", "an archive"): any other suffix, ``.csv`` included, is refused by name."""
+    target = Path(path)
+    if target.suffix.lower() not in HDF5_SUFFIXES:
+        raise OutputPathError(f"{what} writes HDF5: '{target}' must end in {' or '.join(HDF5_SUFFIXES)} "
+                              f"(not '{target.suffix}')")
+    return check_parent(target)
+
+
 def write_result(result: SimulationResult, path: str | os.PathLike[str], *,
                  hdf5_extra: "Callable[[Any], None] | None" = None,
                  csv_extra: Mapping[str, Any] | None = None) -> Path:

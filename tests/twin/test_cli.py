@@ -170,3 +170,15 @@ def test_build_defaults(monkeypatch, capsys, tmp_path):
     assert calls == [("GearTwin.Gearbox21", Path("modelica"), tmp_path,
                       5e-6, False)]
     assert capsys.readouterr().out.strip() == str(tmp_path / "GearTwin.Gearbox21.fmu")
+
+
+@pytest.mark.parametrize("command", [["run", "scenarios/lubricated.yaml", "--output"],
+                                     ["archive", "scenarios/lubricated.yaml", "--out"]])
+def test_hdf5_only_outputs_refuse_other_suffixes_before_running(tmp_path, capsys, command):
+    """A degradation run and an archive only exist as HDF5: a .csv name is refused, not filled with HDF5."""
+    repo = Path(__file__).resolve().parents[2]
+    command = [str(repo / c) if c.startswith("scenarios/") else c for c in command]
+    out = tmp_path / "stages.csv"
+    assert main([*command, str(out), "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert "writes HDF5" in err and "'.csv'" in err and not out.exists()

@@ -221,3 +221,9 @@ def test_csv_with_a_bad_field_is_refused_by_name(tmp_path, typed):
         csv.writer(fh, lineterminator="\n").writerows(rows)
     with pytest.raises(OutputPathError, match="channel 'i8'"):
         read_result(path)
+
+
+def test_hdf5_only_paths(tmp_path):
+    assert res.check_hdf5_path(tmp_path / "a.hdf5", "an archive") == tmp_path / "a.hdf5"
+    with pytest.raises(OutputPathError, match=r"an archive writes HDF5: '.*a.csv' must end in .h5 or .hdf5 \(not '.csv'\)"):
+        res.check_hdf5_path(tmp_path / "a.csv", "an archive")
