@@ -317,6 +317,7 @@ class FMU:
         text = message.decode("utf-8", "replace") if isinstance(message, bytes) else str(message)
         if status >= 2:
             self._messages.append(text)
+            del self._messages[:-20]        # the last few explain a failure; an FMU may log many
 
     def _make_callbacks(self):
         from fmpy import calloc, free
@@ -534,6 +535,7 @@ class FMU:
 
     def _read(self, variables: Sequence[Variable]) -> list:
         """Current values of ``variables`` as Python values of their types, one FMI call per type."""
+        self.instantiate()
         out: list = [None] * len(variables)
         for kind, idx in self._groups(variables).items():
             vrs = [variables[i].value_reference for i in idx]

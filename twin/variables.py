@@ -104,16 +104,23 @@ class Variable:
         return self.causality in ("parameter", "structuralParameter")
 
     def read_only_reason(self, model: str) -> str | None:
-        """Why this variable cannot be given a value (by a parameter, an input or an event), or None."""
+        """Why this variable cannot be given a value (by a parameter, an input or an event), or None.
+
+        The message says what the variable is and what can be done with it instead, in the
+        command line's and the scenario file's terms."""
         what = f"'{self.name}' of {model}"
+        cannot = "it cannot be set by --param, --input or a scenario"
+        record = "--outputs (output.variables in a scenario) records it"
         if self.variability == "constant":
             value = f"value {self.format(self.start)}, " if self.start is not None else ""
-            return f"{what} is a constant ({value}fixed when the FMU was built); it is read-only"
+            return (f"{what} is a constant ({value}fixed when the FMU was built); it is read-only: {cannot}; "
+                    f"`twin info` lists it and {record}")
         if self.causality == "structuralParameter":
             return (f"{what} is a structural parameter (it shapes the model when the FMU is configured); "
-                    "it is read-only here")
+                    f"it is read-only here: {cannot}; `twin info` lists it")
         if self.causality == "calculatedParameter":
-            return f"{what} is a calculated parameter (the FMU computes it from other parameters); it is read-only"
+            return (f"{what} is a calculated parameter (the FMU computes it from other parameters); it is "
+                    f"read-only: {cannot}; {record}")
         if self.causality == "independent":
             return f"{what} is the independent variable (time); it is read-only"
         if self.causality in ("parameter", "input"):

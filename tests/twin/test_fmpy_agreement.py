@@ -140,3 +140,17 @@ def test_ball_bounces_on_the_samples_the_closed_form_gives(typecov_fmus, tmp_pat
         np.testing.assert_array_equal(result["bounces"], expected)
         assert len(impacts) >= 8
         assert result.units == {"h": "m", "v": "m/s", "bounces": "", "energy": "J/kg", "resting": ""}
+
+
+def test_read_only_and_bad_values_are_refused_in_cli_terms(typecov_fmus, tmp_path, capsys):
+    fmu = str(typecov_fmus[("AllTypes", 3)])
+    out = tmp_path / "never.h5"
+    assert main(["simulate", fmu, "--output", str(out), "--param", "teeth=20", "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert "'teeth' of AllTypes is a constant (value 19" in err and "--param" in err and "twin info" in err
+    assert "()" not in err                                    # no Python method in the advice
+    assert main(["simulate", fmu, "--output", str(out), "--param", "sections=2", "--param", "gain=fast",
+                 "--input", "Int8_input=300", "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert "3 bad values" in err and "structural parameter" in err and "'gain' must be a number" in err
+    assert "within [-128, 127]" in err and not out.exists()

@@ -152,3 +152,10 @@ def test_a_model_exchange_only_fmu_is_refused(tmp_path, typecov_fmus):
             zout.writestr(item, data)
     with pytest.raises(FMUError, match="does not support Co-Simulation"):
         FMU(bad)
+
+
+def test_values_can_be_read_before_setup(typecov_fmus):
+    """Reading instantiates the FMU when needed (the parameters' start values, before initialisation)."""
+    with FMU(typecov_fmus[("AllTypes", 3)]) as fmu:
+        values = fmu.parameter_values()
+        assert values["label"] == "gear" and values["mode"] == 2 and values["sections"] == 4

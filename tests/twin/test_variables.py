@@ -70,8 +70,10 @@ def test_read_only_variables_say_why():
     assert var("Real").read_only_reason("M") is None
     assert var("Real", causality="input", variability="continuous").read_only_reason("M") is None
     constant = var("Integer", causality="local", variability="constant", start=19)
-    assert constant.read_only_reason("M") == \
-        "'x' of M is a constant (value 19, fixed when the FMU was built); it is read-only"
+    assert constant.read_only_reason("M") == (
+        "'x' of M is a constant (value 19, fixed when the FMU was built); it is read-only: it cannot be set by "
+        "--param, --input or a scenario; `twin info` lists it and --outputs (output.variables in a scenario) "
+        "records it")
     assert "structural parameter" in var("UInt16", causality="structuralParameter",
                                          variability="fixed").read_only_reason("M")
     assert "calculated parameter" in var("Real", causality="calculatedParameter", variability="fixed",
