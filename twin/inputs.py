@@ -85,29 +85,30 @@ class InputTable:
         return out
 
 
-def simulate_with_inputs(path: str | Path, table: InputTable, *, stop_time: float, start_time: float = 0.0,
-                         output_interval: float, outputs: Sequence[str] | None = None,
+def simulate_with_inputs(path: str | Path, table: InputTable, *, stop_time: float | None = None,
+                         start_time: float | None = None, output_interval: float | None = None,
+                         outputs: Sequence[str] | None = None,
                          parameters: Mapping[str, object] | None = None, inputs: Mapping[str, object] | None = None,
                          progress: bool = False):
     """Simulate an FMU driven by ``table`` (set at every output sample and held over it).
 
     ``inputs`` holds further inputs constant; a variable both here and in the table is an error.
+    Times left out come from the model's default experiment (see :meth:`twin.fmu.FMU.experiment`).
     Returns a :class:`~twin.results.SimulationResult`.
     """
     from twin.fmu import FMU
-    from twin.errors import SimulationError
 
-    if stop_time <= start_time:
-        raise SimulationError(f"stop_time ({stop_time} s) must be after start_time ({start_time} s)")
     both = sorted(set(table.values) & set(inputs or {}))
     if both:
         raise ParameterError(f"{', '.join(map(repr, both))} given both as a constant input and in {table.source}")
     with FMU(path) as fmu:
+        start_time, stop_time, output_interval = fmu.experiment(start_time, stop_time, output_interval)
         linear, held = table.check(fmu.variables)
         start = table.at(start_time, linear, held)
         fmu.setup(start_time, parameters={**dict(parameters or {}), **{n: start[n] for n in held if n not in linear
                                                                          and fmu.variables[n].causality == "parameter"}},
                   inputs={**dict(inputs or {}), **{n: v for n, v in start.items()
-                                                   if fmu.variables[n].causality == "input"}})
+                                                   if fmu.variables[n].causality == "input"}},
+                  stop_time=stop_time)
         return fmu.run(stop_time, output_interval, outputs=outputs, communication_step=output_interval,
                        progress=progress, callback=lambda f, t: f.set(table.at(t, linear, held)))

@@ -31,7 +31,7 @@ from pathlib import Path, PurePosixPath
 from typing import Any
 from xml.sax.saxutils import quoteattr
 
-from twin.errors import FMUError, SSPError, TwinError
+from twin.errors import FMUError, ParameterError, SSPError, TwinError
 from twin.ssv import (NS_SSC, NS_SSD, NS_SSM, NS_SSV, ParameterSet, parameter_set_xml, parse_parameter_set,
                       read_units, resolve, units_xml, utc_now)
 
@@ -387,6 +387,17 @@ def ssd_xml(*, name: str, fmu_file: str, model: str, variables: Mapping[str, Any
 """
 
 
+def _from_text(variable, name: str, value):
+    """A value given as text (the command line's ``--param k=60``) in its variable's type; other
+    values, text for String variables and names the FMU does not have are left as they are."""
+    if not isinstance(value, str) or variable is None or variable.kind == "string":
+        return value
+    try:
+        return variable.coerce(value)
+    except ParameterError as exc:
+        raise SSPError(f"parameter {name!r}: {exc}") from None
+
+
 def write_ssp(fmu: str | os.PathLike[str], parameters: Mapping[str, Any], out: str | os.PathLike[str], *,
               name: str | None = None, description: str = "") -> Path:
     """Write ``out`` (``.ssp``): the FMU, ``parameters`` as an ``.ssv`` with the FMU's units, and the SSD.
@@ -417,6 +428,7 @@ def write_ssp(fmu: str | os.PathLike[str], parameters: Mapping[str, Any], out: s
     except TwinError as exc:
         raise SSPError(f"cannot write an SSP for {fmu}: {exc}") from None
     name = name or out.stem
+    parameters = {k: _from_text(variables.get(k), k, v) for k, v in parameters.items()}
     # validate every entry against the FMU, exactly as a reader will apply it
     typed = []
     for key, value in parameters.items():

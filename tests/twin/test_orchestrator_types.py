@@ -122,6 +122,8 @@ def test_run_output_format_follows_the_suffix(typecov_fmus, tmp_path, capsys):
     data = {"version": 1, "name": "ball", "fmu": str(typecov_fmus[("Ball", 2)])}
     path = _write(tmp_path, data)
     assert main(["run", str(path), "--output", str(tmp_path / "b.csv"), "--no-progress"]) == 0
-    assert (tmp_path / "b.csv").read_text().startswith("time,h[m],v[m/s]")
+    assert (tmp_path / "b.csv").read_text().startswith("time,h,v,bounces")
+    units = json.loads((tmp_path / "b.csv.json").read_text())["units"]
+    assert units["h"] == "m" and units["v"] == "m/s" and units["energy"] == "J/kg"
     assert main(["run", str(path), "--output", str(tmp_path / "b.mat"), "--no-progress"]) == 2
     assert "'.mat'" in capsys.readouterr().err and not (tmp_path / "b.mat").exists()

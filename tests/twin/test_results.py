@@ -215,7 +215,7 @@ def test_csv_with_a_bad_field_is_refused_by_name(tmp_path, typed):
     path = write_result(typed, tmp_path / "typed.csv")
     with open(path, newline="", encoding="utf-8") as fh:
         rows = list(csv.reader(fh))
-    assert rows[0][3] == "i8[]"
+    assert rows[0][3] == "i8"
     rows[2][3] = "1.5"                              # an Int8 field that is not whole
     with open(path, "w", newline="", encoding="utf-8") as fh:
         csv.writer(fh, lineterminator="\n").writerows(rows)
