@@ -47,20 +47,23 @@ def check_times(start_time: float | None, stop_time: float | None, output_interv
     A time left out (None) is the model's default experiment's (read from ``fmu``'s
     description); ``n_channels`` defaults to the number of outputs of ``fmu``.
     """
-    given = None not in (start_time, stop_time, output_interval)
-    if not given:
+    # the run's own span and interval are checked for whole multiples; a model's default experiment
+    # is taken as it is
+    user_grid = stop_time is not None or output_interval is not None
+    if None in (start_time, stop_time, output_interval):
         if fmu is None:
             return
-        from twin.errors import SimulationError
         from twin.fmu import FMU
         for name, v in (("--start-time", start_time), ("--stop-time", stop_time), ("--output-interval", output_interval)):
             if v is not None and not math.isfinite(v):
                 raise ParameterError(f"{name} must be a finite number of seconds, got {v!r}")
-        try:
-            with FMU(fmu) as f:
-                start_time, stop_time, output_interval = f.experiment(start_time, stop_time, output_interval)
-        except SimulationError as exc:
-            raise ParameterError(str(exc)) from None
+        with FMU(fmu) as f:
+            de = f.default_experiment
+            start_time = start_time if start_time is not None else (de.start_time or 0.0)
+            stop_time = stop_time if stop_time is not None else (
+                de.stop_time if de.stop_time is not None else start_time + 1.0)
+            if output_interval is None:      # (a span that is no span is refused below, by name)
+                output_interval = f.experiment(start_time, stop_time, None)[2] if stop_time > start_time else 1.0
     for name, v in (("--start-time", start_time), ("--stop-time", stop_time), ("--output-interval", output_interval)):
         if not math.isfinite(v):
             raise ParameterError(f"{name} must be a finite number of seconds, got {v!r}")
@@ -72,7 +75,7 @@ def check_times(start_time: float | None, stop_time: float | None, output_interv
     if span < output_interval * (1 - 1e-9):
         raise ParameterError(f"--stop-time {stop_time:g} s leaves no output sample after {start_time:g} s at an "
                              f"interval of {output_interval:g} s")
-    if given and not whole_multiple(span, output_interval):   # a model's own default experiment is taken as it is
+    if user_grid and not whole_multiple(span, output_interval):
         raise ParameterError(f"the run of {span:.10g} s is not a whole number of output intervals "
                              f"({output_interval:g} s); use --stop-time "
                              f"{start_time + math.floor(span / output_interval) * output_interval:.10g} or "

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import math
 import sys
 import warnings
 from collections.abc import Sequence
@@ -52,13 +53,27 @@ def parse_assignments(tokens: Sequence[str] | None, option: str) -> dict[str, st
     return out
 
 
+def _numbers(assignments: dict[str, str], option: str) -> dict[str, float]:
+    """``NAME=VALUE`` texts that must be finite numbers (build options), as floats."""
+    out = {}
+    for name, text in assignments.items():
+        try:
+            value = float(text)
+        except ValueError:
+            raise ParameterError(f"bad {option} '{name}={text}': '{text}' is not a number") from None
+        if not math.isfinite(value):
+            raise ParameterError(f"bad {option} '{name}={text}': value must be finite")
+        out[name] = value
+    return out
+
+
 def _cmd_build(args: argparse.Namespace) -> int:
     fmu_build = _lib("fmu_build")
     # FMI 3.0 builds go to their own directory by default, so that they never replace the FMI 2.0 ones
     out = Path(args.out) if args.out else Path("build") / ("fmi3" if args.fmi == 3 else "")
     if args.fmi == 3 and not args.out:
         out.parent.mkdir(exist_ok=True)
-    sets = parse_assignments(args.set, "--set")
+    sets = _numbers(parse_assignments(args.set, "--set"), "--set")
     for model in args.models or [DEFAULT_MODEL]:
         options = {"fmi_version": 3} if args.fmi == 3 else {}
         if sets:
@@ -224,8 +239,10 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     options = dict(stop_time=args.stop_time, start_time=args.start_time, output_interval=args.output_interval,
                    outputs=outputs, parameters=parameters, inputs=inputs, progress=not args.no_progress)
     # the FMU runs in a child process: a crash inside it is reported, not fatal to the CLI
-    print(_lib("twin.isolation").run_isolated(_simulate_in_child, args, fmu, options, target,
-                                              what=f"FMU {fmu}", timeout=args.timeout))
+    text, notes = _lib("twin.isolation").run_isolated(_recording_warnings, _simulate_in_child, args, fmu, options,
+                                                      target, what=f"FMU {fmu}", timeout=args.timeout)
+    _print_warnings(notes)
+    print(text)
     return 0
 
 
@@ -272,9 +289,10 @@ def _cmd_run(args: argparse.Namespace) -> int:
         raise _lib("twin.errors").ResumeError("--resume continues degradation runs only; a plain run starts "
                                               "from its start time (its partial output is kept for inspection)")
     scenario.fmu_path()            # build or find the FMU here, so its errors are reported plainly
-    text, code = _lib("twin.isolation").run_isolated(_run_in_child, scenario, out, not args.no_progress,
-                                                     args.resume, what=f"scenario {scenario.name}",
-                                                     timeout=args.timeout)
+    (text, code), notes = _lib("twin.isolation").run_isolated(_recording_warnings, _run_in_child, scenario, out,
+                                                              not args.no_progress, args.resume,
+                                                              what=f"scenario {scenario.name}", timeout=args.timeout)
+    _print_warnings(notes)
     print(text)
     return code
 
@@ -787,6 +805,20 @@ def main(argv: Sequence[str] | None = None) -> int:
         print("twin: interrupted", file=sys.stderr)
         return 130
     return code
+
+
+def _recording_warnings(fn, *args):
+    """``fn(*args)`` with the library's warnings recorded: (its value, their messages).  Used in
+    the child process that runs an FMU, whose own stderr the caller may not see."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", TwinWarning)
+        value = fn(*args)
+    return value, [str(w.message) for w in caught if issubclass(w.category, TwinWarning)]
+
+
+def _print_warnings(notes) -> None:
+    for note in notes:
+        print(f"twin: warning: {note}", file=sys.stderr)
 
 
 def _one_line_warnings() -> None:

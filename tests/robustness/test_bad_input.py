@@ -29,7 +29,7 @@ def cli(capsys):
 
 SIMULATE_TIMES = [
     (["--stop-time=nan"], "nan"), (["--stop-time=inf"], "inf"), (["--stop-time=-inf"], "inf"),
-    (["--stop-time=1e5"], "TiB"), (["--stop-time=1e12"], "memory"), (["--stop-time=-1"], "-1"),
+    (["--stop-time=1e5", "--output-interval=1e-5"], "TiB"), (["--stop-time=1e12"], "memory"), (["--stop-time=-1"], "-1"),
     (["--stop-time=0"], "after --start-time"), (["--stop-time=1e-7"], "no output sample"),
     (["--stop-time=0.1", "--start-time=nan"], "nan"), (["--stop-time=0.1", "--output-interval=0"], "> 0"),
     (["--stop-time=0.1", "--output-interval=-1e-5"], "> 0"), (["--stop-time=0.1", "--output-interval=nan"], "nan"),

@@ -26,7 +26,8 @@ def pair_18_35(fmu_dir) -> Path:
 
 
 def _scenario(**extra):
-    return scenario_from_dict({"version": 1, "name": "s", "fmu": "GearTwin.Gearbox21", "stop_time": 0.01, **extra})
+    return scenario_from_dict({"version": 1, "name": "s", "fmu": "GearTwin.Gearbox21", "stop_time": 0.01,
+                               "output": {"sample_rate": 1e5}, **extra})
 
 
 def test_a_changed_geometry_gets_the_computed_mesh_stiffness():
