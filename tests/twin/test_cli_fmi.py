@@ -119,3 +119,71 @@ def test_run_an_ssp_as_it_is(two_mass_fmu, tmp_path, capsys):
     result = read_hdf5(tmp_path / "r.h5")
     assert result.parameters["k12"] == 60.0 and result.time[-1] == pytest.approx(0.05)
     assert "tm: 51 samples" in capsys.readouterr().out      # at the model's default step, 1 ms
+
+
+# ---- FMI 3.0 builds through twin -----------------------------------------------------------------
+def _same_results(a: Path, b: Path) -> None:
+    """Two result files hold the same channels, units, parameters and samples (to 1e-12)."""
+    import numpy as np
+
+    from twin.results import read_result
+
+    ra, rb = read_result(a), read_result(b)
+    assert ra.channels == rb.channels and ra.units == rb.units and ra.parameters == rb.parameters
+    np.testing.assert_array_equal(ra.time, rb.time)
+    for name in ra.channels:
+        scale = max(float(np.max(np.abs(ra[name]))), 1e-300)
+        np.testing.assert_allclose(rb[name], ra[name], rtol=0, atol=1e-12 * scale, err_msg=name)
+
+
+def test_fmi3_build_simulates_and_runs_scenarios_like_the_fmi2_build(two_mass_fmu, tmp_path, capsys):
+    """`twin build --fmi 3` gives an FMU that `twin simulate` (with and without the model's default
+    experiment) and `twin run` run to the FMI 2.0 build's results."""
+    assert main(["build", "GearTwin.Examples.TwoMassOscillator", "--fmi", "3", "--out", str(tmp_path)]) == 0
+    fmu3 = Path(capsys.readouterr().out.strip())
+    for version, fmu in ((2, two_mass_fmu), (3, fmu3)):
+        assert main(["simulate", str(fmu), "--output", str(tmp_path / f"default{version}.h5"), "--no-progress"]) == 0
+        assert main(["simulate", str(fmu), "--stop-time", "2", "--output-interval", "1e-4", "--param", "k1=150",
+                     "--input", "force=0.5", "--output", str(tmp_path / f"sim{version}.csv"), "--no-progress"]) == 0
+        (tmp_path / f"s{version}.yaml").write_text(
+            f"version: 1\nname: s{version}\nfmu: {fmu}\nstop_time: 1.0\ncommunication_step: 0.01\n"
+            "output: {sample_rate: 2000}\nparameters: {k12: 60.0}\n"
+            "operating:\n  inputs:\n    force: {ramp: {from: 0, to: 2, duration: 0.5}}\n"
+            "events:\n  - {time: 0.4, override: {k1: 120.0}}\n  - {time: 0.7, reset: [k1]}\n")
+        assert main(["run", str(tmp_path / f"s{version}.yaml"), "--output", str(tmp_path / f"run{version}.h5"),
+                     "--no-progress"]) == 0
+    out = capsys.readouterr().out
+    assert "10001 samples x 2 channels, t=[0, 10] s" in out and out.count("2001 samples of 2 channels (complete)") == 2
+    for stem in ("default", "run"):
+        _same_results(tmp_path / f"{stem}2.h5", tmp_path / f"{stem}3.h5")
+    _same_results(tmp_path / "sim2.csv", tmp_path / "sim3.csv")
+
+
+def test_fmi3_gearbox_runs_a_scenario_and_a_degradation_run_like_fmi2(gearbox_fmu, gearbox_fmu3, tmp_path):
+    """The gearbox built for FMI 3.0 through the orchestrator (events, operating profile) and the
+    degradation loop (wear re-written into the FMU between records): the FMI 2.0 build's numbers."""
+    import h5py
+    import numpy as np
+
+    for version, fmu in ((2, gearbox_fmu), (3, gearbox_fmu3)):
+        common = (f"fmu: {fmu}\nstop_time: 0.05\ncommunication_step: 0.01\n"
+                  "output: {sample_rate: 20000, variables: [accel_pinion_casing, mesh_force, transmission_error]}\n")
+        (tmp_path / f"e{version}.yaml").write_text(
+            f"version: 1\nname: e{version}\n{common}operating:\n  speed: {{ramp: {{from: 5, to: 10, duration: 0.05}}}}\n"
+            "  load: {constant: 5}\nevents:\n  - {time: 0.02, override: {mesh_stiffness_scale: 0.8}}\n")
+        (tmp_path / f"d{version}.yaml").write_text(
+            f"version: 1\nname: d{version}\n{common}operating:\n  speed: {{constant: 10}}\n  load: {{constant: 5}}\n"
+            "degradation: {model: wear, max_increment: 1.5e-5, stop: {wear_depth: 5.0e-6}, max_updates: 4,\n"
+            "              load_window: 0.1, record_duration: 0.01}\nseed: 0\n")
+        for stem in ("e", "d"):
+            assert main(["run", str(tmp_path / f"{stem}{version}.yaml"), "--output",
+                         str(tmp_path / f"{stem}{version}.h5"), "--no-progress"]) == 0
+    _same_results(tmp_path / "e2.h5", tmp_path / "e3.h5")
+    with h5py.File(tmp_path / "d2.h5") as a, h5py.File(tmp_path / "d3.h5") as b:
+        names = []
+        a.visititems(lambda n, o: names.append(n) if isinstance(o, h5py.Dataset) else None)
+        assert "stages/00001/vibration/mesh_force" in names
+        for name in names:
+            x, y = a[name][()], b[name][()]
+            scale = max(float(np.max(np.abs(x))), 1e-300)
+            np.testing.assert_allclose(y, x, rtol=0, atol=1e-12 * scale, err_msg=name)

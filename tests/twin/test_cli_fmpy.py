@@ -86,6 +86,33 @@ def test_show_plot_and_validate(two_mass_fmu, tmp_path, capsys):
     assert f"plot of 2 channel(s) -> {tmp_path / 'r.png'}" in capsys.readouterr().out
 
 
+@pytest.mark.parametrize("which", ["Ball", "two_mass"])
+def test_fmpy_readme_show_plot_runs_headless(which, typecov_fmus, two_mass_fmu, tmp_path):
+    """fmpy's README: `fmpy simulate BouncingBall.fmu --show-plot`, no stop time, no output file,
+    as `twin simulate`, on a machine with no display: the model's default experiment, out.h5 and
+    its plot in the working directory."""
+    import os
+
+    from matplotlib.image import imread
+
+    from twin.results import read_result
+
+    fmu, samples = (typecov_fmus[("Ball", 2)], 301) if which == "Ball" else (two_mass_fmu, 10001)
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    env["MPLBACKEND"] = "Agg"
+    proc = subprocess.run([str(Path(sys.executable).parent / "twin"), "simulate", str(fmu), "--show-plot"],
+                          cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert "Traceback" not in proc.stderr and "warning" not in proc.stderr.lower()    # a progress bar only
+    result = read_result(tmp_path / "out.h5")
+    assert len(result) == samples
+    assert f"plot of {len(result.signals)} channel(s) -> out.png" in proc.stdout
+    png = tmp_path / "out.png"
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    image = imread(png)
+    assert image.shape[0] > 200 and image.shape[1] > 200 and image[..., :3].std() > 0.05   # something drawn
+
+
 def test_import_an_fmpy_result_with_units_from_the_fmu(two_mass_fmu, tmp_path, capsys):
     from twin.measurements import load_measurements
 
