@@ -29,6 +29,13 @@ def measured_fmu(fmu_dir) -> Path:
 
 
 @pytest.fixture(scope="session")
+def casing_fmu(fmu_dir) -> Path:
+    """The gearbox on a casing that moves on its mounts, sensors on the casing (GearTwin.Gearbox21Casing)."""
+    from fmu_build import build_fmu
+    return build_fmu("GearTwin.Gearbox21Casing", MODELICA, fmu_dir)
+
+
+@pytest.fixture(scope="session")
 def wheel_fmu(fmu_dir) -> Path:
     """The variant with the gear's own tooth errors (GearTwin.Variants.Gearbox21WheelErrors)."""
     from fmu_build import build_fmu

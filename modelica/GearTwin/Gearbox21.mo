@@ -212,6 +212,17 @@ model Gearbox21 "21-DOF lumped model of the UNSW spur-gear test rig (Feng et al.
   Real excitation_off_line_force(unit = "N") = 0 "Process force on the pinion across the line of action (like effect_off_line_force)";
   Real sensor_path_acceleration_pinion(unit = "m/s2") = 0 "What the transfer path and sensor add to the pinion-side casing acceleration";
   Real sensor_path_acceleration_gear(unit = "m/s2") = 0 "What the transfer path and sensor add to the gear-side casing acceleration";
+  // Motion of the casing under the bearing pedestals (GearTwin.Gearbox21Casing binds them; zero
+  // here: the pedestals stand on rigid ground, as in the paper). Both pedestals of a shaft sit at
+  // the same point of the gear plane.
+  Real support_input_x(unit = "m") = 0 "Horizontal displacement of the casing under pedestals 4 and 6";
+  Real support_input_y(unit = "m") = 0 "Vertical displacement of the casing under pedestals 4 and 6";
+  Real support_output_x(unit = "m") = 0 "Horizontal displacement of the casing under pedestals 9 and 11";
+  Real support_output_y(unit = "m") = 0 "Vertical displacement of the casing under pedestals 9 and 11";
+  Real support_input_vx(unit = "m/s") = 0 "Time derivative of support_input_x";
+  Real support_input_vy(unit = "m/s") = 0 "Time derivative of support_input_y";
+  Real support_output_vx(unit = "m/s") = 0 "Time derivative of support_output_x";
+  Real support_output_vy(unit = "m/s") = 0 "Time derivative of support_output_y";
 equation
   // Tooth-pair bookkeeping without events: the mesh phase is wrapped with atan2, the tooth
   // identity is read from the angle of the last entered tooth on the unit circle.
@@ -273,18 +284,18 @@ equation
   der(y10) = vy10;
   der(x11) = vx11;
   der(y11) = vy11;
-  m4 * der(vx4) = -kx4 * x4 - cx4 * vx4 + kx45 * (x5 - x4) + cx45 * (vx5 - vx4);
-  m4 * der(vy4) = -ky4 * y4 - cy4 * vy4 + ky45 * (y5 - y4) + cy45 * (vy5 - vy4);
+  m4 * der(vx4) = -kx4 * (x4 - support_input_x) - cx4 * (vx4 - support_input_vx) + kx45 * (x5 - x4) + cx45 * (vx5 - vx4);
+  m4 * der(vy4) = -ky4 * (y4 - support_input_y) - cy4 * (vy4 - support_input_vy) + ky45 * (y5 - y4) + cy45 * (vy5 - vy4);
   m5 * der(vx5) = -kx45 * (x5 - x4) - cx45 * (vx5 - vx4) - kx56 * (x5 - x6) - cx56 * (vx5 - vx6) - mesh_force * sin(alpha) + (effect_off_line_force + excitation_off_line_force) * cos(alpha);
   m5 * der(vy5) = -ky45 * (y5 - y4) - cy45 * (vy5 - vy4) - ky56 * (y5 - y6) - cy56 * (vy5 - vy6) - mesh_force * cos(alpha) - (effect_off_line_force + excitation_off_line_force) * sin(alpha);
-  m6 * der(vx6) = -kx6 * x6 - cx6 * vx6 + kx56 * (x5 - x6) + cx56 * (vx5 - vx6);
-  m6 * der(vy6) = -ky6 * y6 - cy6 * vy6 + ky56 * (y5 - y6) + cy56 * (vy5 - vy6);
-  m9 * der(vx9) = -kx9 * x9 - cx9 * vx9 + kx910 * (x10 - x9) + cx910 * (vx10 - vx9);
-  m9 * der(vy9) = -ky9 * y9 - cy9 * vy9 + ky910 * (y10 - y9) + cy910 * (vy10 - vy9);
+  m6 * der(vx6) = -kx6 * (x6 - support_input_x) - cx6 * (vx6 - support_input_vx) + kx56 * (x5 - x6) + cx56 * (vx5 - vx6);
+  m6 * der(vy6) = -ky6 * (y6 - support_input_y) - cy6 * (vy6 - support_input_vy) + ky56 * (y5 - y6) + cy56 * (vy5 - vy6);
+  m9 * der(vx9) = -kx9 * (x9 - support_output_x) - cx9 * (vx9 - support_output_vx) + kx910 * (x10 - x9) + cx910 * (vx10 - vx9);
+  m9 * der(vy9) = -ky9 * (y9 - support_output_y) - cy9 * (vy9 - support_output_vy) + ky910 * (y10 - y9) + cy910 * (vy10 - vy9);
   m10 * der(vx10) = -kx910 * (x10 - x9) - cx910 * (vx10 - vx9) - kx1011 * (x10 - x11) - cx1011 * (vx10 - vx11) + mesh_force * sin(alpha) - (effect_off_line_force + excitation_off_line_force) * cos(alpha);
   m10 * der(vy10) = -ky910 * (y10 - y9) - cy910 * (vy10 - vy9) - ky1011 * (y10 - y11) - cy1011 * (vy10 - vy11) + mesh_force * cos(alpha) + (effect_off_line_force + excitation_off_line_force) * sin(alpha);
-  m11 * der(vx11) = -kx11 * x11 - cx11 * vx11 + kx1011 * (x10 - x11) + cx1011 * (vx10 - vx11);
-  m11 * der(vy11) = -ky11 * y11 - cy11 * vy11 + ky1011 * (y10 - y11) + cy1011 * (vy10 - vy11);
+  m11 * der(vx11) = -kx11 * (x11 - support_output_x) - cx11 * (vx11 - support_output_vx) + kx1011 * (x10 - x11) + cx1011 * (vx10 - vx11);
+  m11 * der(vy11) = -ky11 * (y11 - support_output_y) - cy11 * (vy11 - support_output_vy) + ky1011 * (y10 - y11) + cy1011 * (vy10 - vy11);
 
   // ---- Sensors ------------------------------------------------------------------------------
   casing_acceleration_pinion = cos(sensor_angle_pinion) * der(vy6) + sin(sensor_angle_pinion) * der(vx6);

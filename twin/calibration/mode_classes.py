@@ -11,7 +11,7 @@ share of the mode's kinetic energy; the part with the largest share names the mo
 | ``gear lateral x`` / ``y`` | ``vx10`` / ``vy10`` | ``m10`` |
 | ``input pedestals x`` / ``y`` | ``vx4``, ``vx6`` / ``vy4``, ``vy6`` | ``m4``, ``m6`` |
 | ``output pedestals x`` / ``y`` | ``vx9``, ``vx11`` / ``vy9``, ``vy11`` | ``m9``, ``m11`` |
-| ``casing`` | ``casing.qd[k]`` (GearTwin.Housing.ModalCasing) | 1 (its states carry sqrt of the modal mass) |
+| ``casing`` | ``vx_casing``, ``vy_casing`` / ``w_casing`` (GearTwin.Gearbox21Casing); ``casing.qd[k]`` (a modal casing) | ``m_casing`` / ``I_casing``; 1 (modal states carry sqrt of the modal mass) |
 | ``sensor path`` | a sensor's panel or mount modes (massless: only when nothing else moves) | |
 
 A mode whose energy is split (a torsional mode that drags the pinion sideways through the mesh)
@@ -36,6 +36,8 @@ DOF_RULES: tuple[tuple[str, str, str | None], ...] = (
     (r"^vy(4|6)$", "input pedestals y", r"m\1"),
     (r"^vx(9|11)$", "output pedestals x", r"m\1"),
     (r"^vy(9|11)$", "output pedestals y", r"m\1"),
+    (r"^v(x|y)_casing$", "casing", "m_casing"),
+    (r"^w_casing$", "casing", "I_casing"),
     (r"^casing\.qd\[(\d+)\]$", "casing", None),
     (r"^sensor_\w+\.(panel_rate\[\d+\]|deflection_rate)$", "sensor path", None),
 )
@@ -125,7 +127,7 @@ def mass_values(fmu_path, parameters: Mapping[str, float]) -> dict[str, float]:
     if key not in _STARTS:
         with FMU(fmu_path) as fmu:
             _STARTS[key] = {v.name: float(v.start if v.start is not None else 1.0) for v in fmu.parameters
-                            if re.match(r"^(I|m)\d+$", v.name)}
+                            if re.match(r"^(I|m)(\d+|_casing)$", v.name)}
     return {n: float(parameters.get(n, v)) for n, v in _STARTS[key].items()}
 
 
