@@ -32,8 +32,8 @@ from typing import Any
 from xml.sax.saxutils import quoteattr
 
 from twin.errors import FMUError, ParameterError, SSPError, TwinError
-from twin.ssv import (NS_SSC, NS_SSD, NS_SSM, NS_SSV, ParameterSet, parameter_set_xml, parse_parameter_set,
-                      read_units, resolve, units_xml, utc_now)
+from twin.ssv import (_FMI_TYPE, NS_SSC, NS_SSD, NS_SSM, NS_SSV, EnumerationItem, ParameterSet, parameter_set_xml,
+                      parse_parameter_set, read_units, resolve, units_xml, utc_now)
 
 FMU_MIME = "application/x-fmu-sharedlibrary"
 SSV_MIME = "application/x-ssp-parameter-set"
@@ -349,7 +349,7 @@ def ssd_xml(*, name: str, fmu_file: str, model: str, variables: Mapping[str, Any
         kind = v.causality if v.causality in ("input", "output") else ("parameter" if v.name in bound else None)
         if kind is None:
             continue
-        vtype = {"Float64": "Real", "Float32": "Real"}.get(v.type, v.type)
+        vtype = _FMI_TYPE.get(v.type, v.type)
         if vtype == "Real":
             unit = f" unit={quoteattr(v.unit)}" if v.unit else ""
             if v.unit:
@@ -398,6 +398,19 @@ def _from_text(variable, name: str, value):
         raise SSPError(f"parameter {name!r}: {exc}") from None
 
 
+def _enumeration_item(variable, name: str, value):
+    """An enumeration variable's value (its item's name or value) as an :class:`EnumerationItem`."""
+    if variable is None or variable.kind != "enumeration" or isinstance(value, bool):
+        return value
+    try:
+        item = variable.item_name(variable.coerce(value))
+    except ParameterError as exc:
+        raise SSPError(f"parameter {name!r}: {exc}") from None
+    if item is None:
+        raise SSPError(f"parameter {name!r}: {value!r} is no item of {variable.declared_type or 'its enumeration'}")
+    return EnumerationItem(item)
+
+
 def write_ssp(fmu: str | os.PathLike[str], parameters: Mapping[str, Any], out: str | os.PathLike[str], *,
               name: str | None = None, description: str = "") -> Path:
     """Write ``out`` (``.ssp``): the FMU, ``parameters`` as an ``.ssv`` with the FMU's units, and the SSD.
@@ -429,16 +442,18 @@ def write_ssp(fmu: str | os.PathLike[str], parameters: Mapping[str, Any], out: s
         raise SSPError(f"cannot write an SSP for {fmu}: {exc}") from None
     name = name or out.stem
     parameters = {k: _from_text(variables.get(k), k, v) for k, v in parameters.items()}
+    # an enumeration's value is written as its item's name (ssv:Enumeration)
+    parameters = {k: _enumeration_item(variables.get(k), k, v) for k, v in parameters.items()}
     # validate every entry against the FMU, exactly as a reader will apply it
     typed = []
     for key, value in parameters.items():
-        kind = "Boolean" if isinstance(value, bool) else "Integer" if isinstance(value, int) else \
-            "String" if isinstance(value, str) else "Real"
+        kind = "Enumeration" if isinstance(value, EnumerationItem) else "Boolean" if isinstance(value, bool) else \
+            "Integer" if isinstance(value, int) else "String" if isinstance(value, str) else "Real"
         typed.append(ParameterValue(key, kind, value, ""))
     resolve(ParameterSet(name, tuple(typed), {}, f"parameters for {out.name}"), variables, fmu_units)
     for key, (lo, hi) in bounds.items():
         value = parameters[key]
-        if isinstance(value, (bool, str)):
+        if isinstance(value, (bool, str)) or variables[key].kind == "enumeration":
             continue
         if (lo is not None and float(value) < float(lo)) or (hi is not None and float(value) > float(hi)):
             raise SSPError(f"parameter {key!r} = {value!r} is outside its range "

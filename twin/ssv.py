@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import Any
 from xml.sax.saxutils import quoteattr
 
-from twin.errors import SSPError, UnitError
+from twin.errors import ParameterError, SSPError, UnitError
 from twin.units import Unit, convert, parse_unit
 
 NS_SSV = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
@@ -236,9 +236,17 @@ def _value_for(entry: ParameterValue, target: str, var, fmu_units, scope, where:
         if not math.isfinite(converted):
             raise SSPError(f"{where}: parameter {entry.name!r}: {value!r} {entry.unit} is not finite in {target_unit}")
         return converted
-    if entry.type != vtype:
+    if vtype == "Enumeration" and entry.type in ("Enumeration", "Integer"):
+        pass          # an item by name (ssv:Enumeration) or by its value (ssv:Integer, as some tools write it)
+    elif entry.type != vtype:
         raise SSPError(f"{where}: parameter {entry.name!r} is an {entry.type} but {target!r} is a {var.type}")
-    return entry.value
+    coerce = getattr(var, "coerce", None)
+    if coerce is None:
+        return entry.value
+    try:          # integer ranges (FMI 3.0 Int8 ... UInt64) and enumeration items, as the FMU takes them
+        return coerce(entry.value)
+    except ParameterError as exc:
+        raise SSPError(f"{where}: parameter {entry.name!r}: {exc}") from None
 
 
 # ---- writing --------------------------------------------------------------------------------------
@@ -248,8 +256,14 @@ def utc_now() -> str:
     return datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
 
 
+class EnumerationItem(str):
+    """An enumeration item by name, written as ``ssv:Enumeration`` (a plain str is an ``ssv:String``)."""
+
+
 def _typed(name: str, value) -> tuple[str, str]:
     """(SSP type, xs value text) of a Python value; non-finite numbers and big integers refused."""
+    if isinstance(value, EnumerationItem):
+        return "Enumeration", str(value)
     if isinstance(value, bool):
         return "Boolean", "true" if value else "false"
     if isinstance(value, int):
@@ -314,7 +328,8 @@ def write_ssv(parameters: Mapping[str, Any], path: str | os.PathLike[str], *, na
     """Write an ``.ssv`` file atomically and return its path.
 
     ``parameters`` maps names to floats (``ssv:Real``), ints (``ssv:Integer``), bools
-    (``ssv:Boolean``) or strings (``ssv:String``); ``units`` gives the unit of Real entries, each
+    (``ssv:Boolean``), strings (``ssv:String``) or :class:`EnumerationItem` names
+    (``ssv:Enumeration``); ``units`` gives the unit of Real entries, each
     defined in the file's ``Units`` with its BaseUnit (from ``fmu_units`` or parsed from the
     name). A non-finite value is an :class:`~twin.errors.SSPError` and nothing is written.
     """

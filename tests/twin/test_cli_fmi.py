@@ -187,3 +187,58 @@ def test_fmi3_gearbox_runs_a_scenario_and_a_degradation_run_like_fmi2(gearbox_fm
             x, y = a[name][()], b[name][()]
             scale = max(float(np.max(np.abs(x))), 1e-300)
             np.testing.assert_allclose(y, x, rtol=0, atol=1e-12 * scale, err_msg=name)
+
+
+# ---- parameters of every type in SSP -------------------------------------------------------------
+@pytest.mark.parametrize("version", [2, 3])
+def test_export_ssp_writes_every_type_and_runs_it(typecov_fmus, tmp_path, capsys, version):
+    """Integer, Boolean, String and Enumeration parameters go into the .ssv as ssv:Integer,
+    ssv:Boolean, ssv:String and ssv:Enumeration (the item's name), and the package runs with them."""
+    from twin.results import read_result
+
+    fmu = typecov_fmus[("AllTypes", version)]
+    out = tmp_path / "a.ssp"
+    assert main(["export-ssp", str(fmu), "--param", "step=2", "--param", "invert=true", "--param", "label=wheel",
+                 "--param", "mode=fast", "--param", "gain=3", "--out", str(out)]) == 0
+    with zipfile.ZipFile(out) as zf:
+        ssv = zf.read("resources/a.ssv").decode()
+    for element in ('<ssv:Integer value="2"/>', '<ssv:Boolean value="true"/>', '<ssv:String value="wheel"/>',
+                    '<ssv:Enumeration value="fast"/>', '<ssv:Real value="3.0"'):
+        assert element in ssv
+    assert read_ssp(out).parameters == {"step": 2, "invert": True, "label": "wheel", "mode": 3, "gain": 3.0}
+    assert main(["validate", str(out)]) == 0
+    assert main(["simulate", str(out), "--output", str(tmp_path / "r.h5"), "--no-progress"]) == 0
+    got = read_result(tmp_path / "r.h5").parameters
+    assert {k: got[k] for k in ("step", "invert", "label", "mode", "gain")} == \
+        {"step": 2, "invert": True, "label": "wheel", "mode": 3, "gain": 3.0}
+    capsys.readouterr()
+    # an item the enumeration does not have, and an integer outside an FMI 3.0 Int8, by name
+    assert main(["export-ssp", str(fmu), "--param", "mode=medium", "--out", str(tmp_path / "b.ssp")]) == 2
+    assert "parameter 'mode'" in capsys.readouterr().err and not (tmp_path / "b.ssp").exists()
+
+
+def test_foreign_ssv_enumeration_by_value_and_integer_ranges(typecov_fmus, tmp_path):
+    from twin.errors import SSPError
+    from twin.fmu import FMU
+    from twin.ssv import read_ssv, resolve
+
+    def ssv(body: str) -> Path:
+        path = tmp_path / "p.ssv"
+        path.write_text(f'<ssv:ParameterSet xmlns:ssv="{SSV}" version="1.0" name="p"><ssv:Parameters>{body}'
+                        "</ssv:Parameters></ssv:ParameterSet>")
+        return path
+
+    with FMU(typecov_fmus[("AllTypes", 3)]) as f:
+        variables = dict(f.variables)
+    good = ssv('<ssv:Parameter name="mode"><ssv:Integer value="1"/></ssv:Parameter>'
+               '<ssv:Parameter name="Int8_parameter"><ssv:Integer value="-7"/></ssv:Parameter>')
+    assert resolve(read_ssv(good), variables) == {"mode": 1, "Int8_parameter": -7}
+    for body, message in [('<ssv:Parameter name="mode"><ssv:Integer value="9"/></ssv:Parameter>', "must be an item"),
+                          ('<ssv:Parameter name="mode"><ssv:Enumeration value="medium"/></ssv:Parameter>',
+                           "must be an item"),
+                          ('<ssv:Parameter name="Int8_parameter"><ssv:Integer value="300"/></ssv:Parameter>',
+                           "within [-128, 127]"),
+                          ('<ssv:Parameter name="mode"><ssv:Boolean value="true"/></ssv:Parameter>',
+                           "is an Boolean but 'mode' is a Enumeration")]:
+        with pytest.raises(SSPError, match=message.replace("[", r"\[").replace("]", r"\]")):
+            resolve(read_ssv(ssv(body)), variables)
