@@ -206,6 +206,10 @@ def resolve(pset: ParameterSet, variables: Mapping[str, Any], fmu_units: Mapping
     return out
 
 
+def _a(word: str) -> str:
+    return ("an " if word[:1] in "AEIOU" else "a ") + word
+
+
 def _value_for(entry: ParameterValue, target: str, var, fmu_units, scope, where: str):
     if var.causality not in ("parameter", "input") or var.variability == "constant":
         raise SSPError(f"{where}: {target!r} has causality {var.causality!r} and variability "
@@ -213,7 +217,7 @@ def _value_for(entry: ParameterValue, target: str, var, fmu_units, scope, where:
     vtype = _FMI_TYPE.get(var.type, var.type)
     if entry.type == "Real" or (entry.type == "Integer" and vtype == "Real"):
         if vtype != "Real":
-            raise SSPError(f"{where}: parameter {entry.name!r} is a Real but {target!r} is a {var.type}")
+            raise SSPError(f"{where}: parameter {entry.name!r} is a Real but {target!r} is {_a(var.type)}")
         value = float(entry.value)
         if not entry.unit:
             return value
@@ -239,7 +243,7 @@ def _value_for(entry: ParameterValue, target: str, var, fmu_units, scope, where:
     if vtype == "Enumeration" and entry.type in ("Enumeration", "Integer"):
         pass          # an item by name (ssv:Enumeration) or by its value (ssv:Integer, as some tools write it)
     elif entry.type != vtype:
-        raise SSPError(f"{where}: parameter {entry.name!r} is an {entry.type} but {target!r} is a {var.type}")
+        raise SSPError(f"{where}: parameter {entry.name!r} is {_a(entry.type)} but {target!r} is {_a(var.type)}")
     coerce = getattr(var, "coerce", None)
     if coerce is None:
         return entry.value

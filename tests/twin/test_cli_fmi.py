@@ -239,6 +239,6 @@ def test_foreign_ssv_enumeration_by_value_and_integer_ranges(typecov_fmus, tmp_p
                           ('<ssv:Parameter name="Int8_parameter"><ssv:Integer value="300"/></ssv:Parameter>',
                            "within [-128, 127]"),
                           ('<ssv:Parameter name="mode"><ssv:Boolean value="true"/></ssv:Parameter>',
-                           "is an Boolean but 'mode' is a Enumeration")]:
+                           "is a Boolean but 'mode' is an Enumeration")]:
         with pytest.raises(SSPError, match=message.replace("[", r"\[").replace("]", r"\]")):
             resolve(read_ssv(ssv(body)), variables)

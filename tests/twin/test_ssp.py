@@ -93,7 +93,7 @@ def test_resolve_checks_types_and_settability():
     pset = ParameterSet("s", (ParameterValue("k", "Integer", 3), ParameterValue("n", "Integer", 4),
                               ParameterValue("flag", "Boolean", False)))
     assert resolve(pset, variables) == {"k": 3.0, "n": 4, "flag": False}
-    for entry, message in ((ParameterValue("n", "Real", 4.0), r"'n' is a Real but 'n' is a Integer"),
+    for entry, message in ((ParameterValue("n", "Real", 4.0), r"'n' is a Real but 'n' is an Integer"),
                            (ParameterValue("flag", "Integer", 1), r"'flag' is an Integer but 'flag' is a Boolean"),
                            (ParameterValue("z1", "Integer", 18), r"'z1' has causality 'local' and variability 'constant'"),
                            (ParameterValue("y", "Real", 1.0), r"'y' has causality 'output'")):
