@@ -4,16 +4,18 @@ At each update (stage):
 
 1. co-simulate a short window (``load_window``, default 0.1 s = two pinion revolutions at
    20 Hz) and sample the load each tooth pair carries along the path of contact
-   (``roll[i]``, ``pair_force[i]``) and the pinion speed;
+   (``roll[i]``, ``pair_force[i]``), the transmitted mesh force and the pinion speed;
 2. record a vibration snippet (``record_duration``) for the stage;
-3. advance the wear or pitting model by a jump of pinion cycles with that load (cycle
-   jumping: the load is assumed steady over the jump). The jump is the smaller of
-   ``cycles_per_update`` and the cycles after which the largest local damage increment reaches
-   ``max_increment`` (default 3 um of wear depth or 0.01 of pitting density), so the load is
-   re-sampled as often as the damage needs;
-4. turn the damage into the FMU's mesh parameters (``k_pair``, ``profile_deviation``) and
-   set them on the FMU, so the next window runs on the degraded mesh. A wear field is then
-   projected back onto the 11 nodes the FMU sees, so that state and simulation agree.
+3. advance the wear or pitting model by a jump of pinion cycles (cycle jumping: the load is
+   assumed steady over the jump). Wear (:class:`~twin.degradation.wear.FlankWear`) shares the
+   co-simulated mean mesh force among the tooth pairs by the loaded tooth contact analysis of
+   the current worn flanks, both of them; pitting uses the sampled pair forces. The jump is the
+   smaller of ``cycles_per_update`` and the cycles after which the largest local damage
+   increment reaches ``max_increment`` (default 3 um of wear depth or 0.01 of pitting
+   density), so the load is re-sampled as often as the damage needs;
+4. turn the damage into the FMU's mesh parameters (``k_pair``, ``profile_deviation`` on the
+   FMU's ``n_profile`` nodes) and set them on the FMU, so the next window runs on the
+   degraded mesh.
 
 The run stops on the scenario's criterion (pitting density, wear depth or cycles) or after
 ``max_updates``.  After every stage the stages so far are rewritten atomically to
@@ -39,8 +41,11 @@ from twin.fmu import FMU
 from twin.orchestrator import check_compatibility
 from twin.scenario import Scenario
 
+#: Default log-sd of the per-tooth pitting strength factors (``degradation.tooth_scatter``).
+DEFAULT_TOOTH_SCATTER = 0.2
 ROLL = [f"roll[{i}]" for i in (1, 2, 3)]
 FORCE = [f"pair_force[{i}]" for i in (1, 2, 3)]
+#: The flank fields written per stage: pinion (``field``) and, for wear, the gear (``gear_field``).
 
 
 @dataclass(frozen=True)
@@ -56,6 +61,7 @@ class Stage:
     field: np.ndarray                   # (n,) pitting density or wear depth [m]
     truncation_error: dict[str, float]
     vibration: dict[str, np.ndarray] = field(default_factory=dict)   # snippet per channel
+    gear_field: np.ndarray | None = None   # (n,) wear depth of the gear flank [m] (wear runs)
 
 
 @dataclass(frozen=True)
@@ -82,12 +88,12 @@ class DegradationRun:
 
 
 def _model(spec: dict[str, Any]):
-    from twin.degradation import ArchardWear, FatiguePitting
+    from twin.degradation import FatiguePitting, FlankWear
     coeffs = dict(spec.get("coefficients", {}))
     try:
         if spec["model"] == "pitting":
             return FatiguePitting(**coeffs)
-        return ArchardWear(**coeffs)
+        return FlankWear(**coeffs)
     except TypeError as exc:
         raise ScenarioError([("<scenario>", "degradation.coefficients", str(exc))]) from None
 
@@ -133,7 +139,8 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
     """Run the scenario's degradation block; write the stages to ``output`` (HDF5) if given."""
     from twin import _interrupt
     from twin._atomic import partial_path
-    from twin.degradation import GearPair, MeshLoad, mesh_parameters, project_wear
+    from twin.degradation import GearPair, MeshLoad, TransmittedLoad, mesh_parameters
+    from twin.degradation.pitting_map import ToothScatter, pitting_parameters
     from twin.plausibility import check_block, check_parameters
 
     spec = scenario.degradation
@@ -164,9 +171,12 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
         geometry_values.update(fmu.structural_values())       # the tooth counts are built in
         geometry_values.update({k: v for k, v in scenario.parameters.items() if "[" not in k})
         geometry = GearPair.from_parameters(geometry_values)
+        n_nodes = int(fmu.structural_values().get("n_profile", 11))
         k_healthy = tuple(scenario.parameters.get(f"k_pair[{i}]", fmu.variable(f"k_pair[{i}]").start)
-                          for i in range(1, 12))
+                          for i in range(1, n_nodes + 1))
         state = model.initial_state(geometry)
+        scatter = ToothScatter.draw(geometry.z1, float(spec.get("tooth_scatter", DEFAULT_TOOTH_SCATTER)),
+                                    scenario.seed) if model_name == "pitting" else None
         source = next((p for p in (partial, path) if p is not None and p.exists()), None) if resume else None
         if source is not None:     # the partial output, else a complete one to extend (a later stop)
             stages, state = _load_for_resume(source, model, model_name, geometry, identity)
@@ -177,6 +187,9 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
         params = dict(scenario.parameters)
         if stages:
             params.update(stages[-1].parameters)
+        if model_name == "wear" and not stages and (np.any(state.pinion_form > 0) or np.any(state.gear_form > 0)):
+            # the flanks' form deviation is in the mesh from the first record on
+            params.update(mesh_parameters(geometry, wear=state, k_pair_healthy=k_healthy, n_nodes=n_nodes).parameters)
         from twin.operating import consistent_start
         start = consistent_start(params, inputs, [v.name for v in fmu.parameters])
         check_parameters(fmu, start)
@@ -188,12 +201,16 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
             for u in range(len(stages), max_updates):
                 _interrupt.check()
                 t = fmu.time
-                names = [*ROLL, *FORCE, "motor_speed"]
+                names = [*ROLL, *FORCE, "motor_speed", "mesh_force"]
                 block = fmu.capture(t + window, dt, names)
                 check_block(names, block, {}, t0=t + dt, dt=dt, load=inputs.get("load_torque"),
                             contact=block[:, 3:6].sum(axis=1))
-                load = MeshLoad.from_samples(block[:, 0:3], block[:, 3:6])
                 omega1 = float(np.mean(block[:, 6]))
+                force = _mean_force(block[:, 7], t)
+                if model_name == "wear":
+                    load = TransmittedLoad(force)
+                else:
+                    load = MeshLoad.from_samples(block[:, 0:3], block[:, 3:6])
                 vib = {}
                 if rec_dur > 0:
                     snip = fmu.capture(fmu.time + rec_dur, dt, list(channels))
@@ -201,11 +218,16 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
                                 t0=fmu.time - rec_dur, dt=dt)
                     vib = {c: snip[:, j].astype(np.float32) for j, c in enumerate(channels)}
                 damage, dmax, xi, fld = _damage(model_name, state)
-                current = {f"k_pair[{i}]": fmu.get(f"k_pair[{i}]") for i in range(1, 12)}
-                current.update({f"profile_deviation[{i}]": fmu.get(f"profile_deviation[{i}]") for i in range(1, 12)})
+                current = {f"k_pair[{i}]": fmu.get(f"k_pair[{i}]") for i in range(1, n_nodes + 1)}
+                current.update({f"profile_deviation[{i}]": fmu.get(f"profile_deviation[{i}]")
+                                for i in range(1, n_nodes + 1)})
+                if model_name == "pitting":
+                    current.update({f"tooth_stiffness_factor[{j}]": fmu.get(f"tooth_stiffness_factor[{j}]")
+                                    for j in range(1, geometry.z1 + 1)})
                 trunc = stages[-1].truncation_error if stages else {}
+                gear = np.asarray(state.gear_depth) if model_name == "wear" else None
                 stages.append(Stage(u, float(state.cycles), damage, dmax, current, np.asarray(xi), np.asarray(fld),
-                                    trunc, vib))
+                                    trunc, vib, gear))
                 bar.update(1)
                 if partial is not None:
                     _write(partial, scenario, model_name, stages, dt, complete=False, state=state, identity=identity)
@@ -217,13 +239,15 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
                 if stop_cycles is not None:
                     dn = min(dn, max(stop_cycles - state.cycles, 1.0))
                 state = model.advance(state, load, dn, omega1)
-                update = mesh_parameters(geometry, wear=state if model_name == "wear" else None,
-                                         pitting=state if model_name == "pitting" else None,
-                                         k_pair_healthy=k_healthy)
                 if model_name == "wear":
-                    state = project_wear(state)
-                fmu.set(update.parameters)
-                stages[-1] = Stage(**{**stages[-1].__dict__, "truncation_error": dict(update.truncation_error)})
+                    update = mesh_parameters(geometry, wear=state, k_pair_healthy=k_healthy, n_nodes=n_nodes)
+                    new, trunc_error = update.parameters, dict(update.truncation_error)
+                else:
+                    mapped = pitting_parameters(geometry, state, force, k_healthy, scatter=scatter,
+                                                weibull_slope=model.m)
+                    new, trunc_error = mapped.parameters, {"k_pair": mapped.truncation_error}
+                fmu.set(new)
+                stages[-1] = Stage(**{**stages[-1].__dict__, "truncation_error": trunc_error})
             else:
                 complete = not spec.get("stop")
         except KeyboardInterrupt:
@@ -238,6 +262,15 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
         else:
             _write(partial, scenario, model_name, stages, dt, complete=False, state=None, identity=identity)
     return run
+
+
+def _mean_force(mesh_force: np.ndarray, t: float) -> float:
+    """Mean transmitted force of a co-simulated window [N] (> 0, or the run cannot wear)."""
+    force = float(np.mean(mesh_force))
+    if not (np.isfinite(force) and force > 0):
+        raise SimulationError(f"the mesh transmitted no force on average ({force!r} N) in the window "
+                              f"starting at t = {t:.4g} s; the gears are not in contact", time=t)
+    return force
 
 
 def _write(path: Path, scenario: Scenario, model_name: str, stages: list[Stage], dt: float, *, complete: bool,
@@ -267,6 +300,8 @@ def _write(path: Path, scenario: Scenario, model_name: str, stages: list[Stage],
                 sg.attrs["truncation_error"] = json.dumps(s.truncation_error)
                 sg.create_dataset("field_xi", data=s.field_xi)
                 sg.create_dataset("field", data=s.field)
+                if s.gear_field is not None:
+                    sg.create_dataset("gear_field", data=s.gear_field)
                 for c, v in s.vibration.items():
                     sg.create_dataset(f"vibration/{c}", data=v, compression="gzip", compression_opts=4)
 
@@ -286,9 +321,11 @@ def _load_for_resume(path: Path, model, model_name: str, geometry, identity: str
             for key in f["stages"]:
                 sg = f["stages"][key]
                 vib = {c: sg["vibration"][c][:] for c in sg.get("vibration", {})}
+                gear = sg["gear_field"][:] if "gear_field" in sg else None
                 stages.append(Stage(int(key), float(sg.attrs["cycles"]), float(sg.attrs["damage"]),
                                     float(np.max(sg["field"][:])), json.loads(sg.attrs["parameters"]),
-                                    sg["field_xi"][:], sg["field"][:], json.loads(sg.attrs["truncation_error"]), vib))
+                                    sg["field_xi"][:], sg["field"][:], json.loads(sg.attrs["truncation_error"]), vib,
+                                    gear))
     except ResumeError:
         raise
     except (OSError, KeyError, ValueError, TypeError) as exc:
@@ -298,5 +335,10 @@ def _load_for_resume(path: Path, model, model_name: str, geometry, identity: str
         raise ResumeError(f"cannot resume from '{path}': it holds no stage")
     last = stages[-1]
     state = model.state_from_field(geometry, last.cycles, last.field_xi, last.field)
+    if last.gear_field is not None:
+        from twin.degradation import WearState
+        fresh = model.initial_state(geometry, len(last.field_xi))
+        state = WearState(state.cycles, state.xi, state.depth, geometry, last.gear_field,
+                          fresh.pinion_form, fresh.gear_form)
     # the last stage is re-run from its state so its update is applied again
     return stages[:-1], state

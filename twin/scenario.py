@@ -160,6 +160,8 @@ SCHEMA: dict[str, Any] = {
                 "max_updates": {"type": "integer", "minimum": 1},
                 "load_window": {**_POS, "description": "s of co-simulation sampled to estimate the mesh load at each update"},
                 "record_duration": {**_NONNEG, "description": "s of vibration stored at each update (0 = none)"},
+                "tooth_scatter": {**_NONNEG, "description": "pitting: log-sd of the per-tooth pitting strength "
+                                                           "factors (seeded by 'seed'; default 0.2, 0 = teeth alike)"},
             },
         },
         "archive": {

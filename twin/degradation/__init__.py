@@ -13,14 +13,18 @@ Typical loop (the orchestrator owns the FMU)::
 from twin.degradation.archard import DEFAULT_WEAR_COEFFICIENT, ArchardWear
 from twin.degradation.base import DegradationModel, PittingState, WearState, flank_mean
 from twin.degradation.geometry import GearPair
-from twin.degradation.load import MeshLoad
-from twin.degradation.mapping import HEALTHY_K_PAIR, MeshUpdate, mesh_parameters, project_on_nodes, project_wear
+from twin.degradation.load import MeshLoad, TransmittedLoad
+from twin.degradation.ltca import FlankDamage, LoadedContact
+from twin.degradation.wear import FlankWear
+from twin.degradation.mapping import (HEALTHY_K_PAIR, MeshUpdate, mesh_parameters, project_on_nodes, project_wear,
+                                      wear_deviation)
 from twin.degradation.pitting import (DEFAULT_DEPTH_EXPONENT, DEFAULT_PITTING_COEFFICIENT, DEFAULT_STRESS_EXPONENT,
                                       DEFAULT_WEIBULL_SLOPE, FatiguePitting)
 
 __all__ = [
     "ArchardWear", "DEFAULT_DEPTH_EXPONENT", "DEFAULT_PITTING_COEFFICIENT", "DEFAULT_STRESS_EXPONENT",
-    "DEFAULT_WEAR_COEFFICIENT", "DEFAULT_WEIBULL_SLOPE", "DegradationModel", "FatiguePitting", "GearPair",
-    "HEALTHY_K_PAIR", "MeshLoad", "MeshUpdate", "PittingState", "WearState", "flank_mean", "mesh_parameters",
-    "project_on_nodes", "project_wear",
+    "DEFAULT_WEAR_COEFFICIENT", "DEFAULT_WEIBULL_SLOPE", "DegradationModel", "FatiguePitting", "FlankDamage",
+    "FlankWear", "GearPair", "HEALTHY_K_PAIR", "LoadedContact", "MeshLoad", "MeshUpdate", "PittingState",
+    "TransmittedLoad", "WearState", "flank_mean", "mesh_parameters", "project_on_nodes", "project_wear",
+    "wear_deviation",
 ]

@@ -22,7 +22,7 @@ from typing import ClassVar
 import numpy as np
 
 from twin.degradation.geometry import GearPair
-from twin.degradation.load import MeshLoad
+from twin.degradation.load import MeshLoad, TransmittedLoad
 from twin.errors import ParameterError
 
 _COVER_TOL = 1e-9
@@ -69,35 +69,66 @@ def _check_cycles(name: str, cycles, allow_zero: bool) -> float:
 
 @dataclass(frozen=True, eq=False)
 class WearState:
-    """Abrasive wear of the pinion flank.
+    """Abrasive wear of the pinion flank and of the gear flank it meshes with.
 
     Attributes
     ----------
     cycles : float
         Pinion revolutions run so far.
     xi : (n,) float array
-        Roll positions of the flank points, 0 .. 1.
+        Roll positions of the flank points, 0 .. 1: the pinion (gear) flank point at xi is the
+        one in contact when the pair is at xi.
     depth : (n,) float array
-        Wear depth [m] normal to the flank (= along the line of action), >= 0.
+        Wear depth of the pinion flank [m] normal to the flank (= along the line of action), >= 0.
     geometry : GearPair
         The gear pair the grid refers to.
+    gear_depth : (n,) float array, optional
+        Wear depth of the gear flank [m] at the same roll positions (zeros when not given).
+    pinion_form, gear_form : (n,) float arrays, optional
+        The as-manufactured profile form deviation of each flank: material standing proud of the
+        involute [m] (>= 0, zeros when not given).  The flank surface lies at ``form - depth``
+        from the involute; running-in wears the proud parts first.
     """
 
     cycles: float
     xi: np.ndarray
     depth: np.ndarray
     geometry: GearPair
+    gear_depth: np.ndarray | None = None
+    pinion_form: np.ndarray | None = None
+    gear_form: np.ndarray | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "cycles", _check_cycles("WearState.cycles", self.cycles, allow_zero=True))
         xi, depth = _check_grid("WearState", self.xi, self.depth, 0.0, math.inf)
         object.__setattr__(self, "xi", xi)
         object.__setattr__(self, "depth", depth)
+        for name in ("gear_depth", "pinion_form", "gear_form"):
+            value = np.zeros(xi.shape) if getattr(self, name) is None else getattr(self, name)
+            _, value = _check_grid(f"WearState.{name}", xi, value, 0.0, math.inf)
+            object.__setattr__(self, name, value)
+
+    def with_depths(self, cycles: float, depth: np.ndarray, gear_depth: np.ndarray) -> "WearState":
+        """The same flanks (grid, form) after ``cycles`` revolutions with new depths."""
+        return WearState(cycles, self.xi, depth, self.geometry, gear_depth, self.pinion_form, self.gear_form)
+
+    def deviations(self) -> tuple[np.ndarray, np.ndarray]:
+        """Material missing from each flank relative to its most proud point [m], (n,) each:
+        ``depth - form + max(form)`` (>= 0; a constant is backlash)."""
+        return (self.depth - self.pinion_form + self.pinion_form.max(),
+                self.gear_depth - self.gear_form + self.gear_form.max())
 
     @classmethod
     def pristine(cls, geometry: GearPair, n_grid: int) -> "WearState":
-        """Unworn flank on ``n_grid`` equally spaced roll positions."""
-        return cls(0.0, np.linspace(0.0, 1.0, n_grid), np.zeros(n_grid), geometry)
+        """Unworn flanks on ``n_grid`` equally spaced roll positions."""
+        return cls(0.0, np.linspace(0.0, 1.0, n_grid), np.zeros(n_grid), geometry, np.zeros(n_grid))
+
+    @property
+    def gear_mean_depth(self) -> float:
+        """Mean wear depth over the active gear flank [m], weighted by its involute arc length."""
+        g = self.geometry
+        u2 = g.rho2(self.xi) ** 2 / (2.0 * g.base_radius_gear)
+        return float(np.trapezoid(self.gear_depth, u2) / (u2[-1] - u2[0]))
 
     @property
     def damage(self) -> np.ndarray:
@@ -171,6 +202,8 @@ class DegradationModel(ABC):
     """
 
     state_type: ClassVar[type]
+    #: True for models that compute the load along the path themselves (from the transmitted force).
+    accepts_transmitted_load: ClassVar[bool] = False
 
     def initial_state(self, geometry: GearPair, n_grid: int = 101):
         """Undamaged state on ``n_grid`` equally spaced roll positions in [0, 1]."""
@@ -206,9 +239,13 @@ class DegradationModel(ABC):
         if not isinstance(state, self.state_type):
             raise ParameterError(f"{type(self).__name__} advances a {self.state_type.__name__}, "
                                  f"got {type(state).__name__}")
-        if not isinstance(load, MeshLoad):
-            raise ParameterError(f"load must be a MeshLoad, got {type(load).__name__}")
-        if not load.covers_path:
+        if isinstance(load, TransmittedLoad):
+            if not self.accepts_transmitted_load:
+                raise ParameterError(f"{type(self).__name__} needs the load along the path (a MeshLoad), "
+                                     "not only the transmitted force")
+        elif not isinstance(load, MeshLoad):
+            raise ParameterError(f"load must be a MeshLoad or a TransmittedLoad, got {type(load).__name__}")
+        elif not load.covers_path:
             raise ParameterError(f"load grid must cover the path of contact [0, 1], got "
                                  f"[{load.xi[0]!r}, {load.xi[-1]!r}]")
         n = _check_cycles("cycles", cycles, allow_zero=False)

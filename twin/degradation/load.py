@@ -29,6 +29,20 @@ from twin.errors import ParameterError
 _COVER_TOL = 1e-9
 
 
+@dataclass(frozen=True)
+class TransmittedLoad:
+    """The normal force the mesh transmits, F = T1 / rb1 [N] (> 0), for models that share it
+    among the tooth pairs themselves by a loaded tooth contact analysis."""
+
+    force: float
+
+    def __post_init__(self):
+        ok = isinstance(self.force, (int, float, np.floating)) and math.isfinite(float(self.force))
+        if not (ok and float(self.force) > 0):
+            raise ParameterError(f"transmitted force must be a finite number > 0 N, got {self.force!r}")
+        object.__setattr__(self, "force", float(self.force))
+
+
 @dataclass(frozen=True, eq=False)
 class MeshLoad:
     """Pair force along the path of contact.

@@ -32,7 +32,10 @@ from twin.degradation.base import PittingState, WearState
 from twin.degradation.geometry import GearPair
 from twin.errors import ParameterError
 
-__all__ = ["HEALTHY_K_PAIR", "MeshUpdate", "mesh_parameters", "project_on_nodes", "project_wear"]
+__all__ = ["HEALTHY_K_PAIR", "MeshUpdate", "mesh_parameters", "project_on_nodes", "project_wear", "wear_deviation"]
+
+#: Roll positions the worn pair's separation is evaluated at before it is fitted on the nodes.
+_SEPARATION_GRID = 201
 
 
 @dataclass(frozen=True)
@@ -136,10 +139,12 @@ def mesh_parameters(geometry: GearPair, *, wear: WearState | None = None, pittin
         loss_nodes, _ = project_on_nodes(pitting.xi, k_local_healthy * pitting.density, n_nodes)
         k_nodes = healthy - np.minimum(loss_nodes, healthy)
         k_err = float(np.max(np.abs(interp_nodes(k_nodes, pitting.xi) - k_field) / k_local_healthy))
-    if wear is None or not np.any(wear.depth > 0):
+    if wear is None or not (np.any(wear.depth > 0) or np.any(wear.gear_depth > 0)
+                            or np.any(wear.pinion_form > 0) or np.any(wear.gear_form > 0)):
         e_nodes, e_err = np.zeros(n_nodes), 0.0
     else:
-        e_nodes, e_err = project_on_nodes(wear.xi, wear.depth, n_nodes)
+        xi, separation = wear_deviation(geometry, wear)
+        e_nodes, e_err = project_on_nodes(xi, separation, n_nodes)
 
     for i, value in enumerate(k_nodes, start=1):
         params[f"k_pair[{i}]"] = float(value)
@@ -148,6 +153,23 @@ def mesh_parameters(geometry: GearPair, *, wear: WearState | None = None, pittin
     errors["k_pair"] = k_err
     errors["profile_deviation"] = e_err
     return MeshUpdate(params, errors)
+
+
+def wear_deviation(geometry: GearPair, wear: WearState, n_grid: int = _SEPARATION_GRID
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """The pair's no-load separation along the path of contact [m], from both worn flanks.
+
+    At roll xi the flanks touch where ``h1 + h2 + x^2 / (2 R)`` is least over the tangent
+    distance x from the involute contact point (conjugate action of the worn profiles,
+    :meth:`twin.degradation.ltca.LoadedContact.separation`): a narrow groove narrower than the
+    mating flank's curvature bridges is not seen, uniform thinning of both flanks is a constant
+    (backlash).  Returns ``(xi, separation)``, (n_grid,) each.
+    """
+    from twin.degradation.ltca import FlankDamage, contact_for
+    xi = np.linspace(0.0, 1.0, n_grid)
+    d1, d2 = wear.deviations()
+    damage = FlankDamage.of(wear.xi, pinion_depth=d1, gear_depth=d2)
+    return xi, contact_for(geometry).separation(xi, damage)
 
 
 def project_wear(wear: WearState, n_nodes: int = 11) -> WearState:

@@ -114,11 +114,11 @@ def scenario_speed_hz(scenario) -> float:
 
 
 def _degradation_model(scenario):
-    from twin.degradation import ArchardWear, FatiguePitting
+    from twin.degradation import FatiguePitting, FlankWear
     spec = scenario.degradation
     coeffs = dict(spec.get("coefficients", {}))
     try:
-        return FatiguePitting(**coeffs) if spec["model"] == "pitting" else ArchardWear(**coeffs)
+        return FatiguePitting(**coeffs) if spec["model"] == "pitting" else FlankWear(**coeffs)
     except TypeError as exc:
         raise ScenarioError([(str(scenario.source), "degradation.coefficients", str(exc))]) from None
 
@@ -162,14 +162,17 @@ def trajectory_from_scenario(scenario, *, method: str = "cosim", reach: float | 
         raise RULError(f"trajectory method must be 'static' or 'cosim', got {method!r}")
 
     from twin._progress import progress_bar
-    from twin.degradation import GearPair, MeshLoad, WearState, mesh_parameters, project_wear
+    from twin.degradation import GearPair, MeshLoad, TransmittedLoad
+    from twin.degradation.pitting_map import ToothScatter, pitting_parameters
     model = _degradation_model(scenario)
     geometry = GearPair.from_parameters({**{k: v for k, v in scenario.parameters.items() if "[" not in k},
                                          **scenario.structural})
     torque_pinion = _nominal(scenario, "load_torque", 20.0) * geometry.z1 / geometry.z2
     omega1 = 2 * math.pi * scenario_speed_hz(scenario)
     params = {k: v for k, v in scenario.parameters.items() if "[" in k or k == "mesh_stiffness_scale"}
-    k_healthy = tuple(params.get(f"k_pair[{i}]", h) for i, h in enumerate(_healthy_k(), start=1))
+    healthy = _healthy_k(scenario, geometry)
+    k_healthy = tuple(params.get(f"k_pair[{i}]", h) for i, h in enumerate(healthy, start=1))
+    params.update({f"k_pair[{i}]": k for i, k in enumerate(k_healthy, start=1)})
     stop = spec.get("stop", {})
     crit = stop.get("pitting_density" if kind == "pitting_density" else "wear_depth", 0.0)
     last_stage = float(scenario.archive["stages"][-1]) if scenario.archive else 0.0
@@ -185,36 +188,35 @@ def trajectory_from_scenario(scenario, *, method: str = "cosim", reach: float | 
     state = model.initial_state(geometry)
     cycles, damage = [0.0], [0.0]
     measure = (lambda s: float(s.pitting_density)) if kind == "pitting_density" else (lambda s: float(s.mean_depth))
+    force = torque_pinion / geometry.base_radius_pinion
     bar = progress_bar(max_updates, progress, f"{scenario.name} trajectory", "update")
     try:
         for _ in range(max_updates):
-            try:
-                load = MeshLoad.static(geometry, torque_pinion, parameters=params)
-            except ParameterError:
-                break                                 # a node lost all stiffness: the tooth has failed
             if kind == "wear_depth":
-                # Archard under a frozen load is linear in cycles: one evaluation of the rate gives
-                # the jump and every sub-step exactly (cycles_for_increment would take three).
-                rate = model.depth_per_cycle(geometry, state.xi, load)
-                dn = dn_cap if rate.max() <= 0 else min(dn_cap, max_inc / float(rate.max()))
+                # Archard under a frozen load is linear in cycles: one LTCA gives the jump and every
+                # sub-step exactly.  The load sharing comes from the LTCA of the worn flanks.
+                d1, d2 = model.depth_per_cycle(state, TransmittedLoad(force))
+                peak = max(float(d1.max()), float(d2.max()))
+                dn = dn_cap if peak <= 0 else min(dn_cap, max_inc / peak)
                 start = state
                 for j in range(1, substeps + 1):
-                    state = WearState(start.cycles + dn * j / substeps, start.xi,
-                                      start.depth + rate * (dn * j / substeps), geometry)
+                    f = dn * j / substeps
+                    state = start.with_depths(start.cycles + f, start.depth + d1 * f, start.gear_depth + d2 * f)
                     cycles.append(float(state.cycles))
                     damage.append(measure(state))
             else:
+                try:
+                    load = MeshLoad.static(geometry, torque_pinion, parameters=params)
+                except ParameterError:
+                    break                             # a node lost all stiffness: the tooth has failed
                 dn = min(dn_cap, model.cycles_for_increment(state, load, omega1, max_inc, max_cycles=dn_cap))
                 for _ in range(substeps):
                     state = model.advance(state, load, dn / substeps, omega1)
                     cycles.append(float(state.cycles))
                     damage.append(measure(state))
-            update = mesh_parameters(geometry, wear=state if kind == "wear_depth" else None,
-                                     pitting=state if kind == "pitting_density" else None,
-                                     k_pair_healthy=k_healthy)
-            params = {**params, **update.parameters}
-            if kind == "wear_depth":
-                state = project_wear(state)
+                mapped = pitting_parameters(geometry, state, force, k_healthy,
+                                            scatter=ToothScatter.draw(geometry.z1, 0.0, 0), weibull_slope=model.m)
+                params = {**params, **{k: v for k, v in mapped.parameters.items() if k.startswith("k_pair[")}}
             bar.update(1)
             if damage[-1] >= target or damage[-1] <= damage[-1 - substeps] * (1 + 1e-9):
                 break
@@ -224,8 +226,14 @@ def trajectory_from_scenario(scenario, *, method: str = "cosim", reach: float | 
                    f"quasi-static degradation model of '{scenario.name}'")
 
 
-def _healthy_k():
+def _healthy_k(scenario, geometry):
+    """The healthy k_pair nodes of the scenario's model: computed from the geometry for a variant
+    built with geometry options (as the build does), else the base model's default."""
     from twin.degradation import HEALTHY_K_PAIR
+    from twin.variants import GEOMETRY_OPTIONS
+    if any(k in GEOMETRY_OPTIONS for k in scenario.structural):
+        from twin.degradation.stiffness import k_pair_nodes
+        return tuple(k_pair_nodes(geometry, int(scenario.structural.get("n_profile", 11))))
     return HEALTHY_K_PAIR
 
 

@@ -28,12 +28,24 @@ def test_zero_damage_gives_the_healthy_parameters_exactly():
         assert update.truncation_error == {"k_pair": 0.0, "profile_deviation": 0.0}
 
 
-def test_piecewise_linear_wear_on_the_nodes_is_exact():
+def test_piecewise_linear_field_on_the_nodes_is_exact():
     node_depth = 1e-6 * np.array([40, 30, 22, 15, 8, 2, 6, 10, 14, 18, 20], dtype=float)
-    wear = WearState(1e5, XI, np.interp(XI, NODES, node_depth), GEOMETRY)
+    nodes, err = project_on_nodes(XI, np.interp(XI, NODES, node_depth), 11)
+    assert np.allclose(nodes, node_depth, rtol=0, atol=1e-15) and err < 1e-15
+
+
+def test_wear_maps_to_the_separation_of_both_worn_flanks():
+    """profile_deviation is the worn pair's least separation (conjugate action of both flanks),
+    fitted on the nodes: a gentle wear field is seen as is, pinion and gear depths add."""
+    from twin.degradation import wear_deviation
+    pinion = 1e-6 * (20 + 10 * np.cos(np.pi * XI))
+    gear = 1e-6 * (5 + 5 * XI)
+    wear = WearState(1e5, XI, pinion, GEOMETRY, gear)
+    xi, sep = wear_deviation(GEOMETRY, wear)
+    assert np.allclose(sep, np.interp(xi, XI, pinion + gear), rtol=0, atol=0.3e-6)
     update = mesh_parameters(GEOMETRY, wear=wear)
-    assert np.allclose([update.parameters[k] for k in E_KEYS], node_depth, rtol=0, atol=1e-15)
-    assert update.truncation_error["profile_deviation"] < 1e-15
+    nodes = np.array([update.parameters[k] for k in E_KEYS])
+    assert np.allclose(nodes, project_on_nodes(xi, sep, 11)[0], rtol=0, atol=1e-15)
     assert [update.parameters[k] for k in K_KEYS] == list(HEALTHY_K_PAIR)
 
 
@@ -47,12 +59,10 @@ def test_uniform_pitting_scales_the_stiffness():
 def test_truncation_error_of_a_field_between_the_nodes():
     # A wear bump narrower than a node interval: the nodes cannot follow it.
     depth = 10e-6 * np.exp(-((XI - 0.23) / 0.02) ** 2)
-    update = mesh_parameters(GEOMETRY, wear=WearState(1.0, XI, depth, GEOMETRY))
-    nodes = np.array([update.parameters[k] for k in E_KEYS])
+    nodes, err = project_on_nodes(XI, depth, 11)
     assert nodes.min() >= 0
-    fitted = np.interp(XI, NODES, nodes)
-    assert update.truncation_error["profile_deviation"] == pytest.approx(np.abs(fitted - depth).max())
-    assert 1e-6 < update.truncation_error["profile_deviation"] < 10e-6
+    assert err == pytest.approx(np.abs(np.interp(XI, NODES, nodes) - depth).max())
+    assert 1e-6 < err < 10e-6
     # The same for the stiffness, relative to the local healthy value.
     density = 0.5 * (np.abs(XI - 0.45) < 0.05)
     update = mesh_parameters(GEOMETRY, pitting=PittingState(1.0, XI, density, GEOMETRY))
@@ -80,15 +90,14 @@ def test_pitting_reduces_the_load_share_through_the_static_load():
     assert pitted.force_at(0.5) == pytest.approx(healthy.force_at(0.5))   # single-pair zone: all of it anyway
 
 
-def test_project_wear_is_the_fmu_view_and_keeps_the_volume():
+def test_project_wear_is_the_node_fit_and_keeps_the_volume():
     model = ArchardWear()
     wear = model.advance(model.initial_state(GEOMETRY), MeshLoad.static(GEOMETRY, 1.83), 1e5, 62.8)
     projected = project_wear(wear)
-    nodes = [mesh_parameters(GEOMETRY, wear=wear).parameters[k] for k in E_KEYS]
+    nodes, _ = project_on_nodes(wear.xi, wear.depth, 11)
     assert np.allclose(projected.depth, np.interp(XI, NODES, nodes), rtol=0, atol=1e-18)
     assert projected.cycles == wear.cycles and projected.geometry == wear.geometry
     assert projected.mean_depth == pytest.approx(wear.mean_depth, rel=0.02)
-    assert mesh_parameters(GEOMETRY, wear=projected).truncation_error["profile_deviation"] < 1e-12
 
 
 def test_invalid_inputs_raise_typed_errors_naming_the_value():

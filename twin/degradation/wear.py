@@ -1,0 +1,422 @@
+"""Abrasive wear of both flanks of a spur pair, driven by a loaded tooth contact analysis.
+
+Archard's law (Feng et al. Eq. 10), ``dh = K p ds`` with ``ds`` the sliding distance, on each
+flank, with the contact pressure from :class:`~twin.degradation.ltca.LoadedContact` of the
+current worn flanks at the transmitted force:
+
+* Over one mesh cycle the LTCA is solved at M phases.  At phase m the pair at roll xi carries
+  forces q_i on cells x_i (width w) of its contact; the pressure on the intact face width is
+  ``p_i = q_i / (w L (1 - D_i))``.
+* During the phase step dt = T_mesh / M the contact moves over the pinion flank by v1 dt =
+  rho1 2 pi / (z1 M) and over the gear flank by rho2 2 pi / (z2 M).  A flank point at arc u gets
+  ``p_i ds = p_i (v_s / v) l_i(u)`` where l_i(u) is the time the cell covers the point as it
+  sweeps times v (the cell convolved with the sweep, the pressure taken piecewise linear between
+  phases), v the rolling speed of that flank and v_s = |v1 - v2| the sliding speed
+  (speed-independent per pass: v_s / v).
+* Per pinion revolution every pinion flank point passes through the mesh once and every gear
+  flank point z1 / z2 times: each flank has its own cycle count.
+
+So both flanks wear where they slide under load; the worn profiles feed back through the LTCA
+(a pair whose flanks are worn more carries less load, and contact moves to where the worn
+flanks still touch).  Uniform thinning of a flank changes only the rigid approach (backlash),
+not the load sharing.
+
+**Running-in.**  A fresh flank wears faster while its roughness and the asperities of its tip
+and root edges are removed.  The local wear coefficient is
+``K (1 + (beta - 1) exp(-h / h_r))`` with h the local depth already removed: ``beta`` times the
+steady coefficient on a new surface, decaying over ``h_r`` (of the order of the roughness
+heights, a few um).  Defaults beta = 5, h_r = 2 um, the order of the running-in wear-rate
+ratios reported for steel gears (e.g. Andersson & Eriksson 1990; Flodin & Andersson 1997 use a
+steady coefficient after a run-in).  The tip/root relief that running-in produces comes out of
+the load distribution itself: the ends of the path of contact slide most.
+
+Not modelled: tip-edge contact (contact is sought on the active flanks only), the thinning of
+the tooth body by wear (the tooth-body compliance stays that of the new tooth), wear of the
+flank that does not transmit load.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from twin.degradation.archard import DEFAULT_WEAR_COEFFICIENT
+from twin.degradation.base import DegradationModel, WearState
+from twin.degradation.geometry import GearPair
+from twin.degradation.load import MeshLoad, TransmittedLoad
+from twin.degradation.ltca import FlankDamage, LoadedContact, MeshCycle
+from twin.errors import ParameterError
+
+DEFAULT_RUNNING_IN_FACTOR = 5.0
+DEFAULT_RUNNING_IN_DEPTH = 2.0e-6
+
+
+class FlankWear(DegradationModel):
+    """Archard wear of the pinion and the gear flank under the LTCA contact pressure.
+
+    Parameters
+    ----------
+    wear_coefficient : float
+        Steady dimensional wear coefficient K [m^2/N].
+    running_in_factor : float
+        beta >= 1, the coefficient of a new surface relative to K.
+    running_in_depth : float
+        h_r > 0 [m], the local depth over which the excess decays.
+    n_positions : int
+        Phases of the mesh cycle the LTCA is solved at (>= 8).
+    substep_fraction : float
+        Largest change of a pair's separation within one sub-step of a jump, as a fraction of
+        that pair's elastic approach (0 < f <= 1; see :meth:`_advance`).
+    form_deviation : float
+        Peak-to-valley of the as-manufactured profile form deviation of each flank [m]
+        (ISO 1328-1 f_f_alpha; :func:`iso1328_profile_form`); 0 for perfect involutes.
+    form_seed : int
+        Seed of the form deviation's shape (:func:`profile_form`).
+    """
+
+    state_type = WearState
+    accepts_transmitted_load = True
+
+    def __init__(self, wear_coefficient: float = DEFAULT_WEAR_COEFFICIENT, *,
+                 running_in_factor: float = DEFAULT_RUNNING_IN_FACTOR,
+                 running_in_depth: float = DEFAULT_RUNNING_IN_DEPTH, n_positions: int = 48,
+                 substep_fraction: float = 0.25, form_deviation: float = 0.0, form_seed: int = 0):
+        for name, value, lo in (("wear_coefficient", wear_coefficient, 0.0), ("running_in_depth", running_in_depth, 0.0)):
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > lo):
+                raise ParameterError(f"{name} must be a finite number > 0, got {value!r}")
+        if not (isinstance(running_in_factor, (int, float)) and math.isfinite(running_in_factor)
+                and running_in_factor >= 1):
+            raise ParameterError(f"running_in_factor must be a finite number >= 1, got {running_in_factor!r}")
+        if not (isinstance(n_positions, (int, np.integer)) and n_positions >= 8):
+            raise ParameterError(f"n_positions must be an integer >= 8, got {n_positions!r}")
+        if not (isinstance(substep_fraction, (int, float)) and 0 < substep_fraction <= 1):
+            raise ParameterError(f"substep_fraction must be a number in (0, 1], got {substep_fraction!r}")
+        self.wear_coefficient = float(wear_coefficient)
+        self.running_in_factor = float(running_in_factor)
+        self.running_in_depth = float(running_in_depth)
+        self.n_positions = int(n_positions)
+        self.substep_fraction = float(substep_fraction)
+        if not (isinstance(form_deviation, (int, float)) and math.isfinite(form_deviation) and form_deviation >= 0):
+            raise ParameterError(f"form_deviation must be a finite number >= 0 m, got {form_deviation!r}")
+        self.form_deviation = float(form_deviation)
+        self.form_seed = int(form_seed)
+        self._contact: dict[GearPair, LoadedContact] = {}
+        # (state, force, sweep): sizing a jump and taking it share one LTCA (states are immutable:
+        # the cache holds the state object itself)
+        self._last: tuple | None = None
+        self._calls = 0
+
+    def __repr__(self) -> str:
+        return (f"FlankWear(wear_coefficient={self.wear_coefficient!r}, running_in_factor="
+                f"{self.running_in_factor!r}, running_in_depth={self.running_in_depth!r}, "
+                f"n_positions={self.n_positions!r}, substep_fraction={self.substep_fraction!r})")
+
+    def contact(self, geometry: GearPair) -> LoadedContact:
+        """The LTCA of ``geometry`` (built once per geometry)."""
+        if geometry not in self._contact:
+            self._contact[geometry] = LoadedContact(geometry)
+        return self._contact[geometry]
+
+    @staticmethod
+    def damage(state: WearState) -> FlankDamage:
+        d1, d2 = state.deviations()
+        return FlankDamage.of(state.xi, pinion_depth=d1, gear_depth=d2)
+
+    def initial_state(self, geometry: GearPair, n_grid: int = 201):
+        """New flanks on ``n_grid`` roll positions, with the model's form deviation."""
+        state = super().initial_state(geometry, n_grid)
+        if self.form_deviation == 0:
+            return state
+        f1, f2 = profile_form(state.xi, self.form_deviation, self.form_seed)
+        return WearState(0.0, state.xi, state.depth, geometry, state.gear_depth, f1, f2)
+
+    def mesh_cycle(self, state: WearState, force: float) -> MeshCycle:
+        """LTCA of the state's worn flanks over one mesh cycle at ``force`` [N].
+
+        The phases sampled shift by the golden ratio of a step from one evaluation to the next
+        (deterministic), so that successive jumps do not sample the same mesh positions and
+        leave no ripple at the sampling period in the accumulated wear."""
+        self._calls += 1
+        offset = (0.5 + 0.6180339887498949 * self._calls) % 1.0
+        return self.contact(state.geometry).mesh_cycle(force, self.damage(state), n_positions=self.n_positions,
+                                                       offset=offset)
+
+    def sweep(self, state: WearState, load) -> "_Sweep":
+        """The mesh cycle's contacts of ``state`` at the load, resolved per pair and phase."""
+        force = _force(load, state.geometry)
+        if self._last is not None and self._last[0] is state and self._last[1] == force:
+            return self._last[2]
+        result = _Sweep.of(state, self.mesh_cycle(state, force), self.n_positions)
+        self._last = (state, force, result)
+        return result
+
+    def rates(self, state: WearState, load) -> tuple[np.ndarray, np.ndarray]:
+        """integral of p ds per pinion revolution [Pa m] of the pinion and the gear flank points,
+        (n,) each (times K: the depth removed per revolution without running-in)."""
+        sw = self.sweep(state, load)
+        return sw.d1 @ sw.f_scale, sw.d2 @ sw.f_scale
+
+    def depth_per_cycle(self, state: WearState, load) -> tuple[np.ndarray, np.ndarray]:
+        """Depth removed per pinion revolution [m] from each flank, (n,) each, at the state's
+        load sharing, with the running-in factor of each point's current depth."""
+        r1, r2 = self.rates(state, load)
+        return (self.wear_coefficient * r1 * self._running_in(state.depth),
+                self.wear_coefficient * r2 * self._running_in(state.gear_depth))
+
+    def _running_in(self, depth: np.ndarray) -> np.ndarray:
+        return 1.0 + (self.running_in_factor - 1.0) * np.exp(-depth / self.running_in_depth)
+
+    def _advance(self, state: WearState, load, cycles: float, omega1: float) -> WearState:
+        """Integrate the wear over ``cycles`` in sub-steps.
+
+        The load sharing responds to wear through the separations of the pairs: a pair worn by
+        more than its elastic approach (a fraction of a um at light load) loses its load.  A jump
+        of several um with the load frozen would overshoot and leave a saw-tooth.  So within the
+        jump the LTCA of the jump's start is kept for the pressure shape of each pair at each
+        phase, and each pair's force follows its separation by the linear pair law
+        ``F_j = k_j max(0, delta - e_j)`` (k_j the LTCA's secant stiffness of that pair, e_j its
+        separation plus the wear since the start at its contact point), re-solved per phase every
+        sub-step; a sub-step changes no separation by more than ``substep_fraction`` of the
+        smallest elastic approach.  The next jump starts from a full LTCA of the new flanks.
+        """
+        sw = self.sweep(state, load)
+        k = self.wear_coefficient
+        h1, h2 = state.depth.copy(), state.gear_depth.copy()
+        dh1, dh2 = np.zeros_like(h1), np.zeros_like(h2)
+        done = 0.0
+        for _ in range(100000):
+            if done >= cycles * (1 - 1e-12):
+                break
+            e = sw.e0 + np.interp(sw.xi1, state.xi, dh1) + np.interp(sw.xi2, state.xi, dh2)
+            f = sw.forces(e)
+            r1 = k * (sw.d1 @ (f * sw.inv_ref)) * self._running_in(h1 + dh1)
+            r2 = k * (sw.d2 @ (f * sw.inv_ref)) * self._running_in(h2 + dh2)
+            # the separation of a pair grows with the wear at its contact points
+            growth = np.interp(sw.xi1, state.xi, r1) + np.interp(sw.xi2, state.xi, r2)
+            peak = float(np.max(growth[sw.in_path], initial=0.0))
+            step = cycles - done
+            if peak > 0:
+                step = min(step, self.substep_fraction * sw.approach_scale / peak)
+            dh1 += r1 * step
+            dh2 += r2 * step
+            done += step
+        return state.with_depths(state.cycles + cycles, h1 + dh1, h2 + dh2)
+
+    def cycles_for_increment(self, state, load, omega1: float, max_increment: float, *,
+                             max_cycles: float = 1e10, rtol: float = 1e-3) -> float:
+        """Cycles after which the local depth increment of either flank reaches ``max_increment``
+        [m] at its 90th percentile over the flank, from the rates at the start.  (The percentile,
+        not the maximum: a few points just touched at the ends of the path, still at their
+        running-in rate, would otherwise set every jump; the sub-steps keep the load sharing
+        stable whatever the jump.)"""
+        if not (isinstance(max_increment, (int, float)) and math.isfinite(max_increment) and max_increment > 0):
+            raise ParameterError(f"max_increment must be a finite number > 0, got {max_increment!r}")
+        d1, d2 = self.depth_per_cycle(state, load)
+        peak = max(float(np.percentile(d1, 90)), float(np.percentile(d2, 90)))
+        return max_cycles if peak <= 0 else min(max_cycles, max_increment / peak)
+
+
+def iso1328_profile_form(module: float, diameter: float, quality: int) -> float:
+    """Profile form tolerance f_f_alpha [m] of ISO 1328-1:1995 for a quality class (3..12):
+    (2.5 sqrt(m) + 0.17 sqrt(d) + 0.5) um for class 5 (m, d in mm), times sqrt(2) per class."""
+    if not (isinstance(quality, (int, np.integer)) and 1 <= quality <= 12):
+        raise ParameterError(f"quality must be an ISO 1328 class 1..12, got {quality!r}")
+    m, d = module * 1e3, diameter * 1e3
+    return (2.5 * math.sqrt(m) + 0.17 * math.sqrt(d) + 0.5) * 2.0 ** ((quality - 5) / 2) * 1e-6
+
+
+def profile_form(xi: np.ndarray, peak_to_valley: float, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """Seeded form deviations of the pinion and the gear flank (material proud of the involute,
+    >= 0, peak-to-valley ``peak_to_valley`` each): a waviness of 1 to 4 cycles over the active
+    profile with amplitudes falling as 1/k, as a hobbed or ground flank's form chart shows."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for _ in range(2):
+        f = np.zeros(xi.shape)
+        for k in range(1, 5):
+            f += rng.standard_normal() / k * np.cos(math.pi * k * xi + rng.uniform(0, 2 * math.pi))
+        f -= f.min()
+        out.append(f * (peak_to_valley / f.max()) if f.max() > 0 else f)
+    return out[0], out[1]
+
+
+def _force(load, geometry: GearPair) -> float:
+    if isinstance(load, TransmittedLoad):
+        return load.force
+    if isinstance(load, MeshLoad):
+        # the single-pair zone carries the whole force: the largest pair force is the transmitted one
+        return float(load.force.max())
+    raise ParameterError(f"load must be a TransmittedLoad or a MeshLoad, got {type(load).__name__}")
+
+
+class _Sweep:
+    """The contacts of one mesh cycle, one column per (phase, pair): pressure deposits on both
+    flanks (at the pair's LTCA force, or per newton for a pair out of load), the pair's
+    separation, contact point, secant stiffness, and the pair law to redistribute the force."""
+
+    def __init__(self, d1, d2, f0, inv_ref, e0, xi1, xi2, stiffness, phase_of, n_phases, force, approach_scale,
+                 in_path):
+        self.d1, self.d2 = d1, d2                       # (n, J) deposits [Pa m per revolution / N of ref]
+        self.f_scale = f0 * inv_ref                     # (J,) 1 for loaded items, 0 for the others
+        self.inv_ref = inv_ref                          # (J,) 1 / reference force of the deposit
+        self.e0, self.xi1, self.xi2 = e0, xi1, xi2      # (J,) separation [m], flank points of the contact
+        self.stiffness = stiffness                      # (J,) N/m
+        self.phase_of = phase_of                        # (J,) phase index
+        self.n_phases = n_phases
+        self.force = force
+        self.approach_scale = approach_scale            # smallest elastic approach of a loaded pair [m]
+        self.in_path = in_path
+
+    def forces(self, e: np.ndarray) -> np.ndarray:
+        """Pair forces [N], (J,), for separations e: per phase, sum_j k_j max(0, delta - e_j) = F."""
+        from twin.degradation.load import _approach
+        table = self._table
+        valid = table >= 0
+        k = np.where(valid, self.stiffness[np.maximum(table, 0)], 0.0)
+        ee = np.where(valid, e[np.maximum(table, 0)], np.inf)
+        delta = _approach(k, ee, self.force, np.arange(table.shape[0], dtype=float))
+        f = k * np.maximum(0.0, delta[:, None] - np.where(valid, ee, 0.0))
+        out = np.zeros(e.size)
+        out[table[valid]] = f[valid]
+        return out
+
+    @property
+    def _table(self) -> np.ndarray:
+        """(phases, slots) item index of each pair at each phase, -1 where none."""
+        if self.__dict__.get("_table_cache") is None:
+            width = int(np.max(np.bincount(self.phase_of, minlength=self.n_phases)))
+            table = -np.ones((self.n_phases, width), dtype=int)
+            fill = np.zeros(self.n_phases, dtype=int)
+            for j, m in enumerate(self.phase_of):
+                table[m, fill[m]] = j
+                fill[m] += 1
+            self.__dict__["_table_cache"] = table
+        return self.__dict__["_table_cache"]
+
+    @classmethod
+    def of(cls, state: WearState, cycle: MeshCycle, n_positions: int) -> "_Sweep":
+        g = state.geometry
+        xi = state.xi
+        rb1, rb2 = g.base_radius_pinion, g.base_radius_gear
+        s = g.contact_start + xi * g.path_of_contact_length
+        u1 = s ** 2 / (2 * rb1)
+        u2 = (g.line_of_action_length - s) ** 2 / (2 * rb2)
+        contact = None
+        cells = {"c1": [], "c2": [], "a": [], "s1": [], "s2": [], "w1": [], "w2": [], "item": []}
+        f0, ref, e0, xi1, xi2, kk, phase, loaded_flag = [], [], [], [], [], [], [], []
+        approach = []
+        j = 0
+        for m, pos in enumerate(cycle.positions):
+            for pair in pos.pairs:
+                xc = pair.xi
+                rho1 = g.contact_start + xc * g.path_of_contact_length
+                rho2 = g.line_of_action_length - rho1
+                slide = abs(rho1 - rho2 * g.z1 / g.z2)                   # v_s / omega1
+                loaded = pair.force > 0
+                total = pair.total
+                if total > 0:
+                    x, q = pair.x[loaded], pair.force[loaded]
+                    width = pair.width
+                    centroid = float(np.sum(x * q) / total)
+                    reference = total
+                    # the secant stiffness is only well defined for a pair that carries a fair share
+                    lever = pos.approach - pair.separation
+                    stiffness = total / lever if total > 0.05 * cycle.force and lever > 0 else np.nan
+                    if total > 0.05 * cycle.force and lever > 0:
+                        approach.append(lever * cycle.force / total)
+                else:
+                    # out of load: a contact strip of the healthy width at the least separation,
+                    # per newton
+                    if contact is None:
+                        from twin.degradation.ltca import contact_for
+                        contact = contact_for(g)
+                    d1, d2 = state.deviations()
+                    sep, _ = contact.gap(xc, pair.x, FlankDamage.of(xi, pinion_depth=d1, gear_depth=d2))
+                    centroid = float(pair.x[int(np.argmin(sep))])
+                    width = pair.width
+                    x, q = np.array([centroid]), np.array([1.0])
+                    reference = 1.0
+                    stiffness = np.nan
+                line_pressure = q / (width * g.face_width)
+                cells["c1"].append(rho1 ** 2 / (2 * rb1) + x)
+                cells["c2"].append(rho2 ** 2 / (2 * rb2) - x)
+                cells["a"].append(np.full(x.size, width / 2))
+                cells["s1"].append(np.full(x.size, math.pi * rho1 / (g.z1 * n_positions)))
+                cells["s2"].append(np.full(x.size, math.pi * rho2 / (g.z2 * n_positions)))
+                cells["w1"].append(line_pressure * slide / rho1)                     # v_s / v1
+                cells["w2"].append(line_pressure * slide / (rho2 * g.z1 / g.z2))     # v_s / v2
+                cells["item"].append(np.full(x.size, j))
+                c_xi1, c_xi2, _ = (contact or _contact_of(g))._flank_points(xc, np.array([centroid]))
+                f0.append(total)
+                ref.append(reference)
+                e0.append(pair.separation)
+                xi1.append(float(c_xi1[0]))
+                xi2.append(float(c_xi2[0]))
+                kk.append(stiffness)
+                phase.append(m)
+                loaded_flag.append(total > 0)
+                j += 1
+        n_items = j
+        cat = {k: np.concatenate(v) if v else np.empty(0) for k, v in cells.items()}
+        item = cat["item"].astype(int)
+        d1 = np.zeros((xi.size, n_items))
+        d2 = np.zeros((xi.size, n_items))
+        if n_items:
+            o1 = _overlap(u1, cat["c1"], cat["a"], cat["s1"]) * cat["w1"][None, :]
+            o2 = _overlap(u2, cat["c2"], cat["a"], cat["s2"]) * cat["w2"][None, :] * g.z1 / g.z2
+            for col in range(n_items):
+                sel = item == col
+                d1[:, col] = o1[:, sel].sum(axis=1)
+                d2[:, col] = o2[:, sel].sum(axis=1)
+        kk = np.array(kk, dtype=float)
+        xi_items = np.array([p.xi for pos in cycle.positions for p in pos.pairs])
+        known = np.isfinite(kk)
+        if not known.any():
+            raise ParameterError("no tooth pair carries a fair share of the load in the contact analysis")
+        if not known.all():
+            kk[~known] = np.interp(xi_items[~known], xi_items[known][np.argsort(xi_items[known])],
+                                   kk[known][np.argsort(xi_items[known])])
+        f0 = np.array(f0)
+        ref = np.array(ref)
+        # the elastic approach of a pair carrying the whole force (the stiffest one sets the scale)
+        scale = float(np.min(approach))
+        return cls(d1, d2, f0, 1.0 / ref, np.array(e0), np.array(xi1), np.array(xi2), kk, np.array(phase),
+                   len(cycle.positions), cycle.force, scale, np.ones(n_items, dtype=bool))
+
+
+def _contact_of(geometry: GearPair):
+    from twin.degradation.ltca import contact_for
+    return contact_for(geometry)
+
+
+def _overlap(u: np.ndarray, centre: np.ndarray, half: np.ndarray, sweep: np.ndarray) -> np.ndarray:
+    """(n, c): int hat_c(s) 1[|u - centre_c - s| < half_c] ds, the pressure piecewise linear
+    between phases (a hat of half-width 2 sweep_c per phase; see _deposit)."""
+    t = u[:, None] - centre[None, :]
+    a, h = half[None, :], 2.0 * sweep[None, :]
+    lo, hi = np.maximum(t - a, -h), np.minimum(t + a, h)
+    prim_hi = hi - hi * np.abs(hi) / (2.0 * h)
+    prim_lo = lo - lo * np.abs(lo) / (2.0 * h)
+    return np.where(hi > lo, prim_hi - prim_lo, 0.0)
+
+
+def _deposit(u: np.ndarray, centre: np.ndarray, half: np.ndarray, sweep: np.ndarray, weight: np.ndarray,
+             block: int = 4000) -> np.ndarray:
+    """sum_i weight_i l_i(u), l_i(u) = int hat_i(s) 1[|u - centre_i - s| < half_i] ds.
+
+    Mesh phase m stands for the pressure while the contact moves by one step 2 sweep_i; the
+    pressure is taken piecewise linear between consecutive phases, so each phase's cell weighs
+    the sweep with a hat of half-width 2 sweep_i (peak 1 at the phase), not a box: the deposit is
+    then continuous with a continuous slope instead of a staircase of the phase step."""
+    out = np.zeros(u.size)
+    for start in range(0, centre.size, block):
+        c = centre[start:start + block]
+        t = u[:, None] - c[None, :]
+        a, h = half[None, start:start + block], 2.0 * sweep[None, start:start + block]
+        lo, hi = np.maximum(t - a, -h), np.minimum(t + a, h)
+
+        def prim(x):                        # antiderivative of the hat 1 - |x| / h on [-h, h]
+            return x - x * np.abs(x) / (2.0 * h)
+        overlap = np.where(hi > lo, prim(hi) - prim(lo), 0.0)
+        out += overlap @ weight[start:start + block]
+    return out
