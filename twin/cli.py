@@ -449,8 +449,9 @@ def _cmd_improve(args: argparse.Namespace) -> int:
 def _cmd_effects(args: argparse.Namespace) -> int:
     effects = _lib("twin.effects")
     if args.write_candidates:
-        model, path = effects.write_variant(effects.candidates_source(), args.modelica_dir)
-        print(f"{model} -> {path}")
+        for base in effects.BASE_MODELS:
+            model, path = effects.write_variant(effects.candidates_source(base), args.modelica_dir)
+            print(f"{model} -> {path}")
         return 0
     for e in effects.CATALOGUE.values():
         fit = ", ".join(f"{p.name} [{p.lower:g}, {p.upper:g}]" for p in e.fit)

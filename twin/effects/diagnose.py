@@ -442,7 +442,8 @@ def diagnose(fmu_path, measured: np.ndarray, sample_rate: float, nominal_speed: 
     nominal_speed, load : drive setting [Hz] and brake torque [N.m] of the record.
     parameters : the current model's (calibrated) parameters.
     effects : candidate ids (default: every catalogue effect the current model lacks).
-    candidates_fmu : the built ``Gearbox21Candidates`` FMU (built on demand when None).
+    candidates_fmu : the built candidate model of the current model's base (``Gearbox21Candidates``,
+        ``Gearbox21MeasuredCandidates`` for a model with a sensor path); built on demand when None.
     related_leaders : how many of the leading candidates are refitted once more together with
         their related base parameters (:attr:`Effect.related`); 0 switches that off.
     anchors : calibrated values of base parameters (a scenario's ``diagnosis.calibrated``): the
@@ -466,8 +467,9 @@ def diagnose(fmu_path, measured: np.ndarray, sample_rate: float, nominal_speed: 
     if candidates_fmu is None:
         from fmu_build import build_fmu
 
-        from twin.effects.variant import CANDIDATES_MODEL, _REPO_MODELICA
-        candidates_fmu = build_fmu(CANDIDATES_MODEL, _REPO_MODELICA, _REPO_MODELICA.parent / "build")
+        from twin.effects.variant import _REPO_MODELICA, base_of, candidates_model
+        candidates_fmu = build_fmu(candidates_model(base_of(current)), _REPO_MODELICA,
+                                   _REPO_MODELICA.parent / "build")
     # the candidate model starts from the current model: base parameters, the active effects at
     # their values in the current FMU, every other effect neutral
     probe = dict(parameters)

@@ -132,7 +132,8 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
     from twin.calibration.problem import write_parameter_set
     from twin.compare import compare_signals
     from twin.effects.diagnose import _band_error, starting_values
-    from twin.effects.variant import CANDIDATES_MODEL, _REPO_MODELICA, modelica_root, variant_source, write_variant
+    from twin.effects.variant import (_REPO_MODELICA, base_of, candidates_model, modelica_root, variant_source,
+                                      write_variant)
     from twin.errors import ParameterError
 
     eff = get_effect(effect_id)
@@ -163,7 +164,8 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
         guesses.update(split_fitted(effect_id, start)[0])
     if refit:
         if candidates_fmu is None:
-            candidates_fmu = build_fmu(CANDIDATES_MODEL, _REPO_MODELICA, _REPO_MODELICA.parent / "build")
+            candidates_fmu = build_fmu(candidates_model(base_of(current)), _REPO_MODELICA,
+                                       _REPO_MODELICA.parent / "build")
         probe = {**base_params, **values, **neutral_values(active)}
         spec = TrialSpec(effect_id, str(candidates_fmu), channel, measured, op, probe, guesses, max_evals,
                          related=now, related_anchor=anchors)
@@ -177,7 +179,8 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
     neutral = {eff.parameter(k): v for k, v in eff.neutral.items()}
     ids = [*active, effect_id]
     model, path = write_variant(variant_source(ids, {**values, **neutral,
-                                                     **{eff.parameter(k): v for k, v in fitted_effect.items()}}),
+                                                     **{eff.parameter(k): v for k, v in fitted_effect.items()}},
+                                               base=base_of(current)),
                                 modelica_dir)
     fmu_path = build_fmu(model, modelica_dir, build_dir)
     sim1 = simulate(fmu_path, base_params, op, measured.size, channel)

@@ -31,9 +31,24 @@ def test_each_effect_is_a_bounded_modelica_component_with_a_readme(effect_id):
     assert f"`{effect_id}`" in readme and short in readme
 
 
-def test_committed_candidate_model_is_the_generated_one():
-    committed = (REPO / "modelica" / "GearTwin" / "Variants" / "Gearbox21Candidates.mo").read_text()
-    assert committed == candidates_source(), "regenerate with `twin effects --write-candidates`"
+@pytest.mark.parametrize("base", ["GearTwin.Gearbox21", "GearTwin.Gearbox21Measured"])
+def test_committed_candidate_models_are_the_generated_ones(base):
+    from twin.effects import candidates_model
+    short = candidates_model(base).rsplit(".", 1)[1]
+    committed = (REPO / "modelica" / "GearTwin" / "Variants" / f"{short}.mo").read_text()
+    assert committed == candidates_source(base), "regenerate with `twin effects --write-candidates`"
+    assert f"extends {base}(" in committed
+
+
+def test_variants_extend_the_base_model_they_are_built_on():
+    from twin.effects import base_of
+    from twin.errors import ParameterError
+    src = variant_source(["housing_mode"], {"housing_mode.frequency": 3000.0}, base="GearTwin.Gearbox21Measured")
+    assert "extends GearTwin.Gearbox21Measured(" in src and "model Gearbox21Measured_housing_mode_" in src
+    assert base_of(["sensor_pinion.gain", "kt35"]) == "GearTwin.Gearbox21Measured"
+    assert base_of(["kt35"]) == "GearTwin.Gearbox21"
+    with pytest.raises(ParameterError, match="GearTwin.Gearbox21Other"):
+        variant_source(["housing_mode"], base="GearTwin.Gearbox21Other")
 
 
 def test_variant_sums_hooks_shared_by_two_effects():
