@@ -181,7 +181,8 @@ def reversal(out: Path, per_stage: int) -> dict | None:
         gain = np.exp(np.interp(f, f_path, delta, right=0.0))
         y = np.fft.irfft(np.fft.rfft(x) * gain, n=x.size)
         y *= np.sqrt(np.mean(x ** 2) / np.mean(y ** 2))          # the record keeps its level
-        provoked.append(dataclasses.replace(r, channels={CHANNEL: y}, units={CHANNEL: "m/s2"}))
+        provoked.append(dataclasses.replace(r, channels={CHANNEL: y}, units={CHANNEL: "m/s2"}, tachometer=None,
+                                            tachometer_kind=None))
     res = ens.assess(provoked, time_ordered=False)
     s = res.scores()
     from scipy.stats import spearmanr
