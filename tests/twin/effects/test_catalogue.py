@@ -47,6 +47,8 @@ def test_variants_extend_the_base_model_they_are_built_on():
     assert "extends GearTwin.Gearbox21Measured(" in src and "model Gearbox21Measured_housing_mode_" in src
     assert base_of(["sensor_pinion.gain", "kt35"]) == "GearTwin.Gearbox21Measured"
     assert base_of(["kt35"]) == "GearTwin.Gearbox21"
+    with pytest.raises(ParameterError, match="Gearbox21Casing"):
+        base_of(["sensor_pinion.gain", "m_casing"])
     with pytest.raises(ParameterError, match="GearTwin.Gearbox21Other"):
         variant_source(["housing_mode"], base="GearTwin.Gearbox21Other")
 
