@@ -1,0 +1,160 @@
+"""Benchmark: `twin diagnose` on gearboxes the twin did not generate (rigs/pedestal, rigs/beam).
+
+    python bench/diagnosis_rigs.py --calibrated bench_out/calibration_rigs [--rigs pedestal beam]
+                                   [--seed 1] [--effects ...] [--out bench_out/diagnosis_rigs]
+
+Per rig: the gearbox ``Rig().scattered(seed, 0.12)`` that ``bench/calibration_rigs.py`` calibrated
+(its ``<rig>_<seed>_cal/calibrated.yaml`` under ``--calibrated``: the twin as well calibrated as
+the current tools make it). For each case, the rig writes a 2 s steady record at 20 Hz / 20 N.m
+of that gearbox with one effect hidden (the rig's own implementation and default size; ``none``:
+nothing hidden) and a 6 s run-up from 2 to 20 Hz, in the measurement format, the truth apart.
+Then, as a user would, ``twin.effects.diagnose`` on the steady record's pinion casing channel
+with the calibrated scenario's model and parameters (the run-up is written for the record, the
+current diagnosis reads one record).
+
+Scored: the verdict against the hidden effect (the catalogue effect the rig's effect corresponds
+to; ``none`` -> "nothing missing"; an effect outside the catalogue -> "unexplained"), and the
+floor-aware, gain-free spectral distance of ``bench/spectral_distance.py`` (written apart from
+``twin.compare``) between the record and (a) the calibrated twin, (b) the twin with the top
+candidate at its fitted values, both simulated at the operating point the diagnosis measured.
+
+Cases already in --out/results.json for other rigs or effects are kept. Run once per method change; every figure goes to BENCHMARKS.md as measured. Prints a Markdown
+table; writes results.json under --out.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import os
+import platform
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO))
+sys.path.insert(0, str(REPO / "bench"))
+
+SPEED, LOAD = 20.0, 20.0
+CHANNEL = "accel_pinion_casing"
+#: rig effect -> the catalogue effect a correct diagnosis names (None: "unexplained" is right)
+EXPECTED = {"none": "nothing_missing", "pinion_runout": "pinion_eccentricity", "gear_runout": "gear_eccentricity",
+            "drive_ripple": "motor_torque_ripple", "casing_resonance": "housing_mode",
+            "local_tooth_fault": "local_tooth_damage", "bearing_outer_race": "unexplained",
+            "coupling_misalignment": "unexplained"}
+
+
+def correct(expected: str, d) -> bool:
+    if expected in ("nothing_missing", "unexplained"):
+        return d.verdict == expected
+    return d.verdict == "missing_effect" and d.missing == expected
+
+
+def one_case(rig_name: str, seed: int, effect: str, calibrated, out: Path, ex) -> dict:
+    from spectral_distance import spectral_distance_report
+
+    from twin.effects.catalogue import CATALOGUE
+    from twin.effects.diagnose import diagnose
+    from twin.measurements import load_measurements
+    from twin.operating import simulate_at
+
+    rigmod = importlib.import_module(f"rigs.{rig_name}")
+    box = rigmod.Rig().scattered(seed=seed, scatter=0.12)
+    h5 = out / f"{rig_name}_{seed}_{effect}.h5"
+    eff = None if effect == "none" else effect
+    t = time.perf_counter()
+    if not h5.exists():
+        case_seed = 100 + sorted(EXPECTED).index(effect)
+        steady = box.steady(speed=SPEED, load=LOAD, duration=2.0, effect=eff, seed=case_seed, name="steady")
+        runup = box.runup(speeds=(2.0, SPEED), load=LOAD, duration=6.0, effect=eff, seed=case_seed, name="runup")
+        rigmod.write(h5, [steady, runup])
+    rig_s = time.perf_counter() - t
+    rec = load_measurements(h5)["steady"]
+    fs = float(rec.sample_rate)
+    x = np.asarray(rec[CHANNEL], float)
+    fmu, params = calibrated.fmu_path(), dict(calibrated.parameters)
+    t0 = time.perf_counter()
+    d = diagnose(fmu, x, fs, float(rec.nominal_speed), float(rec.load), parameters=params, executor=ex,
+                 duration=2.0, record="steady")
+    wall = time.perf_counter() - t0
+    n = int(round(2.0 * fs))
+    xm = x[-n:]
+    base = simulate_at(fmu, params, d.operating, n, [CHANNEL])[:, 0]
+    dist0 = spectral_distance_report(base, xm, fs)["distance_db"]
+    top = d.candidates[0]
+    dist1 = None
+    if top.fitted and top.error is None:
+        from fmu_build import build_fmu
+
+        from twin.effects.variant import _REPO_MODELICA, base_of, candidates_model
+        from twin.fmu import FMU
+        with FMU(fmu) as f:
+            base = base_of(f.parameter_values())
+        cand = build_fmu(candidates_model(base), _REPO_MODELICA, _REPO_MODELICA.parent / "build")
+        probe = {**params, **{e.parameter(k): v for e in CATALOGUE.values() for k, v in e.neutral.items()},
+                 **top.fitted}
+        try:
+            y = simulate_at(cand, probe, d.operating, n, [CHANNEL])[:, 0]
+            dist1 = spectral_distance_report(y, xm, fs)["distance_db"]
+        except Exception as exc:  # reported in the table, never ends the benchmark
+            dist1 = f"{type(exc).__name__}: {exc}"
+    truth = json.loads(Path(str(h5) + ".truth.json").read_text())
+    row = {"rig": rig_name, "seed": seed, "hidden": effect, "expected": EXPECTED[effect], "verdict": d.verdict,
+           "missing": d.missing, "correct": correct(EXPECTED[effect], d), "top": top.effect,
+           "top_score": top.score, "top_fitted": top.fitted, "unexplained": list(d.unexplained),
+           "twin_lsd_before": d.lsd_db, "twin_lsd_after_top": top.lsd_after_db,
+           "distance_before_db": dist0, "distance_after_top_db": dist1, "diagnose_s": wall, "rig_s": rig_s,
+           "truth_effect": next((r.get("effect") for r in truth.get("records", [truth]) if isinstance(r, dict)
+                                 and r.get("effect")), None) if isinstance(truth, dict) else None}
+    return row
+
+
+def table(rows: list[dict]) -> str:
+    lines = ["| rig | hidden in the rig | verdict | top candidate (score) | correct | independent distance: "
+             "calibrated twin -> with the top candidate [dB] | diagnose [s] |", "|---|---|---|---|---|---|---|"]
+    for r in rows:
+        verdict = r["verdict"] + (f": {r['missing']}" if r["missing"] else "")
+        after = r["distance_after_top_db"]
+        after = f"{after:.1f}" if isinstance(after, float) else "not simulated"
+        lines.append(f"| {r['rig']} | {r['hidden']} | {verdict} | {r['top']} ({r['top_score']:.2f}) | "
+                     f"{'yes' if r['correct'] else 'no'} | {r['distance_before_db']:.1f} -> {after} | "
+                     f"{r['diagnose_s']:.0f} |")
+    return "\n".join(lines)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--calibrated", type=Path, required=True,
+                    help="output directory of bench/calibration_rigs.py (holds <rig>_<seed>_cal/calibrated.yaml)")
+    ap.add_argument("--rigs", nargs="+", default=["pedestal", "beam"])
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--effects", nargs="+", default=["none", "pinion_runout", "gear_runout", "drive_ripple",
+                                                      "casing_resonance", "local_tooth_fault", "bearing_outer_race"])
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--out", type=Path, default=REPO / "bench_out" / "diagnosis_rigs")
+    args = ap.parse_args()
+
+    from twin.executor import LocalExecutor
+    from twin.scenario import load_scenario
+
+    args.out.mkdir(parents=True, exist_ok=True)
+    done = args.out / "results.json"
+    rows = [r for r in (json.loads(done.read_text()) if done.exists() else [])
+            if (r["rig"], r["hidden"]) not in {(g, e) for g in args.rigs for e in args.effects}]
+    with LocalExecutor(args.workers) as ex:
+        for rig in args.rigs:
+            calibrated = load_scenario(args.calibrated / f"{rig}_{args.seed}_cal" / "calibrated.yaml")
+            for effect in args.effects:
+                rows.append(one_case(rig, args.seed, effect, calibrated, args.out, ex))
+                print(json.dumps({k: v for k, v in rows[-1].items() if k != "top_fitted"}), flush=True)
+                (args.out / "results.json").write_text(json.dumps(rows, indent=1, default=str))
+    print(f"Machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, {args.workers} workers, "
+          f"load average {os.getloadavg()[0]:.1f}")
+    print(table(rows))
+
+
+if __name__ == "__main__":
+    main()
