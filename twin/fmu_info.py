@@ -16,7 +16,7 @@ if TYPE_CHECKING:
 def _experiment(fmu: "FMU") -> str:
     de = fmu.default_experiment
     parts = [f"{label} {value:g} s" for label, value in
-             (("start", de.start_time), ("stop", de.stop_time), ("step", de.step_size)) if value is not None]
+             (("startTime", de.start_time), ("stopTime", de.stop_time), ("stepSize", de.step_size)) if value is not None]
     if de.tolerance is not None:
         parts.append(f"tolerance {de.tolerance:g}")
     return ", ".join(parts) if parts else "none"

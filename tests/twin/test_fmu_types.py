@@ -133,7 +133,7 @@ def test_default_experiment_and_description(typecov_fmus):
         with pytest.raises(SimulationError, match="must be after start_time"):
             fmu.experiment(start_time=5.0, stop_time=2.0)
     text = describe(typecov_fmus[("AllTypes", 2)])
-    assert "Default experiment  start 0 s, stop 3 s, step 0.1 s" in text
+    assert "Default experiment  startTime 0 s, stopTime 3 s, stepSize 0.1 s" in text
     assert "Inputs, outputs and parameters of every FMI 2.0 type" in text          # the model's own description
     assert "Constants (1, read-only):" in text and "teeth" in text
     assert "{off=1, slow=2, fast=3}" in text and "slow (2)" in text
