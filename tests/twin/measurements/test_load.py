@@ -120,7 +120,7 @@ def test_archive_layout_from_write_archive_loads(tmp_path):
     arc = Archive(labels=np.array([0, 0, 1]), damage=np.array([0.01, 0.02, 0.04]), speed=np.array([20.0, 20.1, 19.9]),
                   load=np.array([20.0, 21.0, 19.0]), signals=signals, sample_rate=5000.0, stages=(0.0, 0.03, 0.06),
                   damage_kind="pitting_density")
-    scenario = types.SimpleNamespace(raw={"name": "tiny"}, seed=4)
+    scenario = types.SimpleNamespace(raw={"name": "tiny"}, seed=4, start_time=0.0, inputs={})
     path = write_archive(arc, tmp_path / "arc.h5", scenario)
     mset = load_measurements(path, min_duration=0.1)
     assert mset.names == ("000000", "000001", "000002")
@@ -131,6 +131,7 @@ def test_archive_layout_from_write_archive_loads(tmp_path):
     np.testing.assert_array_equal(r["accel_pinion_casing"], signals["accel_pinion_casing"][2].astype(np.float64))
     assert mset.metadata["damage_kind"] == "pitting_density"
     assert list(mset.metadata["stages"]) == [0.0, 0.03, 0.06]
+    assert (mset.metadata["nominal_speed"], mset.metadata["nominal_load"]) == (20.0, 20.0)   # no inputs: the defaults
 
 
 # --------------------------------------------------------------------------- file-level errors
