@@ -11,11 +11,11 @@ import pytest
 from twin.effects.diagnose import diagnose
 from twin.effects.synthetic import OUT_OF_CATALOGUE_HZ, calibrate_base, make_case
 
-# One effect of each kind the diagnosis must tell apart: shaft-locked (an eccentricity), a line at a
-# frequency of its own (a motor ripple) and a nonlinearity that acts only when the flanks separate
-# (backlash). The whole catalogue, over several seeds, is `bench/effects.py` (BENCHMARKS.md);
-# running all of it here took about half of the suite's time.
-OBSERVABLE = ["gear_eccentricity", "motor_torque_ripple", "backlash"]
+# One effect of each kind the diagnosis must tell apart: shaft-locked (an eccentricity) and a line at
+# a frequency of its own (a motor ripple); backlash, which needs a 6 s nearly unloaded record, is
+# checked below where it must not be blamed. The whole catalogue, over several seeds, is
+# `bench/effects.py` (BENCHMARKS.md); running all of it here took about half of the suite's time.
+OBSERVABLE = ["gear_eccentricity", "motor_torque_ripple"]
 
 
 def _diagnose(effect, gearbox_fmu, candidates_fmu, executor, seed=0, **conditions):
