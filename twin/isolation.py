@@ -36,6 +36,7 @@ from pathlib import Path
 from typing import Any
 
 from twin import _interrupt
+from twin._atomic import _pid_alive as _alive
 from twin.errors import WorkerCrashError
 
 log = logging.getLogger(__name__)
@@ -68,16 +69,6 @@ def _private_root(kind: str) -> str:
         if pid.isdigit() and not _alive(int(pid)):
             shutil.rmtree(old, ignore_errors=True)
     return tempfile.mkdtemp(prefix=f"twin_{kind}_{os.getpid()}_")
-
-
-def _alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
 
 
 def _use_tempdir(root: str) -> None:
