@@ -286,25 +286,32 @@ class FMU:
             raise ParameterError(f"{self.model_name} has no variable {name!r}{hint}") from None
 
     def experiment(self, start_time: float | None = None, stop_time: float | None = None,
-                   output_interval: float | None = None) -> tuple[float, float, float]:
+                   output_interval: float | None = None, *, fmpy_grid: bool = True) -> tuple[float, float, float]:
         """(start, stop, output interval) [s]: the values given, else the model's default experiment.
 
-        Start: ``startTime``, else 0.  Stop: ``stopTime``, else start + 1 s.  Output interval:
-        ``stepSize``, else the FMI 3.0 ``fixedInternalStepSize``, else fmpy's automatic interval
-        (500 to 1000 samples over the run).  Unlike fmpy, a model's ``stepSize`` is never
-        coarsened.
+        Start: ``startTime``, else 0.  Stop: ``stopTime``, else start + 1 s.  Output interval, as
+        ``fmpy.simulate_fmu`` chooses it: the FMI 3.0 ``fixedInternalStepSize``, else ``stepSize``,
+        doubled until the run has at most 1000 intervals; else fmpy's automatic interval (500 to
+        1000 samples).  With ``fmpy_grid=False`` (scenarios) the model's ``stepSize`` is taken as
+        it is, never coarsened, so a vibration model keeps its sample rate.
         """
         de = self.default_experiment
         start = float(start_time) if start_time is not None else (de.start_time if de.start_time is not None else 0.0)
         stop = float(stop_time) if stop_time is not None else (de.stop_time if de.stop_time is not None else start + 1.0)
         if not stop > start:
             raise SimulationError(f"stop_time ({stop} s) must be after start_time ({start} s)")
+        fixed = _float_or_none(getattr(self.model_description.coSimulation, "fixedInternalStepSize", None))
+        step = de.step_size if de.step_size is not None and de.step_size > 0 else None
         if output_interval is not None:
             interval = float(output_interval)
-        elif de.step_size is not None and de.step_size > 0:
-            interval = de.step_size
-        elif _float_or_none(getattr(self.model_description.coSimulation, "fixedInternalStepSize", None)):
-            interval = float(self.model_description.coSimulation.fixedInternalStepSize)
+        elif fmpy_grid and (fixed or step):
+            interval = float(fixed or step)
+            while (stop - start) / interval > 1000:     # fmpy's rule, so both give the same samples
+                interval *= 2
+        elif step:
+            interval = step
+        elif fixed:
+            interval = fixed
         else:
             from fmpy.util import auto_interval
             interval = float(auto_interval(stop - start))
@@ -928,6 +935,11 @@ def simulate_fmu(path: str | Path, *, stop_time: float | None = None, start_time
     params = dict(parameters or {})
     with FMU(path) as fmu:
         start, stop, interval = fmu.experiment(start_time, stop_time, output_interval)
+        step = fmu.default_experiment.step_size
+        if output_interval is None and step and interval > step * (1 + 1e-9):
+            warnings.warn(TwinWarning(f"output interval {interval:g} s: the model's step {step:g} s doubled to at "
+                                      f"most 1000 intervals, as fmpy does; give --output-interval {step:g} "
+                                      "for every step"))
         if step_size is not None:
             if STEP_SIZE not in fmu.variables:
                 raise ParameterError(f"{fmu.model_name} has no {STEP_SIZE} parameter (not built by fmu_build)")

@@ -572,7 +572,7 @@ def _model_experiment(data, source, where, problems) -> tuple[float, float, floa
                 problems.append((where, "stop_time", f"not given, and {fmu.model_name} has no default "
                                                      "experiment stop time"))
                 return None
-            return fmu.experiment(data.get("start_time"), data.get("stop_time"), None)
+            return fmu.experiment(data.get("start_time"), data.get("stop_time"), None, fmpy_grid=False)
     except ScenarioError as exc:
         problems.extend((where, k, f"{' and '.join(missing)} not given, and the model's default experiment "
                                    f"cannot be read: {r}") for _, k, r in exc.problems)

@@ -174,3 +174,22 @@ def test_our_fmi3_build_runs_like_the_fmi2_build(two_mass_fmu, two_mass_fmu3):
     for name in a.channels:
         np.testing.assert_allclose(b[name], a[name], rtol=1e-12, atol=1e-12 * np.max(np.abs(a[name])))
     assert b.parameters["k1"] == 150.0
+
+
+def test_no_option_grid_follows_fmpy(two_mass_fmu):
+    """With no output interval the twin samples where fmpy.simulate_fmu does: the model's stepSize
+    (1 ms over 10 s) doubled until the run has at most 1000 intervals; scenarios keep stepSize."""
+    import warnings
+
+    import fmpy
+
+    with FMU(two_mass_fmu) as fmu:
+        assert fmu.experiment() == (0.0, 10.0, 0.016)
+        assert fmu.experiment(fmpy_grid=False) == (0.0, 10.0, 1e-3)
+        assert fmu.experiment(stop_time=0.5) == (0.0, 0.5, 1e-3)        # 500 intervals: kept
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = simulate_fmu(two_mass_fmu)
+    assert any(isinstance(w.message, TwinWarning) and "--output-interval 0.001" in str(w.message) for w in caught)
+    reference = fmpy.simulate_fmu(str(two_mass_fmu))
+    assert np.array_equal(result.time, reference["time"])
