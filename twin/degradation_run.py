@@ -41,8 +41,11 @@ from twin.fmu import FMU
 from twin.orchestrator import check_compatibility
 from twin.scenario import Scenario
 
-#: Default log-sd of the per-tooth pitting strength factors (``degradation.tooth_scatter``).
-DEFAULT_TOOTH_SCATTER = 0.2
+#: Default log-sd of the per-tooth pitting strength factors (``degradation.tooth_scatter``): the
+#: tooth-to-tooth life scatter of spur-gear pitting, Weibull slope e = 2.5 (Coy, Townsend &
+#: Zaretsky, J. Lubr. Technol. 98 (1976) 267-276, from NASA gear fatigue tests), seen through the
+#: law's cycle exponent m = 9/8: ln(lambda) has the sd (m / e) pi / sqrt(6) = 0.58.
+DEFAULT_TOOTH_SCATTER = 0.58
 ROLL = [f"roll[{i}]" for i in (1, 2, 3)]
 FORCE = [f"pair_force[{i}]" for i in (1, 2, 3)]
 #: The flank fields written per stage: pinion (``field``) and, for wear, the gear (``gear_field``).
@@ -222,7 +225,8 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
                 current.update({f"profile_deviation[{i}]": fmu.get(f"profile_deviation[{i}]")
                                 for i in range(1, n_nodes + 1)})
                 if model_name == "pitting":
-                    current.update({f"tooth_stiffness_factor[{j}]": fmu.get(f"tooth_stiffness_factor[{j}]")
+                    current.update({f"pit_profile[{i}]": fmu.get(f"pit_profile[{i}]") for i in range(1, n_nodes + 1)})
+                    current.update({f"tooth_pit_scale[{j}]": fmu.get(f"tooth_pit_scale[{j}]")
                                     for j in range(1, geometry.z1 + 1)})
                 trunc = stages[-1].truncation_error if stages else {}
                 gear = np.asarray(state.gear_depth) if model_name == "wear" else None
@@ -245,7 +249,8 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
                 else:
                     mapped = pitting_parameters(geometry, state, force, k_healthy, scatter=scatter,
                                                 weibull_slope=model.m)
-                    new, trunc_error = mapped.parameters, {"k_pair": mapped.truncation_error}
+                    new, trunc_error = mapped.parameters, {"k_pair": mapped.truncation_error,
+                                                           "pit_profile": mapped.pit_truncation_error}
                 fmu.set(new)
                 stages[-1] = Stage(**{**stages[-1].__dict__, "truncation_error": trunc_error})
             else:

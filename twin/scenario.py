@@ -161,7 +161,8 @@ SCHEMA: dict[str, Any] = {
                 "load_window": {**_POS, "description": "s of co-simulation sampled to estimate the mesh load at each update"},
                 "record_duration": {**_NONNEG, "description": "s of vibration stored at each update (0 = none)"},
                 "tooth_scatter": {**_NONNEG, "description": "pitting: log-sd of the per-tooth pitting strength "
-                                                           "factors (seeded by 'seed'; default 0.2, 0 = teeth alike)"},
+                                                           "factors (seeded by 'seed', as are the pit cells; default 0.58, "
+                                                           "the Weibull life scatter of gear teeth; 0 = teeth alike)"},
             },
         },
         "archive": {

@@ -15,20 +15,35 @@ stiffness that gives the same approach at the operating force.  The lumped rule 
 the pair's compliance (about a third here), so the LTCA loses less stiffness at low density and
 more where a flank point is nearly all pitted.
 
-**Per-tooth damage.**  Teeth do not pit alike: tooth j has a strength factor lambda_j (seeded,
-lognormal, median 1, log-sd ``scatter``) and, under the Weibull law of
-:class:`~twin.degradation.pitting.FatiguePitting` at constant load, its density is
-``D_j = 1 - (1 - D)^lambda_j``.  For a contact whose pitted fraction is uniform across the
-contact width the LTCA compliance change is exactly ``c_contact (D / (1 - D))`` with c_contact the
+**Per-tooth pits.**  The law gives the probability D(xi) that the stressed material at roll xi
+has failed; real flanks fail in discrete pits, unequally from tooth to tooth.  Each pinion
+flank is divided into pit-sized cells, :data:`PIT_SIZE` along the flank and across the face,
+and each cell carries a seeded uniform quantile u; the cell has pitted once the law's failure
+probability at its centre reaches u.  A cell's pit, once formed, stays as the density grows, and
+the expected pitted fraction is the law's D.  Teeth also differ in load and strength: tooth j
+has a strength factor lambda_j (seeded, lognormal, median 1, log-sd ``scatter``) and, under the
+Weibull law of :class:`~twin.degradation.pitting.FatiguePitting` at constant load, its cells
+fail with probability ``D_j = 1 - (1 - D)^lambda_j``.
+
+A pit wider than the Hertzian contact (initial macropits are about 0.5 mm across, the contact
+2b = 35-75 um wide here) leaves the contact line unsupported over the pit's length: at roll xi
+tooth j carries its load on the face width its pits leave, the fraction ``1 - f_j(xi)``, where
+f_j is the pitted share of the face weighted by the overlap of each cell with the contact band
+[u - b, u + b].  By the uniform-pit law below its compliance is that of the typical tooth plus
+``pitted_contact_compliance(f_j) - pitted_contact_compliance(D)``, so under the pair force F(xi)
+it gives way by ``e_j(xi) = F (c_j - c_typical)`` more than the tooth ``k_pair`` describes; where
+the pits leave no support across the face the contact reaches the pit bottom, and the extra
+approach over the healthy tooth is at most the pit depth, the law's crack depth
+``z0 = 0.786 b`` (Eq. 13).  The FMU takes these per-tooth deviations as one shape along the path
+times one scale per tooth (``pit_profile[1..n]`` [m] x ``tooth_pit_scale[1..z1]``, the leading
+singular pair of the (z1, N) field e_j(xi)); the rank-1 residual is reported as a truncation
+error.  ``tooth_stiffness_factor`` is left to the scenario (it is no longer written).
+
 For a contact whose pitted fraction is uniform across the contact width, the LTCA's cells all
 carry their force on ``L (1 - D)``: the contact is that of a modulus ``E* (1 - D)``, wider by
 ``1 / sqrt(1 - D)``, and its compliance is exactly ``(c_contact + ln(1 - D) / (pi E* L)) / (1 - D)``
 (:func:`pitted_contact_compliance`; test_ltca checks it against the LTCA) with c_contact the
-contact part of the healthy LTCA compliance.  So each tooth's compliance along the path follows
-from the LTCA of the healthy tooth at once.  The FMU scales the common
-``k_pair`` by one ``tooth_stiffness_factor[j]`` per pinion tooth, chosen to keep the tooth's mean
-compliance along the path; the pits remove no material the mating flank touches, so
-``tooth_deviation_offset`` stays zero.
+contact part of the healthy LTCA compliance.
 
 **The gear's flank.**  The pinion flank point at roll xi meshes with the gear flank point at xi
 under the same Hertz contact; the gear point meets it z1/z2 as often, so under the same Weibull
@@ -53,13 +68,23 @@ from twin.errors import ParameterError
 _N_XI = 41
 #: Highest local density the pairs are allowed (a flank point never loses all its contact width).
 _MAX_DENSITY = 0.98
+#: Surface size of a pit [m], along the flank and across the face: initial (non-progressive)
+#: macropits are under 0.020 in (0.5 mm) across and progressive ones grow beyond 0.032 in
+#: (R. Errichello, "Morphology of micropitting", and the macropitting classes of ANSI/AGMA
+#: 1010-F14, as summarised in Gear Solutions, "Gear wear and failure modes"; ISO 10825-1:2022
+#: uses the same progression).  Not fitted to any rig.
+PIT_SIZE = 0.5e-3
+#: Depth of a pit below the flank over its Hertz half-width: the law's z0 / b (Eq. 13), the depth
+#: of the shear stress whose cracks break the pit out.
+PIT_DEPTH_OVER_B = 0.786
 
 
 @dataclass(frozen=True)
 class ToothScatter:
-    """Per-tooth pitting strength factors lambda_j (z1,), median 1."""
+    """Per-tooth pitting strength factors lambda_j (z1,), median 1, and the seed of the pit cells."""
 
     factors: np.ndarray
+    seed: int = 0
 
     @classmethod
     def draw(cls, teeth: int, scatter: float, seed: int) -> "ToothScatter":
@@ -69,7 +94,12 @@ class ToothScatter:
         if not (isinstance(teeth, (int, np.integer)) and teeth >= 1):
             raise ParameterError(f"teeth must be an integer >= 1, got {teeth!r}")
         rng = np.random.default_rng(seed)
-        return cls(np.exp(float(scatter) * rng.standard_normal(int(teeth))))
+        return cls(np.exp(float(scatter) * rng.standard_normal(int(teeth))), int(seed))
+
+    def cell_quantiles(self, n_profile: int, n_face: int) -> np.ndarray:
+        """Seeded uniform strength quantiles of the pit cells, shape (z1, n_profile, n_face)."""
+        rng = np.random.default_rng([self.seed, 1])
+        return rng.random((self.factors.size, n_profile, n_face))
 
 
 def gear_density(geometry: GearPair, density: np.ndarray, weibull_slope: float) -> np.ndarray:
@@ -85,18 +115,26 @@ class PittingMap:
     Attributes
     ----------
     parameters : dict
-        ``k_pair[1..n]`` [N/m] and ``tooth_stiffness_factor[1..z1]`` [-].
+        ``k_pair[1..n]`` [N/m], ``pit_profile[1..n]`` [m] and ``tooth_pit_scale[1..z1]`` [-].
     compliance_change : (N,) the LTCA's dc(xi) of the typical tooth [m/N] on ``xi``.
     tooth_compliance_change : (z1, N) dc of each tooth [m/N].
+    tooth_deviation : (z1, N) e_j(xi), each tooth's extra approach over the typical tooth [m].
+    pitted_share : (z1, N) f_j(xi), the share of the face the contact finds pitted.
+    pit_depth : (N,) depth of a pit at xi [m].
     xi : (N,) roll positions.
     truncation_error : max |k(xi) - interp(nodes)(xi)| / k_healthy(xi).
+    pit_truncation_error : ||e - scale x interp(pit_profile)|| / ||e|| (rank-1 and node fit; 0 if e = 0).
     """
 
     parameters: dict
     compliance_change: np.ndarray
     tooth_compliance_change: np.ndarray
+    tooth_deviation: np.ndarray
+    pitted_share: np.ndarray
+    pit_depth: np.ndarray
     xi: np.ndarray
     truncation_error: float
+    pit_truncation_error: float
 
 
 def pitting_parameters(geometry: GearPair, pitting: PittingState, force: float, k_pair_healthy,
@@ -143,25 +181,71 @@ def pitting_parameters(geometry: GearPair, pitting: PittingState, force: float, 
     k_nodes = healthy - np.minimum(loss_nodes, 0.98 * healthy)
     err = float(np.max(np.abs(interp_nodes(k_nodes, xi) - k_field) / k_h))
     params = {f"k_pair[{i}]": float(v) for i, v in enumerate(k_nodes, start=1)}
-    # per tooth: contact compliance scaled by D_j / (1 - D_j) minus the typical tooth's
-    c_contact = c_healthy - contact.bulk_compliance(xi_in)
     lam = np.ones(geometry.z1) if scatter is None else np.asarray(scatter.factors, dtype=float)
     if lam.size != geometry.z1:
         raise ParameterError(f"scatter has {lam.size} tooth factors, the pinion has {geometry.z1} teeth")
+    scatter = scatter if scatter is not None else ToothScatter(lam, 0)
+    c_contact = c_healthy - contact.bulk_compliance(xi_in)
     d_xi = np.interp(xi, pitting.xi, d1)
-    intact_typ = (1.0 - d_xi) * (1.0 - gear_density(geometry, d_xi, weibull_slope))
-    d_tooth = 1.0 - (1.0 - d_xi[None, :]) ** lam[:, None]
-    d_tooth = np.minimum(d_tooth, _MAX_DENSITY)
-    intact = (1.0 - d_tooth) * (1.0 - gear_density(geometry, d_tooth, weibull_slope))
-    # the typical tooth's change from its full LTCA, plus the difference the tooth's own density
-    # makes by the uniform-pit law
-    dc_tooth = dc[None, :] + (pitted_contact_compliance(geometry, c_contact[None, :], 1.0 - intact)
-                              - pitted_contact_compliance(geometry, c_contact, 1.0 - intact_typ)[None, :])
-    c_common = 1.0 / k_h + dc                                              # the typical tooth
-    c_tooth = 1.0 / k_h[None, :] + dc_tooth
-    factors = np.mean(c_common) / np.mean(c_tooth, axis=1)
-    params.update({f"tooth_stiffness_factor[{j}]": float(f) for j, f in enumerate(factors, start=1)})
-    return PittingMap(params, dc, dc_tooth, xi, err)
+    g_xi = gear_density(geometry, d_xi, weibull_slope)
+    share = pitted_share(geometry, pitting, scatter, xi_in, pair_force)                 # (z1, N)
+    # the tooth's pits, the typical gear flank's (the gear teeth meet every pinion tooth in turn)
+    intact_typ = (1.0 - d_xi) * (1.0 - g_xi)
+    intact = np.maximum((1.0 - share) * (1.0 - g_xi)[None, :], 1e-9)
+    with np.errstate(over="ignore", divide="ignore"):
+        dc_tooth = dc[None, :] + (pitted_contact_compliance(geometry, c_contact[None, :], 1.0 - intact)
+                                  - pitted_contact_compliance(geometry, c_contact, 1.0 - intact_typ)[None, :])
+    depth = PIT_DEPTH_OVER_B * geometry.hertz_half_width(pair_force, xi_in)
+    # extra approach over the typical tooth; over the healthy one at most the pit depth
+    extra = np.minimum(pair_force[None, :] * dc_tooth, depth[None, :])
+    # the differences between the teeth: their mean is the law's typical tooth, which k_pair
+    # carries (the cells' mean departs from it only by their sampling of D(xi))
+    deviation = extra - np.mean(extra, axis=0)[None, :]
+    profile, scale, pit_err = _rank_one(deviation, xi, n_nodes)
+    params.update({f"pit_profile[{i}]": float(v) for i, v in enumerate(profile, start=1)})
+    params.update({f"tooth_pit_scale[{j}]": float(v) for j, v in enumerate(scale, start=1)})
+    return PittingMap(params, dc, dc_tooth, deviation, share, depth, xi, err, pit_err)
+
+
+def pitted_share(geometry: GearPair, pitting: PittingState, scatter: ToothScatter, xi, pair_force) -> np.ndarray:
+    """f_j(xi): share of the face width tooth j's pits leave without support under the contact
+    band of half-width b(xi) at pair force ``pair_force`` [N] (module docstring), shape (z1, N)."""
+    u0, u1 = (float(v) for v in geometry.flank_position(np.array([0.0, 1.0])))
+    n_prof = max(1, math.ceil((u1 - u0) / PIT_SIZE))
+    n_face = max(1, round(geometry.face_width / PIT_SIZE))
+    edges = u0 + PIT_SIZE * np.arange(n_prof + 1)
+    centres = np.minimum(0.5 * (edges[:-1] + edges[1:]), u1)
+    # the law's density averaged over each cell (5 points), the cell's failure probability
+    sub = np.minimum(edges[:-1, None] + PIT_SIZE * (np.arange(5)[None, :] + 0.5) / 5, u1)
+    d_cell = np.interp(geometry.xi_at_flank_position(sub), pitting.xi, np.minimum(pitting.density, 1.0)).mean(axis=1)
+    lam = np.asarray(scatter.factors, dtype=float)
+    d_tooth = 1.0 - (1.0 - d_cell[None, :]) ** lam[:, None]                          # (z1, cells)
+    pitted = scatter.cell_quantiles(n_prof, n_face) < d_tooth[:, :, None]
+    face_share = pitted.mean(axis=2)                                                    # (z1, cells)
+    u = geometry.flank_position(np.asarray(xi, dtype=float))
+    b = geometry.hertz_half_width(np.asarray(pair_force, dtype=float), xi)
+    lo = np.maximum(u[:, None] - b[:, None], edges[None, :-1])
+    hi = np.minimum(u[:, None] + b[:, None], edges[None, 1:])
+    overlap = np.maximum(0.0, hi - lo) / (2.0 * b[:, None])                             # (N, cells)
+    return face_share @ overlap.T
+
+
+def _rank_one(field: np.ndarray, xi: np.ndarray, n_nodes: int) -> tuple[np.ndarray, np.ndarray, float]:
+    """Node profile (n_nodes,) [m] and per-tooth scales (z1,) of the leading singular pair of
+    ``field`` (z1, N) on ``xi``, the scales' largest magnitude 1; and the relative residual."""
+    from twin.degradation._nodes import hat_matrix
+    norm = float(np.linalg.norm(field))
+    if norm == 0.0:
+        return np.zeros(n_nodes), np.zeros(field.shape[0]), 0.0
+    u, s, vt = np.linalg.svd(field, full_matrices=False)
+    big = float(np.max(np.abs(u[:, 0])))
+    scale, shape = u[:, 0] / big, vt[0] * s[0] * big
+    if shape.sum() < 0:
+        scale, shape = -scale, -shape
+    basis = hat_matrix(xi, n_nodes)
+    profile = np.linalg.lstsq(basis, shape, rcond=None)[0]
+    residual = field - scale[:, None] * (basis @ profile)[None, :]
+    return profile, scale, float(np.linalg.norm(residual) / norm)
 
 
 def pitted_contact_compliance(geometry: GearPair, contact_compliance, pitted):

@@ -23,12 +23,18 @@ def _k(params, n=11):
     return np.array([params[f"k_pair[{i}]"] for i in range(1, n + 1)])
 
 
+def _pits(params, z1=19, n=11):
+    return (np.array([params[f"pit_profile[{i}]"] for i in range(1, n + 1)]),
+            np.array([params[f"tooth_pit_scale[{j}]"] for j in range(1, z1 + 1)]))
+
+
 def test_no_pits_leaves_the_mesh_healthy():
     state = FatiguePitting().initial_state(G)
     m = pitting_parameters(G, state, F, HEALTHY_K_PAIR, scatter=ToothScatter.draw(19, 0.3, 1))
     np.testing.assert_allclose(_k(m.parameters), HEALTHY_K_PAIR, rtol=1e-12)
-    factors = [m.parameters[f"tooth_stiffness_factor[{j}]"] for j in range(1, 20)]
-    np.testing.assert_allclose(factors, 1.0, rtol=1e-9)
+    profile, scale = _pits(m.parameters)
+    assert np.all(profile == 0) and np.all(scale == 0)
+    assert not any(k.startswith("tooth_stiffness_factor") for k in m.parameters)
 
 
 def test_pits_soften_only_the_contact(pitted):
@@ -41,20 +47,51 @@ def test_pits_soften_only_the_contact(pitted):
     light = (d > 0.02) & (d < 0.3)
     assert light.any()
     assert np.all(k[light] / np.array(HEALTHY_K_PAIR)[light] > 1 - d[light])
-    # teeth alike: every factor 1
-    np.testing.assert_allclose([m.parameters[f"tooth_stiffness_factor[{j}]"] for j in range(1, 20)], 1.0,
-                               atol=1e-9)
 
 
-def test_weaker_teeth_get_softer(pitted):
-    scatter = ToothScatter.draw(19, 0.3, 7)
+def test_teeth_pit_in_discrete_cells(pitted):
+    m = pitting_parameters(G, pitted, F, HEALTHY_K_PAIR, scatter=ToothScatter.draw(19, 0.0, 3))
+    share = m.pitted_share
+    assert share.shape == (19, m.xi.size) and np.all((share >= 0) & (share <= 1))
+    # the cells' expected pitted share is the law's density: the teeth's mean follows it
+    d = np.interp(m.xi, pitted.xi, pitted.density)
+    assert abs(share.mean() - d.mean()) < 0.2 * d.mean()
+    # the teeth differ, and the per-tooth deviations are the differences (mean zero over the teeth)
+    assert np.ptp(share, axis=0).max() > 0.05
+    np.testing.assert_allclose(m.tooth_deviation.mean(axis=0), 0.0, atol=1e-15)
+    # a tooth never gives way more than a pit is deep over the healthy tooth
+    assert np.all(m.tooth_deviation <= m.pit_depth[None, :] + 1e-12) and np.all(np.isfinite(m.tooth_deviation))
+    # the FMU's rank-1 form reproduces the field to its stated residual
+    profile, scale = _pits(m.parameters)
+    from twin.degradation._nodes import interp_nodes
+    approx = scale[:, None] * interp_nodes(profile, m.xi)[None, :]
+    resid = np.linalg.norm(m.tooth_deviation - approx) / np.linalg.norm(m.tooth_deviation)
+    assert resid == pytest.approx(m.pit_truncation_error, rel=1e-9) and resid < 1
+    assert np.max(np.abs(scale)) == pytest.approx(1.0)
+
+
+def test_pits_grow_where_they_started():
+    model = FatiguePitting()
+    load = MeshLoad.static(G, 20.0 * 19 / 52)
+    early = model.advance(model.initial_state(G), load, 3e6, 125.0)
+    late = model.advance(early, load, 4e6, 125.0)
+    scatter = ToothScatter.draw(19, 0.58, 5)
+    a = pitting_parameters(G, early, F, HEALTHY_K_PAIR, scatter=scatter).pitted_share
+    b = pitting_parameters(G, late, F, HEALTHY_K_PAIR, scatter=scatter).pitted_share
+    assert np.all(b >= a - 1e-12) and b.sum() > a.sum()
+
+
+def test_weaker_teeth_pit_more(pitted):
+    scatter = ToothScatter.draw(19, 0.58, 7)
     m = pitting_parameters(G, pitted, F, HEALTHY_K_PAIR, scatter=scatter)
-    factors = np.array([m.parameters[f"tooth_stiffness_factor[{j}]"] for j in range(1, 20)])
-    # lambda > 1 pits faster: a lower factor; the order of the factors is the reverse of lambda's
-    assert np.all(np.diff(factors[np.argsort(scatter.factors)]) < 0)
-    assert factors.min() < 1 < factors.max()
-    # the same seed gives the same teeth
-    np.testing.assert_array_equal(ToothScatter.draw(19, 0.3, 7).factors, scatter.factors)
+    pitted_area = m.pitted_share.mean(axis=1)
+    order = np.argsort(scatter.factors)
+    # lambda > 1 pits faster: the strongest third of the teeth has less pitted area than the weakest
+    assert pitted_area[order[:6]].mean() < pitted_area[order[-6:]].mean()
+    # the same seed gives the same teeth and the same pits
+    again = pitting_parameters(G, pitted, F, HEALTHY_K_PAIR, scatter=ToothScatter.draw(19, 0.58, 7))
+    np.testing.assert_array_equal(again.pitted_share, m.pitted_share)
+    np.testing.assert_array_equal(ToothScatter.draw(19, 0.58, 7).factors, scatter.factors)
 
 
 def test_the_gear_flank_pits_less():
