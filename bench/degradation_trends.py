@@ -5,7 +5,7 @@
     python bench/degradation_trends.py nodes            # convergence with n_profile
     python bench/degradation_trends.py pitting          # signature against rigs.ltca (black box)
     python bench/degradation_trends.py speed            # lubricated to 20 %, dry to 240 um
-    python bench/degradation_trends.py rigs             # the same features on rigs.pedestal, rigs.beam
+    python bench/degradation_trends.py rigs [--kind pitting]   # the same features on rigs.pedestal, rigs.beam
 
 ``wear``: an 18/35 module-3 pair at 15 Hz / 10 N.m (light load), profile form deviation of
 ISO 1328-1 class 7, coupled wear run to about 1 mm of mean pinion wear depth on 41 profile
@@ -381,6 +381,8 @@ def part_rigs(args) -> dict:
     result = {}
     print(f"Machine: {machine()}\n")
     for kind, (damages, speed, load, scenario) in RIG_POINTS.items():
+        if args.kind and kind not in args.kind:
+            continue
         t = time.perf_counter()
         sources = {"twin": [(x, 50000.0) for x in
                             _twin_stage_records(kind, damages, speed, load, scenario, duration, manufacturing)]}
@@ -459,6 +461,8 @@ def main() -> None:
     ap.add_argument("part", choices=("build", "wear", "nodes", "pitting", "speed", "rigs"))
     ap.add_argument("--depth", type=float, default=1.0e-3, help="wear: mean pinion depth to reach [m]")
     ap.add_argument("--seed", type=int, default=0, help="pitting: the rig's gear seed")
+    ap.add_argument("--kind", action="append", choices=tuple(RIG_POINTS),
+                    help="rigs: only this damage kind (repeatable; default both)")
     args = ap.parse_args()
     if args.part == "nodes" and args.depth == 1.0e-3:
         args.depth = 3.0e-4
