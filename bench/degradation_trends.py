@@ -232,7 +232,7 @@ def part_nodes(args) -> dict:
     inputs = {"motor_speed_ref": 2 * math.pi * 15, "load_torque": 10.0}
     for n in (11, 21, 41, 81):
         fmu = build_variant("GearTwin.Gearbox21", {"z1": 18, "z2": 35, "n_profile": n})
-        upd = mesh_parameters(g, wear=state, k_pair_healthy=k_pair_nodes(g, n), n_nodes=n)
+        upd = mesh_parameters(g, wear=state, k_pair_healthy=k_pair_nodes(g, n), n_nodes=n, force=load.force)
         with FMU(fmu) as f:
             f.setup(0.0, parameters=consistent_start(upd.parameters, inputs, [v.name for v in f.parameters]),
                     inputs=inputs)

@@ -192,7 +192,10 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
             params.update(stages[-1].parameters)
         if model_name == "wear" and not stages and (np.any(state.pinion_form > 0) or np.any(state.gear_form > 0)):
             # the flanks' form deviation is in the mesh from the first record on
-            params.update(mesh_parameters(geometry, wear=state, k_pair_healthy=k_healthy, n_nodes=n_nodes).parameters)
+            torque = float(inputs.get("load_torque", 0.0) or 0.0)
+            nominal = torque / geometry.base_radius_gear if torque > 0 else None
+            params.update(mesh_parameters(geometry, wear=state, k_pair_healthy=k_healthy, n_nodes=n_nodes,
+                                          force=nominal).parameters)
         from twin.operating import consistent_start
         start = consistent_start(params, inputs, [v.name for v in fmu.parameters])
         check_parameters(fmu, start)
@@ -244,7 +247,8 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
                     dn = min(dn, max(stop_cycles - state.cycles, 1.0))
                 state = model.advance(state, load, dn, omega1)
                 if model_name == "wear":
-                    update = mesh_parameters(geometry, wear=state, k_pair_healthy=k_healthy, n_nodes=n_nodes)
+                    update = mesh_parameters(geometry, wear=state, k_pair_healthy=k_healthy, n_nodes=n_nodes,
+                                             force=force)
                     new, trunc_error = update.parameters, dict(update.truncation_error)
                 else:
                     mapped = pitting_parameters(geometry, state, force, k_healthy, scatter=scatter,

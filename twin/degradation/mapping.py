@@ -89,7 +89,8 @@ def project_on_nodes(xi, values, n_nodes: int) -> tuple[np.ndarray, float]:
 
 
 def mesh_parameters(geometry: GearPair, *, wear: WearState | None = None, pitting: PittingState | None = None,
-                    k_pair_healthy: Sequence[float] = HEALTHY_K_PAIR, n_nodes: int = 11) -> MeshUpdate:
+                    k_pair_healthy: Sequence[float] = HEALTHY_K_PAIR, n_nodes: int = 11,
+                    force: float | None = None) -> MeshUpdate:
     """FMU mesh parameters for the given damage states.
 
     Parameters
@@ -104,6 +105,9 @@ def mesh_parameters(geometry: GearPair, *, wear: WearState | None = None, pittin
         Undamaged pair stiffness [N/m] at the nodes (e.g. calibrated values).
     n_nodes : int
         Number of FMU nodes (``n_profile``, 11).
+    force : float, optional
+        Transmitted normal force [N]: the worn flanks are seen through the Hertz contact width of
+        that force (:func:`wear_deviation`); the rigid flanks when None.
 
     Zero damage returns ``k_pair_healthy`` and zero deviation exactly.
     """
@@ -143,7 +147,7 @@ def mesh_parameters(geometry: GearPair, *, wear: WearState | None = None, pittin
                             or np.any(wear.pinion_form > 0) or np.any(wear.gear_form > 0)):
         e_nodes, e_err = np.zeros(n_nodes), 0.0
     else:
-        xi, separation = wear_deviation(geometry, wear)
+        xi, separation = wear_deviation(geometry, wear, force=force)
         e_nodes, e_err = project_on_nodes(xi, separation, n_nodes)
 
     for i, value in enumerate(k_nodes, start=1):
@@ -155,19 +159,30 @@ def mesh_parameters(geometry: GearPair, *, wear: WearState | None = None, pittin
     return MeshUpdate(params, errors)
 
 
-def wear_deviation(geometry: GearPair, wear: WearState, n_grid: int = _SEPARATION_GRID
-                   ) -> tuple[np.ndarray, np.ndarray]:
+def wear_deviation(geometry: GearPair, wear: WearState, n_grid: int = _SEPARATION_GRID, *,
+                   force: float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The pair's no-load separation along the path of contact [m], from both worn flanks.
 
     At roll xi the flanks touch where ``h1 + h2 + x^2 / (2 R)`` is least over the tangent
     distance x from the involute contact point (conjugate action of the worn profiles,
     :meth:`twin.degradation.ltca.LoadedContact.separation`): a narrow groove narrower than the
     mating flank's curvature bridges is not seen, uniform thinning of both flanks is a constant
-    (backlash).  Returns ``(xi, separation)``, (n_grid,) each.
+    (backlash).  With ``force`` [N] (the transmitted normal force) each flank is first taken as
+    the loaded contact sees it, its Hertz-weighted mean over the contact half-width b of that
+    force (:func:`twin.degradation._hertz.contact_average`): a feature narrower than the contact
+    is bridged.  Returns ``(xi, separation)``, (n_grid,) each.
     """
     from twin.degradation.ltca import FlankDamage, contact_for
     xi = np.linspace(0.0, 1.0, n_grid)
     d1, d2 = wear.deviations()
+    if force is not None:
+        from twin.degradation._hertz import contact_average
+        if not (isinstance(force, (int, float, np.floating)) and np.isfinite(force) and force > 0):
+            raise ParameterError(f"force must be a finite number > 0 N, got {force!r}")
+        b = geometry.hertz_half_width(float(force), wear.xi)
+        d1 = contact_average(geometry.flank_position(wear.xi), b) @ d1
+        rho2 = geometry.rho2(wear.xi)
+        d2 = contact_average(rho2 * rho2 / (2.0 * geometry.base_radius_gear), b) @ d2
     damage = FlankDamage.of(wear.xi, pinion_depth=d1, gear_depth=d2)
     return xi, contact_for(geometry).separation(xi, damage)
 

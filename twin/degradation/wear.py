@@ -40,6 +40,7 @@ import math
 
 import numpy as np
 
+from twin.degradation._hertz import contact_average
 from twin.degradation.archard import DEFAULT_WEAR_COEFFICIENT
 from twin.degradation.base import DegradationModel, WearState
 from twin.degradation.geometry import GearPair
@@ -49,6 +50,7 @@ from twin.errors import ParameterError
 
 DEFAULT_RUNNING_IN_FACTOR = 5.0
 DEFAULT_RUNNING_IN_DEPTH = 2.0e-6
+DEFAULT_LTCA_INCREMENT = 3.0e-6
 
 
 class FlankWear(DegradationModel):
@@ -72,6 +74,9 @@ class FlankWear(DegradationModel):
         (ISO 1328-1 f_f_alpha; :func:`iso1328_profile_form`); 0 for perfect involutes.
     form_seed : int
         Seed of the form deviation's shape (:func:`profile_form`).
+    ltca_increment : float
+        Local wear [m] (90th percentile over a flank) after which a jump takes a new LTCA of
+        the worn flanks (see :meth:`_advance`).
     """
 
     state_type = WearState
@@ -80,7 +85,8 @@ class FlankWear(DegradationModel):
     def __init__(self, wear_coefficient: float = DEFAULT_WEAR_COEFFICIENT, *,
                  running_in_factor: float = DEFAULT_RUNNING_IN_FACTOR,
                  running_in_depth: float = DEFAULT_RUNNING_IN_DEPTH, n_positions: int = 48,
-                 substep_fraction: float = 0.25, form_deviation: float = 0.0, form_seed: int = 0):
+                 substep_fraction: float = 0.25, form_deviation: float = 0.0, form_seed: int = 0,
+                 ltca_increment: float = DEFAULT_LTCA_INCREMENT):
         for name, value, lo in (("wear_coefficient", wear_coefficient, 0.0), ("running_in_depth", running_in_depth, 0.0)):
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value > lo):
                 raise ParameterError(f"{name} must be a finite number > 0, got {value!r}")
@@ -100,6 +106,9 @@ class FlankWear(DegradationModel):
             raise ParameterError(f"form_deviation must be a finite number >= 0 m, got {form_deviation!r}")
         self.form_deviation = float(form_deviation)
         self.form_seed = int(form_seed)
+        if not (isinstance(ltca_increment, (int, float)) and math.isfinite(ltca_increment) and ltca_increment > 0):
+            raise ParameterError(f"ltca_increment must be a finite number > 0 m, got {ltca_increment!r}")
+        self.ltca_increment = float(ltca_increment)
         self._contact: dict[GearPair, LoadedContact] = {}
         # (state, force, sweep): sizing a jump and taking it share one LTCA (states are immutable:
         # the cache holds the state object itself)
@@ -109,7 +118,8 @@ class FlankWear(DegradationModel):
     def __repr__(self) -> str:
         return (f"FlankWear(wear_coefficient={self.wear_coefficient!r}, running_in_factor="
                 f"{self.running_in_factor!r}, running_in_depth={self.running_in_depth!r}, "
-                f"n_positions={self.n_positions!r}, substep_fraction={self.substep_fraction!r})")
+                f"n_positions={self.n_positions!r}, substep_fraction={self.substep_fraction!r}, "
+                f"ltca_increment={self.ltca_increment!r})")
 
     def contact(self, geometry: GearPair) -> LoadedContact:
         """The LTCA of ``geometry`` (built once per geometry)."""
@@ -167,19 +177,41 @@ class FlankWear(DegradationModel):
         return 1.0 + (self.running_in_factor - 1.0) * np.exp(-depth / self.running_in_depth)
 
     def _advance(self, state: WearState, load, cycles: float, omega1: float) -> WearState:
-        """Integrate the wear over ``cycles`` in sub-steps.
+        """Integrate the wear over ``cycles`` in segments, each with a fresh LTCA of its flanks.
+
+        Within a segment the LTCA fixes where each pair touches and the shape of its pressure;
+        the contact moves on a worn flank as soon as the wear at its spot exceeds the
+        differences of the separation around it (a fraction of a um), so a spot held for a long
+        segment would be dug into a groove a few contact widths wide that the next LTCA then
+        avoids: a ripple of the integration, not of the physics.  A segment therefore ends when
+        the 90th percentile of the local wear of either flank reaches ``ltca_increment``
+        (3 um by default; for the 18/35 flanks worn to 300 um, 3 um gives a smooth profile where
+        10 um leaves grooves of 100 um).  Within a segment the load sharing between the pairs
+        follows the wear by sub-steps (:meth:`_integrate`).
+        """
+        done = 0.0
+        while done < cycles * (1 - 1e-12):
+            d1, d2 = self.depth_per_cycle(state, load)
+            peak = max(float(np.percentile(d1, 90)), float(np.percentile(d2, 90)))
+            segment = cycles - done
+            if peak > 0 and segment * peak > self.ltca_increment:
+                # equal segments, so the last is not a sliver
+                segment = segment / math.ceil(segment * peak / self.ltca_increment)
+            state = self._integrate(state, self.sweep(state, load), segment)
+            done += segment
+        return state
+
+    def _integrate(self, state: WearState, sw: "_Sweep", cycles: float) -> WearState:
+        """Wear over ``cycles`` with the contacts of one LTCA, in sub-steps.
 
         The load sharing responds to wear through the separations of the pairs: a pair worn by
-        more than its elastic approach (a fraction of a um at light load) loses its load.  A jump
-        of several um with the load frozen would overshoot and leave a saw-tooth.  So within the
-        jump the LTCA of the jump's start is kept for the pressure shape of each pair at each
-        phase, and each pair's force follows its separation by the linear pair law
+        more than its elastic approach (a fraction of a um at light load) loses its load.  So
+        each pair's force follows its separation by the linear pair law
         ``F_j = k_j max(0, delta - e_j)`` (k_j the LTCA's secant stiffness of that pair, e_j its
-        separation plus the wear since the start at its contact point), re-solved per phase every
-        sub-step; a sub-step changes no separation by more than ``substep_fraction`` of the
-        smallest elastic approach.  The next jump starts from a full LTCA of the new flanks.
+        separation plus the pressure-weighted mean wear under its contact since the start),
+        re-solved per phase every sub-step; a sub-step changes no separation by more than
+        ``substep_fraction`` of the smallest elastic approach.
         """
-        sw = self.sweep(state, load)
         k = self.wear_coefficient
         h1, h2 = state.depth.copy(), state.gear_depth.copy()
         dh1, dh2 = np.zeros_like(h1), np.zeros_like(h2)
@@ -187,12 +219,12 @@ class FlankWear(DegradationModel):
         for _ in range(100000):
             if done >= cycles * (1 - 1e-12):
                 break
-            e = sw.e0 + np.interp(sw.xi1, state.xi, dh1) + np.interp(sw.xi2, state.xi, dh2)
+            e = sw.e0 + sw.press1 @ dh1 + sw.press2 @ dh2
             f = sw.forces(e)
             r1 = k * (sw.d1 @ (f * sw.inv_ref)) * self._running_in(h1 + dh1)
             r2 = k * (sw.d2 @ (f * sw.inv_ref)) * self._running_in(h2 + dh2)
-            # the separation of a pair grows with the wear at its contact points
-            growth = np.interp(sw.xi1, state.xi, r1) + np.interp(sw.xi2, state.xi, r2)
+            # the separation of a pair grows with the wear under its contact
+            growth = sw.press1 @ r1 + sw.press2 @ r2
             peak = float(np.max(growth[sw.in_path], initial=0.0))
             step = cycles - done
             if peak > 0:
@@ -254,12 +286,13 @@ class _Sweep:
     flanks (at the pair's LTCA force, or per newton for a pair out of load), the pair's
     separation, contact point, secant stiffness, and the pair law to redistribute the force."""
 
-    def __init__(self, d1, d2, f0, inv_ref, e0, xi1, xi2, stiffness, phase_of, n_phases, force, approach_scale,
+    def __init__(self, d1, d2, f0, inv_ref, e0, press1, press2, stiffness, phase_of, n_phases, force, approach_scale,
                  in_path):
         self.d1, self.d2 = d1, d2                       # (n, J) deposits [Pa m per revolution / N of ref]
         self.f_scale = f0 * inv_ref                     # (J,) 1 for loaded items, 0 for the others
         self.inv_ref = inv_ref                          # (J,) 1 / reference force of the deposit
-        self.e0, self.xi1, self.xi2 = e0, xi1, xi2      # (J,) separation [m], flank points of the contact
+        self.e0 = e0                                    # (J,) separation [m]
+        self.press1, self.press2 = press1, press2       # (J, n) pressure weights under each contact
         self.stiffness = stiffness                      # (J,) N/m
         self.phase_of = phase_of                        # (J,) phase index
         self.n_phases = n_phases
@@ -302,8 +335,11 @@ class _Sweep:
         u1 = s ** 2 / (2 * rb1)
         u2 = (g.line_of_action_length - s) ** 2 / (2 * rb2)
         contact = None
-        cells = {"c1": [], "c2": [], "a": [], "s1": [], "s2": [], "w1": [], "w2": [], "item": []}
-        f0, ref, e0, xi1, xi2, kk, phase, loaded_flag = [], [], [], [], [], [], [], []
+        cells = {"c1": [], "c2": [], "a": [], "s1": [], "s2": [], "w1": [], "w2": [], "item": [], "ahead": [],
+                 "behind": []}
+        step = 1.0 / (n_positions * g.contact_ratio)          # roll advance per phase
+        under = {"xi1": [], "xi2": [], "w": [], "item": []}     # the flank points under each pair's pressure
+        f0, ref, e0, kk, phase, loaded_flag = [], [], [], [], [], []
         approach = []
         j = 0
         for m, pos in enumerate(cycle.positions):
@@ -343,15 +379,19 @@ class _Sweep:
                 cells["a"].append(np.full(x.size, width / 2))
                 cells["s1"].append(np.full(x.size, math.pi * rho1 / (g.z1 * n_positions)))
                 cells["s2"].append(np.full(x.size, math.pi * rho2 / (g.z2 * n_positions)))
+                cells["ahead"].append(np.full(x.size, (1.0 - xc) / step))
+                cells["behind"].append(np.full(x.size, xc / step))
                 cells["w1"].append(line_pressure * slide / rho1)                     # v_s / v1
                 cells["w2"].append(line_pressure * slide / (rho2 * g.z1 / g.z2))     # v_s / v2
                 cells["item"].append(np.full(x.size, j))
-                c_xi1, c_xi2, _ = (contact or _contact_of(g))._flank_points(xc, np.array([centroid]))
+                p_xi1, p_xi2, _ = (contact or _contact_of(g))._flank_points(xc, x)
+                under["xi1"].append(p_xi1)
+                under["xi2"].append(p_xi2)
+                under["w"].append(q / q.sum())
+                under["item"].append(np.full(x.size, j))
                 f0.append(total)
                 ref.append(reference)
                 e0.append(pair.separation)
-                xi1.append(float(c_xi1[0]))
-                xi2.append(float(c_xi2[0]))
                 kk.append(stiffness)
                 phase.append(m)
                 loaded_flag.append(total > 0)
@@ -362,8 +402,10 @@ class _Sweep:
         d1 = np.zeros((xi.size, n_items))
         d2 = np.zeros((xi.size, n_items))
         if n_items:
-            o1 = _overlap(u1, cat["c1"], cat["a"], cat["s1"]) * cat["w1"][None, :]
-            o2 = _overlap(u2, cat["c2"], cat["a"], cat["s2"]) * cat["w2"][None, :] * g.z1 / g.z2
+            ends = cat["ahead"], cat["behind"]
+            o1 = _cell_mean(u1, lambda v: _overlap(v, cat["c1"], cat["a"], cat["s1"], *ends, 1.0)) * cat["w1"][None, :]
+            o2 = _cell_mean(u2, lambda v: _overlap(v, cat["c2"], cat["a"], cat["s2"], *ends, -1.0)) * (
+                cat["w2"][None, :] * g.z1 / g.z2)
             for col in range(n_items):
                 sel = item == col
                 d1[:, col] = o1[:, sel].sum(axis=1)
@@ -378,10 +420,35 @@ class _Sweep:
                                    kk[known][np.argsort(xi_items[known])])
         f0 = np.array(f0)
         ref = np.array(ref)
+        if n_items:
+            # wear levels what is narrower than the contact: the increment is the Hertz-weighted
+            # mean over the contact width of the pair's force at that roll position
+            order = np.argsort(xi_items)
+            pair_force = np.interp(xi, xi_items[order], f0[order])
+            b = g.hertz_half_width(pair_force, xi)
+            d1 = contact_average(u1, b) @ d1
+            d2 = contact_average(u2, b) @ d2
         # the elastic approach of a pair carrying the whole force (the stiffest one sets the scale)
         scale = float(np.min(approach))
-        return cls(d1, d2, f0, 1.0 / ref, np.array(e0), np.array(xi1), np.array(xi2), kk, np.array(phase),
+        # a pair's separation grows by the pressure-weighted mean of the wear under its contact
+        # (to first order, Betti's theorem), not by the wear at one point of it
+        un = {k: np.concatenate(v) if v else np.empty(0) for k, v in under.items()}
+        rows = un["item"].astype(int)
+        press1 = _interp_rows(xi, un["xi1"], un["w"], rows, n_items)
+        press2 = _interp_rows(xi, un["xi2"], un["w"], rows, n_items)
+        return cls(d1, d2, f0, 1.0 / ref, np.array(e0), press1, press2, kk, np.array(phase),
                    len(cycle.positions), cycle.force, scale, np.ones(n_items, dtype=bool))
+
+
+def _interp_rows(grid: np.ndarray, points: np.ndarray, weight: np.ndarray, rows: np.ndarray, n_rows: int) -> np.ndarray:
+    """(n_rows, n) matrix M with ``M @ f`` = sum over a row's points of weight x f(point), f
+    interpolated linearly on ``grid`` (increasing, (n,))."""
+    out = np.zeros((n_rows, grid.size))
+    j = np.clip(np.searchsorted(grid, points, side="right") - 1, 0, grid.size - 2)
+    t = np.clip((points - grid[j]) / (grid[j + 1] - grid[j]), 0.0, 1.0)
+    np.add.at(out, (rows, j), weight * (1.0 - t))
+    np.add.at(out, (rows, j + 1), weight * t)
+    return out
 
 
 def _contact_of(geometry: GearPair):
@@ -389,34 +456,51 @@ def _contact_of(geometry: GearPair):
     return contact_for(geometry)
 
 
-def _overlap(u: np.ndarray, centre: np.ndarray, half: np.ndarray, sweep: np.ndarray) -> np.ndarray:
-    """(n, c): int hat_c(s) 1[|u - centre_c - s| < half_c] ds, the pressure piecewise linear
-    between phases (a hat of half-width 2 sweep_c per phase; see _deposit)."""
+def _cell_mean(u: np.ndarray, field, n_sub: int = 4) -> np.ndarray:
+    """Mean of ``field(v)`` (v (m,) -> (m, c)) over the flank stretch each grid point stands for
+    (halfway to its neighbours), (n, c).  The grid is coarser than the contact at the tips (tens
+    of um against a Hertz half-width of some 10-30 um at light load): point samples would give a
+    feature narrower than the contact the width of a grid step."""
+    mid = 0.5 * (u[1:] + u[:-1])
+    lo = np.concatenate([u[:1], mid])
+    hi = np.concatenate([mid, u[-1:]])
+    frac = (np.arange(n_sub) + 0.5) / n_sub
+    v = lo[:, None] + frac[None, :] * (hi - lo)[:, None]            # (n, n_sub)
+    out = field(v.ravel())
+    return out.reshape(u.size, n_sub, -1).mean(axis=1)
+
+
+def _overlap(u: np.ndarray, centre: np.ndarray, half: np.ndarray, sweep: np.ndarray, ahead: np.ndarray,
+             behind: np.ndarray, direction: float) -> np.ndarray:
+    """(n, c): int w_c(s) 1[|u - centre_c - s| < half_c] ds, the time-weighted coverage of flank
+    points u by cell c while the contact sweeps past.
+
+    Mesh phase m stands for the pressure while the contact moves by one step h_c = 2 sweep_c on
+    either side; the pressure is taken piecewise linear between consecutive phases, so each
+    phase's cell weighs the sweep with a hat 1 - |s| / h_c (peak 1 at the phase), not a box: the
+    deposit is then continuous with a continuous slope instead of a staircase of the phase step.
+    Where the pair enters or leaves the path of contact within that step there is no phase
+    beyond to interpolate to: the pair carries its pressure up to the end of the path and none
+    after, so on that side the weight is a box of length ``ahead_c h_c`` (towards the end of
+    the path, in the direction ``direction`` = +1 or -1 of u as the roll grows) or
+    ``behind_c h_c`` (towards its start) instead of the ramp.  ``ahead``/``behind`` >= 1 keep
+    the ramp."""
     t = u[:, None] - centre[None, :]
     a, h = half[None, :], 2.0 * sweep[None, :]
-    lo, hi = np.maximum(t - a, -h), np.minimum(t + a, h)
-    prim_hi = hi - hi * np.abs(hi) / (2.0 * h)
-    prim_lo = lo - lo * np.abs(lo) / (2.0 * h)
-    return np.where(hi > lo, prim_hi - prim_lo, 0.0)
-
-
-def _deposit(u: np.ndarray, centre: np.ndarray, half: np.ndarray, sweep: np.ndarray, weight: np.ndarray,
-             block: int = 4000) -> np.ndarray:
-    """sum_i weight_i l_i(u), l_i(u) = int hat_i(s) 1[|u - centre_i - s| < half_i] ds.
-
-    Mesh phase m stands for the pressure while the contact moves by one step 2 sweep_i; the
-    pressure is taken piecewise linear between consecutive phases, so each phase's cell weighs
-    the sweep with a hat of half-width 2 sweep_i (peak 1 at the phase), not a box: the deposit is
-    then continuous with a continuous slope instead of a staircase of the phase step."""
-    out = np.zeros(u.size)
-    for start in range(0, centre.size, block):
-        c = centre[start:start + block]
-        t = u[:, None] - c[None, :]
-        a, h = half[None, start:start + block], 2.0 * sweep[None, start:start + block]
-        lo, hi = np.maximum(t - a, -h), np.minimum(t + a, h)
-
-        def prim(x):                        # antiderivative of the hat 1 - |x| / h on [-h, h]
-            return x - x * np.abs(x) / (2.0 * h)
-        overlap = np.where(hi > lo, prim(hi) - prim(lo), 0.0)
-        out += overlap @ weight[start:start + block]
-    return out
+    lo, hi = t - a, t + a
+    # s measured along the roll direction: the forward side is s * direction > 0
+    fwd_box, bwd_box = ahead[None, :] < 1.0, behind[None, :] < 1.0
+    if direction > 0:
+        f_lo, f_hi, b_lo, b_hi = lo, hi, lo, hi
+    else:                                   # mirror: forward in roll is -u
+        f_lo, f_hi, b_lo, b_hi = -hi, -lo, -hi, -lo
+    f_end = np.where(fwd_box, ahead[None, :] * h, h)
+    b_end = np.where(bwd_box, behind[None, :] * h, h)
+    # forward side, s in [0, f_end]
+    x0, x1 = np.maximum(f_lo, 0.0), np.minimum(f_hi, f_end)
+    ramp = lambda x: x - x * x / (2.0 * h)                                      # noqa: E731
+    fwd = np.where(x1 > x0, np.where(fwd_box, x1 - x0, ramp(x1) - ramp(x0)), 0.0)
+    # backward side, s' = -s in [0, b_end]
+    y0, y1 = np.maximum(-b_hi, 0.0), np.minimum(-b_lo, b_end)
+    bwd = np.where(y1 > y0, np.where(bwd_box, y1 - y0, ramp(y1) - ramp(y0)), 0.0)
+    return fwd + bwd

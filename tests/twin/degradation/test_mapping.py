@@ -114,3 +114,24 @@ def test_invalid_inputs_raise_typed_errors_naming_the_value():
         mesh_parameters(GEOMETRY, pitting=WearState.pristine(GEOMETRY, 11))
     with pytest.raises(ParameterError, match="too coarse"):
         project_on_nodes(np.linspace(0, 1, 5), np.ones(5), 11)
+
+
+def test_at_load_a_ridge_narrower_than_the_contact_is_bridged():
+    """With the transmitted force the flanks are seen through the Hertz contact width: a pinion tip
+    left proud over one grid step (narrower than the contact) no longer makes a step of the
+    separation at the end of the path; a gentle field is seen as without the force."""
+    from twin.degradation import wear_deviation
+    xi = np.linspace(0, 1, 401)
+    depth = np.full(xi.size, 30e-6)
+    depth[-1] = 10e-6                                     # the last 13 um of the pinion tip stand proud
+    wear = WearState(1e5, xi, depth, GEOMETRY, np.zeros(xi.size))
+    force = 2000.0                                        # b about 80 um at the tip
+    _, rigid = wear_deviation(GEOMETRY, wear)
+    _, loaded = wear_deviation(GEOMETRY, wear, force=force)
+    assert rigid[-2] - rigid[-1] > 15e-6
+    assert loaded[-2] - loaded[-1] < 0.2 * (rigid[-2] - rigid[-1])
+    gentle = WearState(1e5, XI, 1e-6 * (20 + 10 * np.cos(np.pi * XI)), GEOMETRY, 1e-6 * (5 + 5 * XI))
+    np.testing.assert_allclose(wear_deviation(GEOMETRY, gentle, force=force)[1], wear_deviation(GEOMETRY, gentle)[1],
+                               rtol=0, atol=0.2e-6)
+    with pytest.raises(ParameterError, match="force"):
+        mesh_parameters(GEOMETRY, wear=wear, force=-1.0)

@@ -81,6 +81,25 @@ def test_worn_profile_stays_smooth_under_feedback(model):
     assert state.max_depth > 4e-6 and state.gear_mean_depth > 0
 
 
+def test_a_long_jump_takes_a_new_contact_analysis_every_ltca_increment():
+    """A jump of about 10 um at the 90th percentile is integrated in segments of at most
+    ``ltca_increment``, each on a fresh LTCA of the worn flanks, and ends at the cycles asked;
+    with an increment larger than the jump the LTCA of the jump's start serves throughout."""
+    load = TransmittedLoad(F)
+    calls = {}
+    for increment in (1e-3, 2e-6):
+        model = FlankWear(n_positions=16, ltca_increment=increment, running_in_factor=1.0)
+        state = model.initial_state(G, 101)
+        dn = model.cycles_for_increment(state, load, 60.0, 10e-6)
+        before = model._calls
+        worn = model.advance(state, load, dn, 60.0)
+        calls[increment] = model._calls - before
+        assert worn.cycles == pytest.approx(dn, rel=1e-12)
+    assert calls[1e-3] == 0 and calls[2e-6] >= 2
+    with pytest.raises(ParameterError, match="ltca_increment"):
+        FlankWear(ltca_increment=0.0)
+
+
 def test_bad_arguments_are_named(model):
     with pytest.raises(ParameterError, match="running_in_factor"):
         FlankWear(running_in_factor=0.5)
