@@ -27,12 +27,14 @@ force would turn negative).  Nothing here is random.
 """
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from twin.degradation.geometry import GearPair
+from twin.degradation._contact_kernels import gap as _gap_kernel
 from twin.errors import ParameterError
 
 # Cells per Hertz half-width of the healthy contact, cap on cells per pair, active-set iterations.
@@ -61,6 +63,12 @@ class FlankDamage:
     gear_depth: np.ndarray
     pinion_pitted: np.ndarray
     gear_pitted: np.ndarray
+
+    @functools.cached_property
+    def table(self) -> np.ndarray:
+        """(5, n): xi, pinion and gear depth, pinion and gear pitted fraction (for compiled code)."""
+        return np.ascontiguousarray(np.stack([self.xi, self.pinion_depth, self.gear_depth, self.pinion_pitted,
+                                              self.gear_pitted]), dtype=float)
 
     @classmethod
     def healthy(cls, n: int = 2) -> "FlankDamage":
@@ -149,6 +157,8 @@ class LoadedContact:
         s = self._s_a + np.array([0.0, 1.0]) * self._len
         self._u1_0, self._u1_1 = (float(v) for v in s ** 2 / (2.0 * self._rb1))
         self._u2 = (self._loa - s) ** 2 / (2.0 * self._rb2)   # gear arc at xi = 0 (its tip) and xi = 1
+        self._constants = np.array([self._rb1, self._rb2, self._s_a, self._len, self._loa, self._u1_0, self._u1_1,
+                                    self._u2[0], self._u2[1]])
 
     # ---- geometry of one pair ------------------------------------------------------------
     def bulk_compliance(self, xi) -> np.ndarray:
@@ -178,6 +188,9 @@ class LoadedContact:
     def gap(self, xi_c: float, x: np.ndarray, damage: FlankDamage) -> tuple[np.ndarray, np.ndarray]:
         """No-load separation [m] of the pair at roll ``xi_c`` at tangent offsets x, and the
         pitted fraction of the face width there (both flanks, independent pits)."""
+        if np.ndim(xi_c) == 0 and np.ndim(x) == 1:
+            # one pair: the compiled loop (the same formula, no temporaries)
+            return _gap_kernel(np.asarray(x, dtype=float), float(xi_c), self._constants, damage.table)
         r = self._radius(xi_c)
         xi1, xi2, ok = self._flank_points(xi_c, x)
         sep = x * x / (2.0 * r) + np.interp(xi1, damage.xi, damage.pinion_depth) + np.interp(
@@ -384,7 +397,19 @@ class MeshCycle:
 
 def _active_set(c: np.ndarray, sep: np.ndarray, force: float) -> tuple[np.ndarray, float]:
     """min over q >= 0, delta of the contact LCP: (C q + sep - delta)_i >= 0, complementary to q,
-    sum q = force.  Returns (q, delta)."""
+    sum q = force.  Returns (q, delta).  Compiled (:func:`twin.degradation._contact_kernels.active_set`);
+    the NumPy loop below takes over where that meets a singular system."""
+    from twin.degradation._contact_kernels import active_set
+    q, delta, status = active_set(np.ascontiguousarray(c), np.ascontiguousarray(sep), float(force), _MAX_ITER)
+    if status < 0:
+        return _active_set_numpy(c, sep, force)
+    if status == 0:
+        raise ParameterError("the contact analysis did not converge (active set cycling)")
+    return q, float(delta)
+
+
+def _active_set_numpy(c: np.ndarray, sep: np.ndarray, force: float) -> tuple[np.ndarray, float]:
+    """The active-set loop in NumPy, with a least-squares step where the system is singular."""
     n = sep.size
     active = np.zeros(n, dtype=bool)
     active[np.argsort(sep)[:max(1, min(3, n))]] = True

@@ -41,6 +41,7 @@ import math
 import numpy as np
 
 from twin.degradation._hertz import contact_average
+from twin.degradation._wear_kernels import deposit_matrix, integrate
 from twin.degradation.archard import DEFAULT_WEAR_COEFFICIENT
 from twin.degradation.base import DegradationModel, WearState
 from twin.degradation.geometry import GearPair
@@ -51,6 +52,7 @@ from twin.errors import ParameterError
 DEFAULT_RUNNING_IN_FACTOR = 5.0
 DEFAULT_RUNNING_IN_DEPTH = 2.0e-6
 DEFAULT_LTCA_INCREMENT = 3.0e-6
+_N_SUB = 4                     # sub-points of a grid point's flank stretch in the deposit mean
 
 
 class FlankWear(DegradationModel):
@@ -210,28 +212,16 @@ class FlankWear(DegradationModel):
         ``F_j = k_j max(0, delta - e_j)`` (k_j the LTCA's secant stiffness of that pair, e_j its
         separation plus the pressure-weighted mean wear under its contact since the start),
         re-solved per phase every sub-step; a sub-step changes no separation by more than
-        ``substep_fraction`` of the smallest elastic approach.
+        ``substep_fraction`` of the smallest elastic approach.  The local rate is
+        ``K (d @ F) (1 + (beta - 1) exp(-h / h_r))`` with d the deposits per newton of each pair
+        (compiled: :func:`twin.degradation._wear_kernels.integrate`).
         """
-        k = self.wear_coefficient
-        h1, h2 = state.depth.copy(), state.gear_depth.copy()
-        dh1, dh2 = np.zeros_like(h1), np.zeros_like(h2)
-        done = 0.0
-        for _ in range(100000):
-            if done >= cycles * (1 - 1e-12):
-                break
-            e = sw.e0 + sw.press1 @ dh1 + sw.press2 @ dh2
-            f = sw.forces(e)
-            r1 = k * (sw.d1 @ (f * sw.inv_ref)) * self._running_in(h1 + dh1)
-            r2 = k * (sw.d2 @ (f * sw.inv_ref)) * self._running_in(h2 + dh2)
-            # the separation of a pair grows with the wear under its contact
-            growth = sw.press1 @ r1 + sw.press2 @ r2
-            peak = float(np.max(growth[sw.in_path], initial=0.0))
-            step = cycles - done
-            if peak > 0:
-                step = min(step, self.substep_fraction * sw.approach_scale / peak)
-            dh1 += r1 * step
-            dh2 += r2 * step
-            done += step
+        h1, h2 = state.depth, state.gear_depth
+        dh1, dh2, ok = integrate(h1, h2, sw.d1, sw.d2, sw.inv_ref, sw.e0, sw.press1, sw.press2, sw.table,
+                                 sw.stiffness, sw.force, sw.approach_scale, self.wear_coefficient,
+                                 self.running_in_factor, self.running_in_depth, self.substep_fraction, cycles)
+        if not ok:
+            raise ParameterError("no tooth pair stiffness to carry the load at a mesh phase of the wear integration")
         return state.with_depths(state.cycles + cycles, h1 + dh1, h2 + dh2)
 
     def cycles_for_increment(self, state, load, omega1: float, max_increment: float, *,
@@ -284,10 +274,10 @@ def _force(load, geometry: GearPair) -> float:
 class _Sweep:
     """The contacts of one mesh cycle, one column per (phase, pair): pressure deposits on both
     flanks (at the pair's LTCA force, or per newton for a pair out of load), the pair's
-    separation, contact point, secant stiffness, and the pair law to redistribute the force."""
+    separation, the flank points under its pressure and its secant stiffness: what the pair law
+    of :meth:`FlankWear._integrate` needs to redistribute the force as the flanks wear."""
 
-    def __init__(self, d1, d2, f0, inv_ref, e0, press1, press2, stiffness, phase_of, n_phases, force, approach_scale,
-                 in_path):
+    def __init__(self, d1, d2, f0, inv_ref, e0, press1, press2, stiffness, phase_of, n_phases, force, approach_scale):
         self.d1, self.d2 = d1, d2                       # (n, J) deposits [Pa m per revolution / N of ref]
         self.f_scale = f0 * inv_ref                     # (J,) 1 for loaded items, 0 for the others
         self.inv_ref = inv_ref                          # (J,) 1 / reference force of the deposit
@@ -298,23 +288,9 @@ class _Sweep:
         self.n_phases = n_phases
         self.force = force
         self.approach_scale = approach_scale            # smallest elastic approach of a loaded pair [m]
-        self.in_path = in_path
-
-    def forces(self, e: np.ndarray) -> np.ndarray:
-        """Pair forces [N], (J,), for separations e: per phase, sum_j k_j max(0, delta - e_j) = F."""
-        from twin.degradation.load import _approach
-        table = self._table
-        valid = table >= 0
-        k = np.where(valid, self.stiffness[np.maximum(table, 0)], 0.0)
-        ee = np.where(valid, e[np.maximum(table, 0)], np.inf)
-        delta = _approach(k, ee, self.force, np.arange(table.shape[0], dtype=float))
-        f = k * np.maximum(0.0, delta[:, None] - np.where(valid, ee, 0.0))
-        out = np.zeros(e.size)
-        out[table[valid]] = f[valid]
-        return out
 
     @property
-    def _table(self) -> np.ndarray:
+    def table(self) -> np.ndarray:
         """(phases, slots) item index of each pair at each phase, -1 where none."""
         if self.__dict__.get("_table_cache") is None:
             width = int(np.max(np.bincount(self.phase_of, minlength=self.n_phases)))
@@ -335,6 +311,7 @@ class _Sweep:
         u1 = s ** 2 / (2 * rb1)
         u2 = (g.line_of_action_length - s) ** 2 / (2 * rb2)
         contact = None
+        flanks = None
         cells = {"c1": [], "c2": [], "a": [], "s1": [], "s2": [], "w1": [], "w2": [], "item": [], "ahead": [],
                  "behind": []}
         step = 1.0 / (n_positions * g.contact_ratio)          # roll advance per phase
@@ -366,8 +343,9 @@ class _Sweep:
                     if contact is None:
                         from twin.degradation.ltca import contact_for
                         contact = contact_for(g)
-                    d1, d2 = state.deviations()
-                    sep, _ = contact.gap(xc, pair.x, FlankDamage.of(xi, pinion_depth=d1, gear_depth=d2))
+                    if flanks is None:
+                        flanks = FlankWear.damage(state)
+                    sep, _ = contact.gap(xc, pair.x, flanks)
                     centroid = float(pair.x[int(np.argmin(sep))])
                     width = pair.width
                     x, q = np.array([centroid]), np.array([1.0])
@@ -402,14 +380,13 @@ class _Sweep:
         d1 = np.zeros((xi.size, n_items))
         d2 = np.zeros((xi.size, n_items))
         if n_items:
-            ends = cat["ahead"], cat["behind"]
-            o1 = _cell_mean(u1, lambda v: _overlap(v, cat["c1"], cat["a"], cat["s1"], *ends, 1.0)) * cat["w1"][None, :]
-            o2 = _cell_mean(u2, lambda v: _overlap(v, cat["c2"], cat["a"], cat["s2"], *ends, -1.0)) * (
-                cat["w2"][None, :] * g.z1 / g.z2)
-            for col in range(n_items):
-                sel = item == col
-                d1[:, col] = o1[:, sel].sum(axis=1)
-                d2[:, col] = o2[:, sel].sum(axis=1)
+            # each cell's pressure swept past the flank points, as the mean over the flank
+            # stretch each grid point stands for (the grid is coarser than the contact at the
+            # tips; :func:`twin.degradation._wear_kernels.deposit_matrix`)
+            d1 = deposit_matrix(u1, cat["c1"], cat["a"], cat["s1"], cat["ahead"], cat["behind"], 1.0, cat["w1"], item,
+                                n_items, _N_SUB)
+            d2 = deposit_matrix(u2, cat["c2"], cat["a"], cat["s2"], cat["ahead"], cat["behind"], -1.0,
+                                cat["w2"] * (g.z1 / g.z2), item, n_items, _N_SUB)
         kk = np.array(kk, dtype=float)
         xi_items = np.array([p.xi for pos in cycle.positions for p in pos.pairs])
         known = np.isfinite(kk)
@@ -437,7 +414,7 @@ class _Sweep:
         press1 = _interp_rows(xi, un["xi1"], un["w"], rows, n_items)
         press2 = _interp_rows(xi, un["xi2"], un["w"], rows, n_items)
         return cls(d1, d2, f0, 1.0 / ref, np.array(e0), press1, press2, kk, np.array(phase),
-                   len(cycle.positions), cycle.force, scale, np.ones(n_items, dtype=bool))
+                   len(cycle.positions), cycle.force, scale)
 
 
 def _interp_rows(grid: np.ndarray, points: np.ndarray, weight: np.ndarray, rows: np.ndarray, n_rows: int) -> np.ndarray:
@@ -454,53 +431,3 @@ def _interp_rows(grid: np.ndarray, points: np.ndarray, weight: np.ndarray, rows:
 def _contact_of(geometry: GearPair):
     from twin.degradation.ltca import contact_for
     return contact_for(geometry)
-
-
-def _cell_mean(u: np.ndarray, field, n_sub: int = 4) -> np.ndarray:
-    """Mean of ``field(v)`` (v (m,) -> (m, c)) over the flank stretch each grid point stands for
-    (halfway to its neighbours), (n, c).  The grid is coarser than the contact at the tips (tens
-    of um against a Hertz half-width of some 10-30 um at light load): point samples would give a
-    feature narrower than the contact the width of a grid step."""
-    mid = 0.5 * (u[1:] + u[:-1])
-    lo = np.concatenate([u[:1], mid])
-    hi = np.concatenate([mid, u[-1:]])
-    frac = (np.arange(n_sub) + 0.5) / n_sub
-    v = lo[:, None] + frac[None, :] * (hi - lo)[:, None]            # (n, n_sub)
-    out = field(v.ravel())
-    return out.reshape(u.size, n_sub, -1).mean(axis=1)
-
-
-def _overlap(u: np.ndarray, centre: np.ndarray, half: np.ndarray, sweep: np.ndarray, ahead: np.ndarray,
-             behind: np.ndarray, direction: float) -> np.ndarray:
-    """(n, c): int w_c(s) 1[|u - centre_c - s| < half_c] ds, the time-weighted coverage of flank
-    points u by cell c while the contact sweeps past.
-
-    Mesh phase m stands for the pressure while the contact moves by one step h_c = 2 sweep_c on
-    either side; the pressure is taken piecewise linear between consecutive phases, so each
-    phase's cell weighs the sweep with a hat 1 - |s| / h_c (peak 1 at the phase), not a box: the
-    deposit is then continuous with a continuous slope instead of a staircase of the phase step.
-    Where the pair enters or leaves the path of contact within that step there is no phase
-    beyond to interpolate to: the pair carries its pressure up to the end of the path and none
-    after, so on that side the weight is a box of length ``ahead_c h_c`` (towards the end of
-    the path, in the direction ``direction`` = +1 or -1 of u as the roll grows) or
-    ``behind_c h_c`` (towards its start) instead of the ramp.  ``ahead``/``behind`` >= 1 keep
-    the ramp."""
-    t = u[:, None] - centre[None, :]
-    a, h = half[None, :], 2.0 * sweep[None, :]
-    lo, hi = t - a, t + a
-    # s measured along the roll direction: the forward side is s * direction > 0
-    fwd_box, bwd_box = ahead[None, :] < 1.0, behind[None, :] < 1.0
-    if direction > 0:
-        f_lo, f_hi, b_lo, b_hi = lo, hi, lo, hi
-    else:                                   # mirror: forward in roll is -u
-        f_lo, f_hi, b_lo, b_hi = -hi, -lo, -hi, -lo
-    f_end = np.where(fwd_box, ahead[None, :] * h, h)
-    b_end = np.where(bwd_box, behind[None, :] * h, h)
-    # forward side, s in [0, f_end]
-    x0, x1 = np.maximum(f_lo, 0.0), np.minimum(f_hi, f_end)
-    ramp = lambda x: x - x * x / (2.0 * h)                                      # noqa: E731
-    fwd = np.where(x1 > x0, np.where(fwd_box, x1 - x0, ramp(x1) - ramp(x0)), 0.0)
-    # backward side, s' = -s in [0, b_end]
-    y0, y1 = np.maximum(-b_hi, 0.0), np.minimum(-b_lo, b_end)
-    bwd = np.where(y1 > y0, np.where(bwd_box, y1 - y0, ramp(y1) - ramp(y0)), 0.0)
-    return fwd + bwd
