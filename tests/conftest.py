@@ -36,6 +36,13 @@ def casing_fmu(fmu_dir) -> Path:
 
 
 @pytest.fixture(scope="session")
+def shafts_fmu(fmu_dir) -> Path:
+    """The casing model with shafts that bend, from their geometry (GearTwin.Gearbox21Shafts)."""
+    from fmu_build import build_fmu
+    return build_fmu("GearTwin.Gearbox21Shafts", MODELICA, fmu_dir)
+
+
+@pytest.fixture(scope="session")
 def wheel_fmu(fmu_dir) -> Path:
     """The variant with the gear's own tooth errors (GearTwin.Variants.Gearbox21WheelErrors)."""
     from fmu_build import build_fmu

@@ -7,12 +7,16 @@ share of the mode's kinetic energy; the part with the largest share names the mo
 | class | degrees of freedom (velocity states) | mass |
 |---|---|---|
 | ``torsion`` | ``omegaN`` | ``IN`` |
-| ``pinion lateral x`` / ``y`` | ``vx5`` / ``vy5`` | ``m5`` |
-| ``gear lateral x`` / ``y`` | ``vx10`` / ``vy10`` | ``m10`` |
+| ``pinion lateral x`` / ``y`` | ``vx5`` / ``vy5``: the pinion on its shaft | ``m5`` |
+| ``gear lateral x`` / ``y`` | ``vx10`` / ``vy10``: the gear on its shaft | ``m10`` |
 | ``input pedestals x`` / ``y`` | ``vx4``, ``vx6`` / ``vy4``, ``vy6`` | ``m4``, ``m6`` |
 | ``output pedestals x`` / ``y`` | ``vx9``, ``vx11`` / ``vy9``, ``vy11`` | ``m9``, ``m11`` |
 | ``casing`` | ``vx_casing``, ``vy_casing`` / ``w_casing`` (GearTwin.Gearbox21Casing); ``casing.qd[k]`` (a modal casing) | ``m_casing`` / ``I_casing``; 1 (modal states carry sqrt of the modal mass) |
 | ``sensor path`` | a sensor's panel or mount modes (massless: only when nothing else moves) | |
+
+In GearTwin.Gearbox21Shafts the shaft bends under its gear and its mass moves with it: the shaft
+lateral modes are the ``pinion lateral`` and ``gear lateral`` classes, and ``m5``, ``m10`` (gear body
+plus the shaft's share) are calculated parameters, read after initialisation (:func:`mass_values`).
 
 A mode whose energy is split (a torsional mode that drags the pinion sideways through the mesh)
 carries every share, so a calibration can ask "mostly lateral?" as well as "which class?".
@@ -118,7 +122,12 @@ def classify(shapes: np.ndarray, table: Sequence[tuple[int, str, float]]) -> lis
 
 
 def mass_values(fmu_path, parameters: Mapping[str, float]) -> dict[str, float]:
-    """Masses and inertias of the model (``I*``, ``m*`` parameters) at ``parameters``."""
+    """Masses and inertias of the model (``I*``, ``m*`` parameters) at ``parameters``.
+
+    A mass bound to other parameters (a calculated parameter, e.g. a gear body plus its shaft's
+    share in GearTwin.Gearbox21Shafts) is read from the FMU after its initialisation with
+    ``parameters``, so it follows the geometry it is computed from.
+    """
     from pathlib import Path
 
     from twin.fmu import FMU
@@ -126,9 +135,21 @@ def mass_values(fmu_path, parameters: Mapping[str, float]) -> dict[str, float]:
     key = (str(fmu_path), Path(fmu_path).stat().st_mtime_ns)
     if key not in _STARTS:
         with FMU(fmu_path) as fmu:
-            _STARTS[key] = {v.name: float(v.start if v.start is not None else 1.0) for v in fmu.parameters
-                            if re.match(r"^(I|m)(\d+|_casing)$", v.name)}
-    return {n: float(parameters.get(n, v)) for n, v in _STARTS[key].items()}
+            starts = {v.name: float(v.start if v.start is not None else 1.0) for v in fmu.parameters
+                      if re.match(_MASS, v.name)}
+            calculated = tuple(v.name for v in fmu.variables.values()
+                               if v.causality == "calculatedParameter" and re.match(_MASS, v.name))
+        _STARTS[key] = (starts, calculated)
+    starts, calculated = _STARTS[key]
+    out = {n: float(parameters.get(n, v)) for n, v in starts.items()}
+    if calculated:
+        with FMU(fmu_path) as fmu:
+            fmu.setup(parameters={n: v for n, v in parameters.items()
+                                  if n in fmu.variables and fmu.variables[n].causality == "parameter"})
+            out.update(zip(calculated, (float(x) for x in fmu.get(list(calculated)))))
+    return out
 
 
+#: Names of mass and inertia parameters: ``I5``, ``m10``, ``m_casing``, ``I_casing``.
+_MASS = r"^(I|m)(\d+|_casing)$"
 _STARTS: dict = {}
