@@ -4,7 +4,8 @@
    inertia, a stiffness (or the mesh-stiffness scale), with bounds from physics
    (:data:`PHYSICS_BOUNDS`: masses and inertias come from the geometry to within about 30 %,
    shaft stiffnesses to within a factor 1.6, couplings, bearings and supports to within a factor
-   3-4), narrowed to the model's own ``min``/``max`` when it declares them.
+   3-4; where the model computes a shaft from its geometry, its diameter within -15/+20 % and its
+   bearing span within -20/+25 %), narrowed to the model's own ``min``/``max`` when it declares them.
 2. **Modes.** The model is linearised about the operating point (:mod:`twin.linearize`) with
    the sensor output and the mesh excitation; a model mode counts as *visible* when it makes a
    peak of the mesh-to-sensor response, the way a measured mode shows in a run-up. Measured modes
@@ -37,7 +38,12 @@ PHYSICS_BOUNDS: tuple[tuple[str, tuple[str, ...], tuple[float, float], str], ...
     ("N.m/rad", ("shaft",), (0.6, 1.6), "shaft torsional stiffness: from the diameter (d^4), within a factor 1.6"),
     ("N.m/rad", (), (1 / 3, 3.0), "coupling stiffness: catalogue values scatter by a factor 3"),
     ("N/m", ("pedestal", "ground"), (0.25, 4.0), "support stiffness: bolted joints and foundation, a factor 4"),
+    ("N/m", ("radial stiffness of bearing",), (1 / 3, 3.0), "bearing radial stiffness: clearance and preload, a factor 3"),
     ("N/m", (), (1 / 3, 3.0), "shaft-and-bearing stiffness: bearing clearance and preload, a factor 3"),
+    ("m", ("shaft diameter",), (0.85, 1.2),
+     "shaft diameter: the effective bending diameter (shoulders, keyways, the hub's stiffening), -15/+20 %"),
+    ("m", ("bearing span",), (0.8, 1.25),
+     "bearing span: where a bearing's support acts within its width and housing, -20/+25 %"),
     ("", ("calibration multiplier", "pair stiffness"), (0.6, 1.5),
      "mesh stiffness: ISO 6336 single-pair stiffness is good to about -40/+50 %"),
 )
