@@ -1,7 +1,7 @@
 """Benchmark: calibration to gearboxes the twin did not generate (rigs/pedestal, rigs/beam).
 
     python bench/calibration_rigs.py [--rigs pedestal beam] [--seeds 6 7 8 9 10] [--workers 2]
-                                     [--model GearTwin.Gearbox21Casing] [--out bench_out/calibration_rigs]
+                                     [--model GearTwin.Gearbox21Shafts] [--out bench_out/calibration_rigs]
 
 For each rig and seed: one gearbox with its base parameters scattered +-12 %
 (``Rig().scattered(seed, 0.12)``); a 2 s steady record at 20 Hz / 20 N.m and a 6 s run-up from 2 to
@@ -13,7 +13,7 @@ For each rig and seed: one gearbox with its base parameters scattered +-12 %
    Reported: how many extracted modes lie within 2 % of a rig mode (any), how many observable
    rig modes have an extracted mode within 2 %, and the errors of those pairs.
 2. ``twin calibrate`` (parameters auto, modes from the run-up, steady record for the spectrum,
-   model ``--model``, default ``GearTwin.Gearbox21Casing``). The rig's first six observable modes against the
+   model ``--model``, default ``GearTwin.Gearbox21Shafts``). The rig's first six observable modes against the
    nearest mode the calibrated twin shows at its sensor (acceptance: all within 3 %), the
    parameters left on a bound, and the wall time of modes + calibrate.
 3. The spectrum of the steady record against the twin's (default ``GearTwin.Gearbox21``, and the
@@ -198,7 +198,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--rigs", nargs="+", default=["pedestal", "beam"])
     ap.add_argument("--seeds", nargs="+", type=int, default=[6, 7, 8, 9, 10])
-    ap.add_argument("--model", default="GearTwin.Gearbox21Casing",
+    ap.add_argument("--model", default="GearTwin.Gearbox21Shafts",
                     help="the twin's model (GearTwin.Gearbox21Measured: pedestals on rigid ground)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--out", type=Path, default=REPO / "bench_out" / "calibration_rigs")
