@@ -16,14 +16,14 @@ model Gearbox21Shafts "GearTwin.Gearbox21Casing with shafts that bend: each shaf
   extends GearTwin.Gearbox21Casing(
     m5 = pinion_mass + shaft_mass_share * shaft_mass_input,
     m10 = gear_mass + shaft_mass_share * shaft_mass_output,
-    kx45 = 1 / (span_input / ((span_input - pinion_position) * bending_stiffness_input) + 1 / kx_bearing4),
-    ky45 = 1 / (span_input / ((span_input - pinion_position) * bending_stiffness_input) + 1 / ky_bearing4),
-    kx56 = 1 / (span_input / (pinion_position * bending_stiffness_input) + 1 / kx_bearing6),
-    ky56 = 1 / (span_input / (pinion_position * bending_stiffness_input) + 1 / ky_bearing6),
-    kx910 = 1 / (span_output / ((span_output - gear_position) * bending_stiffness_output) + 1 / kx_bearing9),
-    ky910 = 1 / (span_output / ((span_output - gear_position) * bending_stiffness_output) + 1 / ky_bearing9),
-    kx1011 = 1 / (span_output / (gear_position * bending_stiffness_output) + 1 / kx_bearing11),
-    ky1011 = 1 / (span_output / (gear_position * bending_stiffness_output) + 1 / ky_bearing11));
+    kx45 = 1 / (1 / ((1 - pinion_position) * bending_stiffness_input) + 1 / kx_bearing4),
+    ky45 = 1 / (1 / ((1 - pinion_position) * bending_stiffness_input) + 1 / ky_bearing4),
+    kx56 = 1 / (1 / (pinion_position * bending_stiffness_input) + 1 / kx_bearing6),
+    ky56 = 1 / (1 / (pinion_position * bending_stiffness_input) + 1 / ky_bearing6),
+    kx910 = 1 / (1 / ((1 - gear_position) * bending_stiffness_output) + 1 / kx_bearing9),
+    ky910 = 1 / (1 / ((1 - gear_position) * bending_stiffness_output) + 1 / ky_bearing9),
+    kx1011 = 1 / (1 / (gear_position * bending_stiffness_output) + 1 / kx_bearing11),
+    ky1011 = 1 / (1 / (gear_position * bending_stiffness_output) + 1 / ky_bearing11));
   // ---- Shafts (stated geometry: 25 mm steel shafts, bearings about 0.15 m apart, each gear at
   // mid-span) -------------------------------------------------------------------------------------
   parameter Real shaft_youngs_modulus(unit = "Pa", min = 0) = 2.1e11 "Young's modulus of the shaft steel";
@@ -32,13 +32,13 @@ model Gearbox21Shafts "GearTwin.Gearbox21Casing with shafts that bend: each shaf
   parameter Real d_shaft_output(unit = "m", min = 0) = 0.025 "Output shaft diameter between its bearings (effective for bending)";
   parameter Real span_input(unit = "m", min = 0) = 0.15 "Input shaft bearing span, bearing 4 to bearing 6 (between the load centres of the bearings)";
   parameter Real span_output(unit = "m", min = 0) = 0.15 "Output shaft bearing span, bearing 9 to bearing 11 (between the load centres of the bearings)";
-  parameter Real pinion_position(unit = "m", min = 0) = 0.5 * span_input "Distance of the pinion from bearing 4 along the input shaft";
-  parameter Real gear_position(unit = "m", min = 0) = 0.5 * span_output "Distance of the gear from bearing 9 along the output shaft";
+  parameter Real pinion_position(min = 0, max = 1) = 0.5 "Position of the pinion on the input shaft's span, from bearing 4 (0) to bearing 6 (1)";
+  parameter Real gear_position(min = 0, max = 1) = 0.5 "Position of the gear on the output shaft's span, from bearing 9 (0) to bearing 11 (1)";
   parameter Real pinion_mass(unit = "kg", min = 0) = 0.6 "Pinion body (without the shaft)";
   parameter Real gear_mass(unit = "kg", min = 0) = 3.5 "Gear body (without the shaft)";
   parameter Real shaft_mass_share = 17 / 35 "Share of a shaft's mass that moves with a mid-span gear (Rayleigh, simply supported)";
-  parameter Real bending_stiffness_input(unit = "N/m", min = 0) = 3 * shaft_youngs_modulus * (GearTwin.pi * d_shaft_input ^ 4 / 64) * span_input / (pinion_position ^ 2 * (span_input - pinion_position) ^ 2) "Bending stiffness of the input shaft under the pinion (simply supported)";
-  parameter Real bending_stiffness_output(unit = "N/m", min = 0) = 3 * shaft_youngs_modulus * (GearTwin.pi * d_shaft_output ^ 4 / 64) * span_output / (gear_position ^ 2 * (span_output - gear_position) ^ 2) "Bending stiffness of the output shaft under the gear (simply supported)";
+  parameter Real bending_stiffness_input(unit = "N/m", min = 0) = 3 * shaft_youngs_modulus * (GearTwin.pi * d_shaft_input ^ 4 / 64) / (span_input ^ 3 * pinion_position ^ 2 * (1 - pinion_position) ^ 2) "Bending stiffness of the input shaft under the pinion (simply supported)";
+  parameter Real bending_stiffness_output(unit = "N/m", min = 0) = 3 * shaft_youngs_modulus * (GearTwin.pi * d_shaft_output ^ 4 / 64) / (span_output ^ 3 * gear_position ^ 2 * (1 - gear_position) ^ 2) "Bending stiffness of the output shaft under the gear (simply supported)";
   parameter Real shaft_mass_input(unit = "kg", min = 0) = shaft_density * GearTwin.pi * d_shaft_input ^ 2 / 4 * span_input "Mass of the input shaft over its span";
   parameter Real shaft_mass_output(unit = "kg", min = 0) = shaft_density * GearTwin.pi * d_shaft_output ^ 2 / 4 * span_output "Mass of the output shaft over its span";
   // ---- Bearings (25 mm bore deep-groove ball bearings, about 1.5e8 N/m radially under a light

@@ -33,6 +33,13 @@ def test_the_springs_are_the_beam_in_series_with_the_bearings(shafts_fmu):
     assert v["ky45"] + v["ky56"] == pytest.approx(1 / (1 / bend_in + 1 / 4.0e8), rel=1e-9)
     bend_out = 48 * E * math.pi * 0.03 ** 4 / 64 / 0.14 ** 3
     assert v["kx910"] + v["kx1011"] == pytest.approx(1 / (1 / bend_out + 1 / 3.0e8), rel=1e-9)
+    # off-centre: the beam under a point load at a = 0.3 L, k = 3 E I L / (a^2 b^2), split by the
+    # bearings' shares of the load (b/L to bearing 4, a/L to bearing 6)
+    off = _values(shafts_fmu, {**p, "pinion_position": 0.3})
+    L, a, b = 0.16, 0.3 * 0.16, 0.7 * 0.16
+    bend = 3 * E * math.pi * 0.024 ** 4 / 64 * L / (a * a * b * b)
+    assert off["kx45"] == pytest.approx(1 / (L / (b * bend) + 1 / 1.0e8), rel=1e-9)
+    assert off["kx56"] == pytest.approx(1 / (L / (a * bend) + 1 / 3.0e8), rel=1e-9)
     # the shaft's mass moves with its gear (Rayleigh share 17/35 at mid-span)
     assert v["m5"] == pytest.approx(0.6 + 17 / 35 * rho * math.pi * 0.024 ** 2 / 4 * 0.16, rel=1e-9)
     assert v["m10"] == pytest.approx(3.5 + 17 / 35 * rho * math.pi * 0.03 ** 2 / 4 * 0.14, rel=1e-9)
@@ -48,6 +55,7 @@ def test_the_geometry_is_calibratable_within_physical_bounds(shafts_fmu):
     assert cands["span_output"].lower == pytest.approx(0.8 * 0.15)
     assert cands["ky_bearing11"].reason.startswith("bearing radial stiffness")
     assert {"pinion_mass", "gear_mass", "kx_bearing4"} <= set(cands)
+    assert "pinion_position" not in cands          # at mid-span it moves no mode to first order
 
 
 def _lateral(mm, cls):
