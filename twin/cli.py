@@ -405,11 +405,29 @@ def _executor(workers):
     return _lib("twin.executor").make_executor({"type": "local", "workers": workers})
 
 
+def _effects_argument(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--effects", metavar="ID,ID", help="the candidate effects tried, comma-separated catalogue ids "
+                                                      "(default: every one the model lacks; see twin effects)")
+
+
+def _effect_ids(text: str | None) -> list[str] | None:
+    """``--effects a,b``: the catalogue ids tried (None: all); an unknown id is refused by name."""
+    if text is None:
+        return None
+    ids = [e.strip() for e in text.split(",") if e.strip()]
+    effects = _lib("twin.effects")
+    for e in ids:
+        effects.effect(e)
+    if not ids:
+        raise _lib("twin.errors").ParameterError(f"--effects names no effect: {text!r}")
+    return ids
+
+
 def _cmd_diagnose(args: argparse.Namespace) -> int:
     scenario = _lib("twin.scenario").load_scenario(Path(args.scenario))
     diag = _lib("twin.effects.loop").diagnose_scenario(scenario, Path(args.measurements), record=args.record,
                                                        json_path=args.json, executor=_executor(args.workers),
-                                                       duration=args.duration)
+                                                       duration=args.duration, effects=_effect_ids(args.effects))
     print(diag.table())
     for c in diag.candidates[:1]:
         for e in c.evidence:
@@ -440,7 +458,8 @@ def _cmd_improve(args: argparse.Namespace) -> int:
     loop = _lib("twin.effects.loop")
     history = loop.improve(scenario, Path(args.measurements), Path(args.out), record=args.record,
                            max_steps=args.max_steps, executor=_executor(args.workers),
-                           modelica_dir=args.modelica_dir, duration=args.duration)
+                           modelica_dir=args.modelica_dir, duration=args.duration,
+                           effects=_effect_ids(args.effects))
     print(loop.history_table(history))
     print(f"history -> {Path(args.out) / 'history.csv'}, plot -> {Path(args.out) / 'history.png'}")
     return 0
@@ -678,6 +697,7 @@ def build_parser() -> argparse.ArgumentParser:
     _loop_arguments(p, out=False)
     p.add_argument("--json", type=Path, help="write the diagnosis here")
     p.add_argument("--workers", type=_positive_int, help="local worker processes (default: one per core)")
+    _effects_argument(p)
     p.set_defaults(handler=_cmd_diagnose)
 
     p = sub.add_parser("add-effect", help="write a model variant with an effect, build it, recalibrate, report")
@@ -689,6 +709,7 @@ def build_parser() -> argparse.ArgumentParser:
     _loop_arguments(p, out=True)
     p.add_argument("--max-steps", type=int, default=4)
     p.add_argument("--workers", type=_positive_int, help="local worker processes (default: one per core)")
+    _effects_argument(p)
     p.set_defaults(handler=_cmd_improve)
 
     p = sub.add_parser("effects", help="list the effect catalogue")

@@ -12,6 +12,7 @@
 from __future__ import annotations
 
 import json
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -45,8 +46,12 @@ def _out_dir(out) -> Path:
 
 
 def diagnose_scenario(scenario, measurements, *, record: str | None = None, json_path=None, executor=None,
-                      duration: float = 2.0, progress: bool = True, candidates_fmu=None) -> Diagnosis:
-    """``twin diagnose``: the scenario's model against one record; writes ``json_path`` if given."""
+                      duration: float = 2.0, progress: bool = True, candidates_fmu=None,
+                      effects: Sequence[str] | None = None) -> Diagnosis:
+    """``twin diagnose``: the scenario's model against one record; writes ``json_path`` if given.
+
+    ``effects``: the candidate ids tried (default: every catalogue effect the model lacks).
+    """
     from twin.errors import OutputPathError
     if json_path is not None and not Path(json_path).parent.exists():
         raise OutputPathError(f"parent directory of {json_path} does not exist")
@@ -54,7 +59,7 @@ def diagnose_scenario(scenario, measurements, *, record: str | None = None, json
     rec = read_record(measurements, channel, record)
     diag = diagnose(scenario.fmu_path(), rec.signal, rec.sample_rate, rec.nominal_speed, rec.load,
                     parameters=dict(scenario.parameters), channel=channel, executor=executor, record=rec.name,
-                    duration=duration, progress=progress, candidates_fmu=candidates_fmu,
+                    duration=duration, progress=progress, candidates_fmu=candidates_fmu, effects=effects,
                     anchors=(scenario.raw or {}).get("diagnosis", {}).get("calibrated", {}))
     if json_path is not None:
         _write_json(Path(json_path), {"scenario": scenario.name, "measurements": str(measurements),
@@ -221,14 +226,18 @@ class Step:
 
 
 def improve(scenario, measurements, out_dir, *, record: str | None = None, max_steps: int = 4, executor=None,
-            modelica_dir=None, build_dir=None, duration: float = 2.0, progress: bool = True) -> tuple[Step, ...]:
-    """``twin improve``: diagnose -> add -> recalibrate until no candidate improves the fit."""
+            modelica_dir=None, build_dir=None, duration: float = 2.0, progress: bool = True,
+            effects: Sequence[str] | None = None) -> tuple[Step, ...]:
+    """``twin improve``: diagnose -> add -> recalibrate until no candidate improves the fit.
+
+    ``effects``: the candidate ids tried at each step (default: the whole catalogue).
+    """
     from twin.scenario import load_scenario
     out = _out_dir(out_dir)
     history: list[Step] = []
     for k in range(1, max_steps + 1):
         diag = diagnose_scenario(scenario, measurements, record=record, executor=executor, duration=duration,
-                                 progress=progress, json_path=out / f"diagnosis_{k}.json")
+                                 progress=progress, json_path=out / f"diagnosis_{k}.json", effects=effects)
         if diag.verdict != "missing_effect":
             history.append(Step(k, None, diag.lsd_db, diag.lsd_db, scenario.fmu, diag.verdict))
             break

@@ -16,13 +16,19 @@ from twin.effects.synthetic import OUT_OF_CATALOGUE_HZ, calibrate_base, make_cas
 # checked below where it must not be blamed. The whole catalogue, over several seeds, is
 # `bench/effects.py` (BENCHMARKS.md); running all of it here took about half of the suite's time.
 OBSERVABLE = ["gear_eccentricity", "motor_torque_ripple"]
+# The candidates tried here: each observable effect with the ones most easily mistaken for it (the
+# other shaft's eccentricity, a tooth fault's shaft-order sidebands, the other torque line, and the
+# flexible housing mode that absorbs what the base model gets wrong).  The whole catalogue is tried
+# in `bench/effects.py`; trying all nine here doubled these tests' time.
+SHORTLIST = ["pinion_eccentricity", "gear_eccentricity", "motor_torque_ripple", "load_torque_fluctuation",
+             "housing_mode", "local_tooth_damage"]
 
 
-def _diagnose(effect, gearbox_fmu, candidates_fmu, executor, seed=0, **conditions):
+def _diagnose(effect, gearbox_fmu, candidates_fmu, executor, seed=0, effects=SHORTLIST, **conditions):
     case = make_case(effect, seed, candidates_fmu=candidates_fmu, **conditions)
     params = calibrate_base(case, gearbox_fmu)
     return diagnose(gearbox_fmu, case.signal, case.sample_rate, case.nominal_speed, case.load, parameters=params,
-                    candidates_fmu=candidates_fmu, executor=executor, duration=case.duration)
+                    candidates_fmu=candidates_fmu, executor=executor, duration=case.duration, effects=effects)
 
 
 @pytest.mark.slow
@@ -57,5 +63,6 @@ def test_backlash_that_never_acts_is_not_blamed_on_another_effect(gearbox_fmu, c
     flanks stay close enough that a 10 um clearance is never crossed, and the hidden backlash
     leaves no trace (its light-load case above is where it shows); the diagnosis must then not
     invent a different effect."""
-    d = _diagnose("backlash", gearbox_fmu, candidates_fmu, executor, load=20.0, duration=2.0)
+    d = _diagnose("backlash", gearbox_fmu, candidates_fmu, executor, load=20.0, duration=2.0,
+                  effects=["backlash", "distributed_wear", "tooth_friction", "housing_mode", "local_tooth_damage"])
     assert d.missing in (None, "backlash"), d.table()
