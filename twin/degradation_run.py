@@ -14,8 +14,15 @@ At each update (stage):
    increment reaches ``max_increment`` (default 3 um of wear depth or 0.01 of pitting
    density), so the load is re-sampled as often as the damage needs;
 4. turn the damage into the FMU's mesh parameters (``k_pair``, ``profile_deviation`` on the
-   FMU's ``n_profile`` nodes) and set them on the FMU, so the next window runs on the
-   degraded mesh.
+   FMU's ``n_profile`` nodes; for pitting ``pit_profile`` x ``tooth_pit_scale``) and set them on
+   the FMU, so the next window runs on the degraded mesh.  The part of the pits' per-tooth field
+   those arrays cannot hold goes into the pinion's broadband roughness,
+   ``pinion_roughness.rms = sqrt(rms0^2 + residual_rms^2)`` with rms0 the scenario's (calibrated)
+   value (:mod:`twin.degradation.pitting_map`), on a model that has that parameter; on one that has
+   none (``GearTwin.Gearbox21``) it is skipped and only its size is recorded (the stage's
+   ``truncation_error["pit_residual_rms"]`` [m], on every model).  Wear has no such term: its
+   flanks are alike on every tooth, so its node-fit residual repeats at every mesh (mesh
+   harmonics, not random-phase shaft orders) and is reported as a truncation error only.
 
 The run stops on the scenario's criterion (pitting density, wear depth or cycles) or after
 ``max_updates``.  After every stage the stages so far are rewritten atomically to
@@ -143,7 +150,8 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
     from twin import _interrupt
     from twin._atomic import partial_path
     from twin.degradation import GearPair, MeshLoad, TransmittedLoad, mesh_parameters
-    from twin.degradation.pitting_map import ToothScatter, pitting_parameters
+    from twin.degradation.pitting_map import (PINION_ROUGHNESS, ToothScatter, pitting_parameters,
+                                              roughness_with_residual)
     from twin.plausibility import check_block, check_parameters
 
     spec = scenario.degradation
@@ -178,6 +186,10 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
         k_healthy = tuple(scenario.parameters.get(f"k_pair[{i}]", fmu.variable(f"k_pair[{i}]").start)
                           for i in range(1, n_nodes + 1))
         state = model.initial_state(geometry)
+        # the pinion roughness that carries the pits' residual, undamaged: the scenario's value
+        # (a calibrated one), else the model's; None when the model has no such parameter
+        rough0 = (float(scenario.parameters.get(PINION_ROUGHNESS, fmu.variable(PINION_ROUGHNESS).start))
+                  if model_name == "pitting" and PINION_ROUGHNESS in fmu.variables else None)
         scatter = ToothScatter.draw(geometry.z1, float(spec.get("tooth_scatter", DEFAULT_TOOTH_SCATTER)),
                                     scenario.seed) if model_name == "pitting" else None
         source = next((p for p in (partial, path) if p is not None and p.exists()), None) if resume else None
@@ -231,6 +243,8 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
                     current.update({f"pit_profile[{i}]": fmu.get(f"pit_profile[{i}]") for i in range(1, n_nodes + 1)})
                     current.update({f"tooth_pit_scale[{j}]": fmu.get(f"tooth_pit_scale[{j}]")
                                     for j in range(1, geometry.z1 + 1)})
+                    if rough0 is not None:
+                        current[PINION_ROUGHNESS] = fmu.get(PINION_ROUGHNESS)
                 trunc = stages[-1].truncation_error if stages else {}
                 gear = np.asarray(state.gear_depth) if model_name == "wear" else None
                 stages.append(Stage(u, float(state.cycles), damage, dmax, current, np.asarray(xi), np.asarray(fld),
@@ -253,8 +267,11 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
                 else:
                     mapped = pitting_parameters(geometry, state, force, k_healthy, scatter=scatter,
                                                 weibull_slope=model.m)
-                    new, trunc_error = mapped.parameters, {"k_pair": mapped.truncation_error,
-                                                           "pit_profile": mapped.pit_truncation_error}
+                    new, trunc_error = dict(mapped.parameters), {"k_pair": mapped.truncation_error,
+                                                                 "pit_profile": mapped.pit_truncation_error,
+                                                                 "pit_residual_rms": mapped.residual_rms}
+                    if rough0 is not None:
+                        new[PINION_ROUGHNESS] = roughness_with_residual(rough0, mapped.residual_rms)
                 fmu.set(new)
                 stages[-1] = Stage(**{**stages[-1].__dict__, "truncation_error": trunc_error})
             else:

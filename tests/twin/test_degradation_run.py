@@ -34,10 +34,26 @@ def test_pitting_grows_and_lowers_mesh_stiffness(gearbox_fmu, tmp_path):
     profile = np.array([last.parameters[f"pit_profile[{i}]"] for i in range(1, 12)])
     scale = np.array([last.parameters[f"tooth_pit_scale[{j}]"] for j in range(1, 20)])
     assert np.any(profile != 0) and np.ptp(scale) > 0
-    assert set(last.truncation_error) >= {"k_pair", "pit_profile"}
+    assert set(last.truncation_error) >= {"k_pair", "pit_profile", "pit_residual_rms"}
+    # GearTwin.Gearbox21 has no broadband roughness: the residual is recorded, not set
+    assert last.truncation_error["pit_residual_rms"] > 0
+    assert not any(k.startswith("pinion_roughness") for s in run.stages for k in s.parameters)
     with h5py.File(tmp_path / "lub.h5") as f:
         assert f.attrs["complete"] and f.attrs["model"] == "pitting"
         assert len(f["stages"]) == len(run.stages)
+
+
+def test_the_pits_residual_grows_the_pinion_roughness(measured_fmu):
+    # the model with a broadband flank roughness carries the pits' residual in it, in quadrature
+    sc = _lubricated(stop=0.02)
+    sc = sc.with_overrides(fmu="GearTwin.Gearbox21Measured", parameters={**sc.parameters, "pinion_roughness.rms": 4e-8})
+    run = run_degradation(sc, None, fmu_path=measured_fmu, progress=False)
+    rms = [s.parameters["pinion_roughness.rms"] for s in run.stages]
+    assert rms[0] == pytest.approx(4e-8, rel=1e-12)          # no damage: the calibrated value
+    for before, after in zip(run.stages, run.stages[1:]):
+        expected = np.hypot(4e-8, before.truncation_error["pit_residual_rms"])
+        assert after.parameters["pinion_roughness.rms"] == pytest.approx(expected, rel=1e-9)
+    assert rms[-1] > 4e-8
 
 
 def test_wear_moves_the_profile(gearbox_fmu):

@@ -39,6 +39,24 @@ times one scale per tooth (``pit_profile[1..n]`` [m] x ``tooth_pit_scale[1..z1]`
 singular pair of the (z1, N) field e_j(xi)); the rank-1 residual is reported as a truncation
 error.  ``tooth_stiffness_factor`` is left to the scenario (it is no longer written).
 
+**What the arrays cannot hold.**  The residual r_j(xi) of that fit (pits at different places on
+different teeth: 45-70 % of the field's norm) is not dropped.  It is a transmission error that
+differs from tooth to tooth and along the path with no common shape, so over a pinion revolution it
+is a sum of many shaft orders, and, as the pits' places are random, with random phases: the same
+kind of excitation as the flank roughness of the pinion.  :attr:`PittingMap.residual_rms` is its
+RMS over the teeth and the (uniform-in-time) roll positions, and a model with a broadband roughness
+transmission error of the pinion (``pinion_roughness.rms``, GearTwin.Excitation.
+RoughnessTransmissionError) carries it there, added in quadrature to the calibrated roughness:
+``rms = sqrt(rms0^2 + residual_rms^2)`` (:func:`roughness_with_residual`; independent random-phase
+sums add their powers).  The residual is that of a single pair's approach, so where two pairs
+share the load it overstates the transmission error somewhat.  The roughness block holds shaft orders
+8..264 with amplitudes falling as 1/n.  A 0.5 mm pit on the 19-tooth pinion's pitch circle (180 mm
+round) spans 1/360 of a revolution, so a single pit's edges reach about order 360; but the field
+e_j(xi) is resolved by 41 roll positions over the path of contact (contact ratio ~1.6 of the 19
+pitches), i.e. up to about order 20 / (1.6 / 19) = 240, inside the block's range.  The block is not
+widened: what the field resolves fits in it, and its order range is part of every calibrated
+model (the level calibration fits its spectral shape).
+
 For a contact whose pitted fraction is uniform across the contact width, the LTCA's cells all
 carry their force on ``L (1 - D)``: the contact is that of a modulus ``E* (1 - D)``, wider by
 ``1 / sqrt(1 - D)``, and its compliance is exactly ``(c_contact + ln(1 - D) / (pi E* L)) / (1 - D)``
@@ -124,6 +142,7 @@ class PittingMap:
     xi : (N,) roll positions.
     truncation_error : max |k(xi) - interp(nodes)(xi)| / k_healthy(xi).
     pit_truncation_error : ||e - scale x interp(pit_profile)|| / ||e|| (rank-1 and node fit; 0 if e = 0).
+    residual_rms : RMS of that residual over the teeth and xi [m] (module docstring).
     """
 
     parameters: dict
@@ -135,6 +154,22 @@ class PittingMap:
     xi: np.ndarray
     truncation_error: float
     pit_truncation_error: float
+    residual_rms: float = 0.0
+
+
+#: The model parameter that carries the pits' residual: the pinion flanks' roughness RMS [m].
+PINION_ROUGHNESS = "pinion_roughness.rms"
+
+
+def roughness_with_residual(rms0: float, residual_rms: float) -> float:
+    """Roughness RMS [m] carrying the pits' residual: sqrt(rms0^2 + residual_rms^2).
+
+    Both are random-phase sums of shaft orders of the same gear, independent of each other, so their
+    powers add.  ``rms0`` is the model's undamaged (calibrated) roughness RMS."""
+    for name, v in (("rms0", rms0), ("residual_rms", residual_rms)):
+        if not (isinstance(v, (int, float, np.floating)) and math.isfinite(v) and v >= 0):
+            raise ParameterError(f"{name} must be a finite number >= 0 m, got {v!r}")
+    return float(math.hypot(rms0, residual_rms))
 
 
 def pitting_parameters(geometry: GearPair, pitting: PittingState, force: float, k_pair_healthy,
@@ -201,10 +236,11 @@ def pitting_parameters(geometry: GearPair, pitting: PittingState, force: float, 
     # the differences between the teeth: their mean is the law's typical tooth, which k_pair
     # carries (the cells' mean departs from it only by their sampling of D(xi))
     deviation = extra - np.mean(extra, axis=0)[None, :]
-    profile, scale, pit_err = _rank_one(deviation, xi, n_nodes)
+    profile, scale, pit_err, residual = _rank_one(deviation, xi, n_nodes)
     params.update({f"pit_profile[{i}]": float(v) for i, v in enumerate(profile, start=1)})
     params.update({f"tooth_pit_scale[{j}]": float(v) for j, v in enumerate(scale, start=1)})
-    return PittingMap(params, dc, dc_tooth, deviation, share, depth, xi, err, pit_err)
+    return PittingMap(params, dc, dc_tooth, deviation, share, depth, xi, err, pit_err,
+                      float(np.sqrt(np.mean(residual ** 2))))
 
 
 def pitted_share(geometry: GearPair, pitting: PittingState, scatter: ToothScatter, xi, pair_force) -> np.ndarray:
@@ -230,13 +266,14 @@ def pitted_share(geometry: GearPair, pitting: PittingState, scatter: ToothScatte
     return face_share @ overlap.T
 
 
-def _rank_one(field: np.ndarray, xi: np.ndarray, n_nodes: int) -> tuple[np.ndarray, np.ndarray, float]:
+def _rank_one(field: np.ndarray, xi: np.ndarray, n_nodes: int):
     """Node profile (n_nodes,) [m] and per-tooth scales (z1,) of the leading singular pair of
-    ``field`` (z1, N) on ``xi``, the scales' largest magnitude 1; and the relative residual."""
+    ``field`` (z1, N) on ``xi``, the scales' largest magnitude 1; the relative residual; and the
+    residual field (z1, N) [m]."""
     from twin.degradation._nodes import hat_matrix
     norm = float(np.linalg.norm(field))
     if norm == 0.0:
-        return np.zeros(n_nodes), np.zeros(field.shape[0]), 0.0
+        return np.zeros(n_nodes), np.zeros(field.shape[0]), 0.0, np.zeros_like(field)
     u, s, vt = np.linalg.svd(field, full_matrices=False)
     big = float(np.max(np.abs(u[:, 0])))
     scale, shape = u[:, 0] / big, vt[0] * s[0] * big
@@ -245,7 +282,7 @@ def _rank_one(field: np.ndarray, xi: np.ndarray, n_nodes: int) -> tuple[np.ndarr
     basis = hat_matrix(xi, n_nodes)
     profile = np.linalg.lstsq(basis, shape, rcond=None)[0]
     residual = field - scale[:, None] * (basis @ profile)[None, :]
-    return profile, scale, float(np.linalg.norm(residual) / norm)
+    return profile, scale, float(np.linalg.norm(residual) / norm), residual
 
 
 def pitted_contact_compliance(geometry: GearPair, contact_compliance, pitted):

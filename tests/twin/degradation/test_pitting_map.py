@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from twin.degradation import HEALTHY_K_PAIR, FatiguePitting, GearPair, MeshLoad
-from twin.degradation.pitting_map import ToothScatter, gear_density, pitting_parameters
+from twin.degradation.pitting_map import (ToothScatter, gear_density, pitting_parameters,
+                                          roughness_with_residual)
 from twin.errors import ParameterError
 
 G = GearPair()
@@ -34,6 +35,7 @@ def test_no_pits_leaves_the_mesh_healthy():
     np.testing.assert_allclose(_k(m.parameters), HEALTHY_K_PAIR, rtol=1e-12)
     profile, scale = _pits(m.parameters)
     assert np.all(profile == 0) and np.all(scale == 0)
+    assert m.residual_rms == 0.0
     assert not any(k.startswith("tooth_stiffness_factor") for k in m.parameters)
 
 
@@ -68,6 +70,32 @@ def test_teeth_pit_in_discrete_cells(pitted):
     resid = np.linalg.norm(m.tooth_deviation - approx) / np.linalg.norm(m.tooth_deviation)
     assert resid == pytest.approx(m.pit_truncation_error, rel=1e-9) and resid < 1
     assert np.max(np.abs(scale)) == pytest.approx(1.0)
+    # what the arrays cannot hold is kept as an RMS [m], for the pinion's broadband roughness
+    rms = np.sqrt(np.mean((m.tooth_deviation - approx) ** 2))
+    assert m.residual_rms == pytest.approx(rms, rel=1e-9) and m.residual_rms > 0
+
+
+def test_the_residual_rms_of_a_hand_made_field():
+    from twin.degradation._nodes import hat_matrix
+    from twin.degradation.pitting_map import _rank_one
+    xi = np.linspace(0.0, 1.0, 41)
+    # a shape the 11 nodes hold exactly on 19 teeth, and a smaller field orthogonal to it in both
+    # the teeth and the roll: the fit keeps the first, the residual is exactly the second
+    shape = hat_matrix(xi, 11) @ np.array([0, 1, 3, 2, 4, 6, 5, 3, 2, 1, 0], dtype=float) * 1e-6
+    teeth = np.linspace(-1.0, 1.0, 19)
+    other_xi = np.cos(2 * np.pi * 7 * xi)
+    other_xi -= shape * (other_xi @ shape) / (shape @ shape)
+    other_teeth = np.where(np.arange(19) % 2 == 0, 1.0, -1.0)
+    other_teeth -= teeth * (other_teeth @ teeth) / (teeth @ teeth)
+    small = 0.2e-6 * np.outer(other_teeth, other_xi) / np.sqrt(np.mean(np.outer(other_teeth, other_xi) ** 2))
+    profile, scale, rel, residual = _rank_one(np.outer(teeth, shape) + small, xi, 11)
+    np.testing.assert_allclose(residual, small, atol=1e-12)
+    assert np.sqrt(np.mean(residual ** 2)) == pytest.approx(0.2e-6, rel=1e-6)
+    # independent random-phase sums add their powers
+    assert roughness_with_residual(0.3e-6, 0.4e-6) == pytest.approx(0.5e-6)
+    assert roughness_with_residual(5e-8, 0.0) == 5e-8
+    with pytest.raises(ParameterError, match="residual_rms"):
+        roughness_with_residual(5e-8, float("nan"))
 
 
 def test_pits_grow_where_they_started():
