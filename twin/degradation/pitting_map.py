@@ -227,12 +227,17 @@ def pitting_parameters(geometry: GearPair, pitting: PittingState, force: float, 
     # the tooth's pits, the typical gear flank's (the gear teeth meet every pinion tooth in turn)
     intact_typ = (1.0 - d_xi) * (1.0 - g_xi)
     intact = np.maximum((1.0 - share) * (1.0 - g_xi)[None, :], 1e-9)
-    with np.errstate(over="ignore", divide="ignore"):
-        dc_tooth = dc[None, :] + (pitted_contact_compliance(geometry, c_contact[None, :], 1.0 - intact)
-                                  - pitted_contact_compliance(geometry, c_contact, 1.0 - intact_typ)[None, :])
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+        c_tooth = pitted_contact_compliance(geometry, c_contact[None, :], 1.0 - intact)
+        c_typ = pitted_contact_compliance(geometry, c_contact, 1.0 - intact_typ)[None, :]
+        # where the typical tooth's face is pitted through (its law unbounded) a tooth with support
+        # left gives way by its own contact compliance over the healthy contact's
+        dc_tooth = np.where(np.isfinite(c_typ), dc[None, :] + (c_tooth - c_typ), c_tooth - c_contact[None, :])
     depth = PIT_DEPTH_OVER_B * geometry.hertz_half_width(pair_force, xi_in)
     # extra approach over the typical tooth; over the healthy one at most the pit depth
-    extra = np.minimum(pair_force[None, :] * dc_tooth, depth[None, :])
+    # (a tooth and the typical one both pitted through, inf - inf: the pit depth too)
+    # and never less than none: pits only take support away
+    extra = np.clip(np.fmin(pair_force[None, :] * dc_tooth, depth[None, :]), 0.0, None)
     # the differences between the teeth: their mean is the law's typical tooth, which k_pair
     # carries (the cells' mean departs from it only by their sampling of D(xi))
     deviation = extra - np.mean(extra, axis=0)[None, :]
@@ -288,10 +293,16 @@ def _rank_one(field: np.ndarray, xi: np.ndarray, n_nodes: int):
 def pitted_contact_compliance(geometry: GearPair, contact_compliance, pitted):
     """Contact compliance [m/N] of a contact whose face width is pitted over the fraction
     ``pitted`` everywhere under it, from the healthy one: the load is carried on L (1 - D), as by
-    a contact of modulus E* (1 - D), so (c + ln(1 - D) / (pi E* L)) / (1 - D).  Broadcasts."""
+    a contact of modulus E* (1 - D), so (c + ln(1 - D) / (pi E* L)) / (1 - D); infinite where that
+    is not positive (the face pitted through).  Broadcasts."""
     d = np.asarray(pitted, dtype=float)
-    return (np.asarray(contact_compliance, dtype=float)
-            + np.log1p(-d) / (math.pi * geometry.contact_modulus * geometry.face_width)) / (1.0 - d)
+    bracket = (np.asarray(contact_compliance, dtype=float)
+               + np.log1p(-d) / (math.pi * geometry.contact_modulus * geometry.face_width))
+    # the line-contact law holds while the contact is narrower than the flank; a face pitted (almost)
+    # through leaves the contact no support: unbounded compliance (the caller caps the approach at
+    # the pit depth)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(bracket > 0, bracket / (1.0 - d), np.inf)
 
 
 @lru_cache(maxsize=16)

@@ -98,6 +98,18 @@ def test_the_residual_rms_of_a_hand_made_field():
         roughness_with_residual(5e-8, float("nan"))
 
 
+def test_a_face_pitted_through_reaches_the_pit_bottom():
+    # late pitting: some teeth have their whole face pitted at some roll positions
+    late = FatiguePitting().advance(FatiguePitting().initial_state(G), MeshLoad.static(G, 20.0 * 19 / 52),
+                                    3e7, 125.0)
+    m = pitting_parameters(G, late, F, HEALTHY_K_PAIR, scatter=ToothScatter.draw(19, 0.58, 0))
+    assert np.any(m.pitted_share > 0.999)
+    e = m.tooth_deviation
+    assert np.all(np.isfinite(e)) and np.isfinite(m.residual_rms)
+    # over the healthy tooth each tooth gives way by 0 .. the pit depth; so the teeth differ by no more
+    assert np.all(np.ptp(e, axis=0) <= m.pit_depth + 1e-12)
+
+
 def test_pits_grow_where_they_started():
     model = FatiguePitting()
     load = MeshLoad.static(G, 20.0 * 19 / 52)
