@@ -22,6 +22,9 @@ For one measured record:
    (an ``impulsive`` finding: when it is gone). The top candidate is reported as missing only if
    it cuts the LSD by at least ``min_cut`` and by ``min_db`` dB; findings it does not explain
    are reported as unexplained. No finding and no useful candidate means nothing is missing.
+   When no candidate is useful and most of the discrepancy is broadband level off in two or
+   more bands (modes in the wrong place), the verdict is that the base model is not calibrated
+   well enough to diagnose, naming the bands to calibrate (:func:`judge`).
 
 Candidates are fitted in parallel on an :class:`twin.executor.Executor` (local processes or
 Dask). All evaluations use one FMU, so there is one build (seconds, cached) per catalogue.
@@ -42,6 +45,8 @@ from twin.operating import Operating, simulate_at
 MIN_CUT = 0.25      # relative LSD cut for a candidate to count as the missing effect
 MIN_DB = 0.15       # and absolute cut [dB] (the LSD floor of a complete model is about 0.3-0.4 dB)
 MIN_SHARE = 0.05    # findings below this share of the error are not reported as unexplained
+BASE_BANDS = 2      # separate bands of broadband level off by 6 dB or more ...
+BASE_SHARE = 0.5    # ... holding this share of the error: the base model, not an effect, is wrong
 
 
 @dataclass(frozen=True)
@@ -72,7 +77,7 @@ class Diagnosis:
     lsd_db: float                        # baseline headline discrepancy [dB]
     findings: tuple[Finding, ...]        # baseline findings
     candidates: tuple[Candidate, ...]    # best first
-    verdict: str                         # "missing_effect", "nothing_missing" or "unexplained"
+    verdict: str                         # "missing_effect", "nothing_missing", "unexplained", "base_not_calibrated"
     missing: str | None                  # id of the effect to add
     unexplained: tuple[str, ...]         # findings no candidate explains
     message: str
@@ -100,6 +105,44 @@ class Diagnosis:
             rows.append(f"{i + 1:>4}  {c.effect:<24} {c.score:>6.2f}  {c.lsd_after_db:>7.2f} dB  {ex}")
         rows.append(self.message)
         return "\n".join(rows)
+
+
+def judge(before: Comparison, candidates: Sequence[Candidate], *, min_cut: float = MIN_CUT,
+          min_db: float = MIN_DB) -> tuple[str, str | None, tuple[str, ...], str]:
+    """The verdict on a baseline comparison and its ranked candidates (best first):
+    ``(verdict, missing effect id or None, unexplained findings, message)``.
+
+    ``missing_effect``: the top candidate cuts the LSD by ``min_cut`` and ``min_db``.  Otherwise,
+    ``base_not_calibrated`` when the discrepancy is mostly broadband level off in two or more
+    separate bands (resonance findings of +-``resonance_db``, by default 6 dB: modes or a transfer
+    path in the wrong place, which one added effect cannot mend and which would mask any effect);
+    ``unexplained`` for other large findings; else ``nothing_missing``.
+    """
+    best = candidates[0] if candidates else None
+    big = [fd for fd in before.findings if fd.share >= MIN_SHARE]
+    if best is not None and best.score >= min_cut and before.lsd_db - best.lsd_after_db >= min_db:
+        explained = {e.finding for e in best.evidence}
+        unexplained = tuple(fd.description for fd in big if fd.description not in explained)
+        msg = (f"missing: {best.effect} ({best.title}); adding it is expected to cut the log-spectral distance "
+               f"from {before.lsd_db:.2f} to {best.lsd_after_db:.2f} dB ({100 * best.score:.0f} %)")
+        if unexplained:
+            msg += "; unexplained: " + "; ".join(unexplained)
+        return "missing_effect", best.effect, unexplained, msg
+    bands = [fd for fd in big if fd.kind == "resonance"]
+    share = sum(fd.share for fd in bands)
+    if len(bands) >= BASE_BANDS and share >= BASE_SHARE:
+        where = ", ".join(f"{fd.frequency_hz:.0f} Hz ({fd.size_db:+.0f} dB)"
+                          for fd in sorted(bands, key=lambda fd: fd.frequency_hz))
+        msg = (f"base model not calibrated well enough to diagnose: its level is off in {len(bands)} bands "
+               f"({where}), {100 * share:.0f} % of the discrepancy, which no single effect mends; calibrate the "
+               "modes near these frequencies first (twin modes RUNUP, then twin calibrate --modes-from RUNUP)")
+        return "base_not_calibrated", None, tuple(fd.description for fd in big), msg
+    if big:
+        unexplained = tuple(fd.description for fd in big)
+        return "unexplained", None, unexplained, ("no catalogue effect explains the discrepancy; unexplained: "
+                                                  + "; ".join(unexplained))
+    return "nothing_missing", None, (), (f"nothing missing: no localised finding, and no catalogue effect cuts the "
+                                         f"log-spectral distance ({before.lsd_db:.2f} dB) by {100 * min_cut:.0f} %")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -512,24 +555,6 @@ def diagnose(fmu_path, measured: np.ndarray, sample_rate: float, nominal_speed: 
             cands[cands.index(c)] = joint
     cands.sort(key=lambda c: -c.score)
 
-    best = cands[0] if cands else None
-    useful = best is not None and best.score >= min_cut and before.lsd_db - best.lsd_after_db >= min_db
-    big = [fd for fd in before.findings if fd.share >= MIN_SHARE]
-    if useful:
-        explained = {e.finding for e in best.evidence}
-        unexplained = tuple(fd.description for fd in big if fd.description not in explained)
-        verdict, missing = "missing_effect", best.effect
-        msg = (f"missing: {best.effect} ({best.title}); adding it is expected to cut the log-spectral distance "
-               f"from {before.lsd_db:.2f} to {best.lsd_after_db:.2f} dB ({100 * best.score:.0f} %)")
-        if unexplained:
-            msg += "; unexplained: " + "; ".join(unexplained)
-    elif big:
-        unexplained = tuple(fd.description for fd in big)
-        verdict, missing = "unexplained", None
-        msg = "no catalogue effect explains the discrepancy; unexplained: " + "; ".join(unexplained)
-    else:
-        unexplained, verdict, missing = (), "nothing_missing", None
-        msg = (f"nothing missing: no localised finding, and no catalogue effect cuts the log-spectral distance "
-               f"({before.lsd_db:.2f} dB) by {100 * min_cut:.0f} %")
+    verdict, missing, unexplained, msg = judge(before, cands, min_cut=min_cut, min_db=min_db)
     return Diagnosis(record, before.lsd_db, before.findings, tuple(cands), verdict, missing, unexplained, msg, op,
                      time.perf_counter() - t0)

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from twin.compare import spectral_levels
-from twin.effects.diagnose import active_effects, diagnose
+from twin.effects.diagnose import Candidate, active_effects, diagnose, judge
 from twin.errors import MeasurementError, ParameterError
 
 
@@ -23,6 +23,34 @@ def test_spectral_levels_absorb_a_small_gain_error_but_not_a_large_one():
 def test_active_effects_are_read_from_parameter_names():
     assert active_effects(["k_pair[1]", "housing_mode.frequency", "backlash.gap", "solver.step_size"]) == \
         ["housing_mode", "backlash"]
+
+
+def _comparison(*findings, lsd=10.0):
+    from twin.compare import Comparison, Finding
+    return Comparison(lsd, 0.5, 0.5, 1.0, 1.0, 20.0,
+                      tuple(Finding(kind, f"{kind} near {f:.0f} Hz", f, (f - 50, f + 50), size, share)
+                            for kind, f, size, share in findings),
+                      np.zeros(1), np.zeros(1), np.zeros(1))
+
+
+def test_judge_tells_a_missing_effect_a_base_model_off_and_the_rest_apart():
+    """The verdict from a baseline and its best candidate: an effect when it cuts the discrepancy
+    enough; the base model when the level is off in several bands and no effect helps; an
+    unlocked line nobody explains is unexplained; no finding, nothing missing."""
+    weak = Candidate("housing_mode", "housing mode", 0.05, 9.5, {}, (), (), 30)
+    strong = Candidate("housing_mode", "housing mode", 0.6, 4.0, {}, (), (), 30)
+    modes_off = _comparison(("resonance", 636, 12.0, 0.3), ("resonance", 1728, -9.0, 0.25),
+                            ("mesh_harmonic", 385, 7.0, 0.1))
+    verdict, missing, unexplained, msg = judge(modes_off, [weak])
+    assert (verdict, missing, len(unexplained)) == ("base_not_calibrated", None, 3)
+    assert "636 Hz (+12 dB), 1728 Hz (-9 dB)" in msg and "--modes-from" in msg
+    assert judge(modes_off, [strong])[:2] == ("missing_effect", "housing_mode")
+    one_band = _comparison(("resonance", 636, 12.0, 0.6), ("unlocked_line", 113, 15.0, 0.3))
+    assert judge(one_band, [weak])[0] == "unexplained"                # one band: a missing resonance, perhaps
+    small = _comparison(("resonance", 636, 7.0, 0.2), ("resonance", 1728, 7.0, 0.2), ("unlocked_line", 113, 15, 0.5))
+    assert judge(small, [weak])[0] == "unexplained"                   # the bands hold under half the error
+    assert judge(_comparison(lsd=0.4), [weak])[:3] == ("nothing_missing", None, ())
+    assert judge(_comparison(lsd=0.4), [])[0] == "nothing_missing"
 
 
 def test_bad_records_and_models_are_refused(gearbox_fmu, two_mass_fmu):
