@@ -165,3 +165,25 @@ def active_set(c, sep, force, max_iter):
             if gap[i] < limit:
                 active[i] = True
     return q, delta, 0
+
+
+@numba.njit(cache=True)
+def _prim(t):
+    """Antiderivative of ln|t|: t ln|t| - t (0 at t = 0)."""
+    at = abs(t)
+    return t * math.log(at) - t if at > 0 else 0.0
+
+
+@numba.njit(cache=True)
+def half_plane_kernel(n, w, depth, scale, intact):
+    """A[i, k] = scale int_cell_k ln(depth / |x_i - s|) ds / intact_k for n equal cells of width w
+    (``LoadedContact._kernel``)."""
+    row = np.empty(2 * n - 1)
+    for m in range(2 * n - 1):
+        d = w * (m - (n - 1))
+        row[m] = w * math.log(depth) - (_prim(d + w / 2) - _prim(d - w / 2))
+    out = np.empty((n, n))
+    for i in range(n):
+        for k in range(n):
+            out[i, k] = scale * row[i - k + n - 1] / intact[k]
+    return out

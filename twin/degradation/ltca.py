@@ -35,6 +35,7 @@ import numpy as np
 
 from twin.degradation.geometry import GearPair
 from twin.degradation._contact_kernels import gap as _gap_kernel
+from twin.degradation._contact_kernels import half_plane_kernel as _half_plane_kernel
 from twin.errors import ParameterError
 
 # Cells per Hertz half-width of the healthy contact, cap on cells per pair, active-set iterations.
@@ -255,17 +256,12 @@ class LoadedContact:
         return x, w, sep, pitted, gmin
 
     def _kernel(self, x: np.ndarray, w: float, depth: float, intact: np.ndarray) -> np.ndarray:
-        """A[i, k]: contact approach at x_i per newton on cell k [m/N] (two half-planes)."""
-        def prim(t):
-            at = np.abs(t)
-            return np.where(at > 0, t * np.log(np.where(at > 0, at, 1.0)) - t, 0.0)
-        n = x.size
-        d = w * np.arange(-(n - 1), n)                        # equal cells: A depends on i - k only
-        row = w * math.log(depth) - (prim(d + w / 2) - prim(d - w / 2))   # int ln(depth/|x_i - s|) ds
-        idx = np.arange(n)
-        integral = row[idx[:, None] - idx[None, :] + n - 1]
+        """A[i, k]: contact approach at x_i per newton on cell k [m/N] (two half-planes): equal
+        cells, so A depends on i - k only, ``2 / (pi E* L w) int_cell ln(depth / |x_i - s|) ds``
+        divided by the intact fraction of cell k (compiled:
+        :func:`twin.degradation._contact_kernels.half_plane_kernel`)."""
         scale = 2.0 / (math.pi * self._e_star * self.geometry.face_width * w)
-        return scale * integral / intact[None, :]
+        return _half_plane_kernel(x.size, w, depth, scale, np.ascontiguousarray(intact, dtype=float))
 
     def solve(self, xi_pairs, force: float, damage: FlankDamage | None = None, *,
               damages: list[FlankDamage] | None = None) -> MeshPosition:

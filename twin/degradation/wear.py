@@ -310,21 +310,24 @@ class _Sweep:
         s = g.contact_start + xi * g.path_of_contact_length
         u1 = s ** 2 / (2 * rb1)
         u2 = (g.line_of_action_length - s) ** 2 / (2 * rb2)
+        # the geometry's scalars, read once (its properties recompute them on each call)
+        s_a, length, loa = g.contact_start, g.path_of_contact_length, g.line_of_action_length
+        z1, z2, face = g.z1, g.z2, g.face_width
         contact = None
         flanks = None
-        cells = {"c1": [], "c2": [], "a": [], "s1": [], "s2": [], "w1": [], "w2": [], "item": [], "ahead": [],
-                 "behind": []}
+        cells = {"c1": [], "c2": [], "w1": [], "w2": []}
+        per_item = {"a": [], "s1": [], "s2": [], "ahead": [], "behind": [], "count": []}
         step = 1.0 / (n_positions * g.contact_ratio)          # roll advance per phase
-        under = {"xi1": [], "xi2": [], "w": [], "item": []}     # the flank points under each pair's pressure
+        under = {"xi1": [], "xi2": [], "w": []}                 # the flank points under each pair's pressure
         f0, ref, e0, kk, phase, loaded_flag = [], [], [], [], [], []
         approach = []
         j = 0
         for m, pos in enumerate(cycle.positions):
             for pair in pos.pairs:
                 xc = pair.xi
-                rho1 = g.contact_start + xc * g.path_of_contact_length
-                rho2 = g.line_of_action_length - rho1
-                slide = abs(rho1 - rho2 * g.z1 / g.z2)                   # v_s / omega1
+                rho1 = s_a + xc * length
+                rho2 = loa - rho1
+                slide = abs(rho1 - rho2 * z1 / z2)                   # v_s / omega1
                 loaded = pair.force > 0
                 total = pair.total
                 if total > 0:
@@ -351,22 +354,21 @@ class _Sweep:
                     x, q = np.array([centroid]), np.array([1.0])
                     reference = 1.0
                     stiffness = np.nan
-                line_pressure = q / (width * g.face_width)
+                line_pressure = q / (width * face)
                 cells["c1"].append(rho1 ** 2 / (2 * rb1) + x)
                 cells["c2"].append(rho2 ** 2 / (2 * rb2) - x)
-                cells["a"].append(np.full(x.size, width / 2))
-                cells["s1"].append(np.full(x.size, math.pi * rho1 / (g.z1 * n_positions)))
-                cells["s2"].append(np.full(x.size, math.pi * rho2 / (g.z2 * n_positions)))
-                cells["ahead"].append(np.full(x.size, (1.0 - xc) / step))
-                cells["behind"].append(np.full(x.size, xc / step))
+                per_item["a"].append(width / 2)
+                per_item["s1"].append(math.pi * rho1 / (z1 * n_positions))
+                per_item["s2"].append(math.pi * rho2 / (z2 * n_positions))
+                per_item["ahead"].append((1.0 - xc) / step)
+                per_item["behind"].append(xc / step)
+                per_item["count"].append(x.size)
                 cells["w1"].append(line_pressure * slide / rho1)                     # v_s / v1
-                cells["w2"].append(line_pressure * slide / (rho2 * g.z1 / g.z2))     # v_s / v2
-                cells["item"].append(np.full(x.size, j))
+                cells["w2"].append(line_pressure * slide / (rho2 * z1 / z2))     # v_s / v2
                 p_xi1, p_xi2, _ = (contact or _contact_of(g))._flank_points(xc, x)
                 under["xi1"].append(p_xi1)
                 under["xi2"].append(p_xi2)
                 under["w"].append(q / q.sum())
-                under["item"].append(np.full(x.size, j))
                 f0.append(total)
                 ref.append(reference)
                 e0.append(pair.separation)
@@ -376,7 +378,9 @@ class _Sweep:
                 j += 1
         n_items = j
         cat = {k: np.concatenate(v) if v else np.empty(0) for k, v in cells.items()}
-        item = cat["item"].astype(int)
+        count = np.array(per_item.pop("count"), dtype=int)
+        cat.update({k: np.repeat(np.array(v, dtype=float), count) for k, v in per_item.items()})
+        item = np.repeat(np.arange(n_items), count)
         d1 = np.zeros((xi.size, n_items))
         d2 = np.zeros((xi.size, n_items))
         if n_items:
@@ -410,7 +414,7 @@ class _Sweep:
         # a pair's separation grows by the pressure-weighted mean of the wear under its contact
         # (to first order, Betti's theorem), not by the wear at one point of it
         un = {k: np.concatenate(v) if v else np.empty(0) for k, v in under.items()}
-        rows = un["item"].astype(int)
+        rows = item
         press1 = _interp_rows(xi, un["xi1"], un["w"], rows, n_items)
         press2 = _interp_rows(xi, un["xi2"], un["w"], rows, n_items)
         return cls(d1, d2, f0, 1.0 / ref, np.array(e0), press1, press2, kk, np.array(phase),
