@@ -36,6 +36,7 @@ import numpy as np
 from twin.degradation.geometry import GearPair
 from twin.degradation._contact_kernels import gap as _gap_kernel
 from twin.degradation._contact_kernels import half_plane_kernel as _half_plane_kernel
+from twin.degradation._contact_kernels import pair_cells as _pair_cells
 from twin.errors import ParameterError
 
 # Cells per Hertz half-width of the healthy contact, cap on cells per pair, active-set iterations.
@@ -191,7 +192,7 @@ class LoadedContact:
         pitted fraction of the face width there (both flanks, independent pits)."""
         if np.ndim(xi_c) == 0 and np.ndim(x) == 1:
             # one pair: the compiled loop (the same formula, no temporaries)
-            return _gap_kernel(np.asarray(x, dtype=float), float(xi_c), self._constants, damage.table)
+            return _gap_kernel(np.asarray(x, dtype=float), float(xi_c), self._constants, damage.table, True)
         r = self._radius(xi_c)
         xi1, xi2, ok = self._flank_points(xi_c, x)
         sep = x * x / (2.0 * r) + np.interp(xi1, damage.xi, damage.pinion_depth) + np.interp(
@@ -229,30 +230,12 @@ class LoadedContact:
         rho1c = self._s_a + xi_c * self._len
         u1c = rho1c * rho1c / (2 * self._rb1)
         coarse = np.linspace(self._u1_0 - u1c, self._u1_1 - u1c, 301)
-        gap, _ = self.gap(xi_c, coarse, damage)
-        finite = np.isfinite(gap)
-        if not finite.any():
+        # compiled: the scan of the coarse points, a fine scan at half a cell of the stretch that
+        # can touch, and the cells (:func:`twin.degradation._contact_kernels.pair_cells`)
+        found, x, w, sep, pitted, gmin = _pair_cells(coarse, float(xi_c), self._constants, damage.table,
+                                                     float(threshold), float(width), _MAX_CELLS)
+        if not found:
             return None
-        slack = np.abs(np.diff(np.where(finite, gap, 0.0)))
-        margin = float(np.max(np.where(finite[1:] & finite[:-1], slack, 0.0), initial=0.0))
-        near = coarse[gap <= float(gap[finite].min()) + threshold + margin]
-        step = coarse[1] - coarse[0]
-        lo, hi = near.min() - step, near.max() + step
-        fine = np.arange(lo, hi + width / 2, width / 2.0)
-        gfine, _ = self.gap(xi_c, fine, damage)
-        gmin = float(gfine.min())
-        if not math.isfinite(gmin):
-            return None
-        near = fine[gfine <= gmin + threshold]
-        lo, hi = near.min() - width, near.max() + width
-        n = int(math.ceil((hi - lo) / width))
-        w = width if n <= _MAX_CELLS else (hi - lo) / _MAX_CELLS
-        # cells on a lattice anchored at the nominal contact point, so that the discretisation
-        # is the same at every mesh position (a shifting grid leaves a ripple in the wear)
-        k0 = math.floor(lo / w)
-        n = min(max(int(math.ceil(hi / w)) - k0, 3), _MAX_CELLS)
-        x = w * (k0 + np.arange(n) + 0.5)
-        sep, pitted = self.gap(xi_c, x, damage)
         return x, w, sep, pitted, gmin
 
     def _kernel(self, x: np.ndarray, w: float, depth: float, intact: np.ndarray) -> np.ndarray:
