@@ -445,14 +445,15 @@ def part_speed(args) -> dict:
     for name in ("lubricated", "dry"):
         sc = load_scenario(REPO / "scenarios" / f"{name}.yaml")
         fmu = sc.fmu_path()
-        t = time.perf_counter()
+        t, cpu = time.perf_counter(), time.process_time()
         run = run_degradation(sc, None, fmu_path=fmu, progress=False)
-        rows.append((name, time.perf_counter() - t, len(run.stages), run.summary()))
+        rows.append((name, time.perf_counter() - t, time.process_time() - cpu, len(run.stages), run.summary()))
     print(f"Machine: {machine()}\n")
-    print("| scenario | wall time [s] | updates | reached |")
-    print("|---|---|---|---|")
-    for name, wall, n, summary in rows:
-        print(f"| {name} | {wall:.1f} | {n} | {summary} |")
+    # on a shared machine the wall time is an upper bound; the process's CPU time is not
+    print("| scenario | wall time [s] | CPU time [s] | updates | reached |")
+    print("|---|---|---|---|---|")
+    for name, wall, cpu, n, summary in rows:
+        print(f"| {name} | {wall:.1f} | {cpu:.1f} | {n} | {summary} |")
     return {"rows": rows}
 
 
