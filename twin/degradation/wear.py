@@ -11,8 +11,12 @@ current worn flanks at the transmitted force:
   rho1 2 pi / (z1 M) and over the gear flank by rho2 2 pi / (z2 M).  A flank point at arc u gets
   ``p_i ds = p_i (v_s / v) l_i(u)`` where l_i(u) is the time the cell covers the point as it
   sweeps times v (the cell convolved with the sweep, the pressure taken piecewise linear between
-  phases), v the rolling speed of that flank and v_s = |v1 - v2| the sliding speed
-  (speed-independent per pass: v_s / v).
+  phases and held up to the end of the path where the pair leaves it), v the rolling speed of
+  that flank and v_s = |v1 - v2| the sliding speed (speed-independent per pass: v_s / v).  Each
+  grid point gets the mean over the flank stretch it stands for.
+* Wear levels what is narrower than the contact: the increment of a flank point is the
+  Hertz-weighted mean over the contact half-width b of the pair's force there
+  (:func:`twin.degradation._hertz.contact_average`).
 * Per pinion revolution every pinion flank point passes through the mesh once and every gear
   flank point z1 / z2 times: each flank has its own cycle count.
 
