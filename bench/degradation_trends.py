@@ -5,7 +5,7 @@
     python bench/degradation_trends.py nodes            # convergence with n_profile
     python bench/degradation_trends.py pitting          # signature against rigs.ltca (black box)
     python bench/degradation_trends.py speed            # lubricated to 20 %, dry to 240 um
-    python bench/degradation_trends.py rigs [--kind pitting]   # the same features on rigs.pedestal, rigs.beam
+    python bench/degradation_trends.py rigs [--kind pitting] [--model M]   # the same features on rigs.pedestal, rigs.beam
 
 ``wear``: an 18/35 module-3 pair at 15 Hz / 10 N.m (light load), profile form deviation of
 ISO 1328-1 class 7, coupled wear run to about 1 mm of mean pinion wear depth on 41 profile
@@ -25,7 +25,8 @@ stage the Spearman rank correlation of the twin's 15 feature changes with the ri
 common interface, nominal gearbox, committed defaults) at the centres of their own wear stages
 (10 Hz / 5 N.m, dry, 0-240 um) and pitting stages (20 Hz / 20 N.m, 2-20 %), and the twin (base
 19/52 model, coupled runs of ``scenarios/dry.yaml`` and ``scenarios/lubricated.yaml``) at the same
-damage: casing RMS, mesh-harmonic level (first three) and pinion-order sideband level, each
+damage (``--model``: another twin model for those runs, e.g. ``GearTwin.Gearbox21Measured`` with its
+flank roughness, whose pinion RMS carries the pits' per-tooth residual): casing RMS, mesh-harmonic level (first three) and pinion-order sideband level, each
 against damage (Spearman, worn/healthy), and the per-stage Spearman of the 15 harmonic and
 sideband changes of the twin against each rig's.
 
@@ -345,12 +346,14 @@ def band_levels(sig: np.ndarray) -> tuple[float, float]:
 
 
 def _twin_stage_records(kind: str, damages, speed: float, load: float, scenario: str, duration: float,
-                        manufacturing: dict) -> list[np.ndarray]:
+                        manufacturing: dict, model: str | None = None) -> list[np.ndarray]:
     from twin.degradation_run import run_degradation
     from twin.fmu import FMU
     from twin.operating import consistent_start
     from twin.scenario import load_scenario
     sc = load_scenario(REPO / "scenarios" / f"{scenario}.yaml")
+    if model:
+        sc = sc.with_overrides(fmu=model)
     key = "wear_depth" if kind == "wear" else "pitting_density"
     d = {**sc.degradation, "stop": {key: max(damages) * 1.03}, "record_duration": 0.0}
     fmu = sc.fmu_path()
@@ -385,7 +388,8 @@ def part_rigs(args) -> dict:
             continue
         t = time.perf_counter()
         sources = {"twin": [(x, 50000.0) for x in
-                            _twin_stage_records(kind, damages, speed, load, scenario, duration, manufacturing)]}
+                            _twin_stage_records(kind, damages, speed, load, scenario, duration, manufacturing,
+                                                args.model)]}
         ped, bm = pedestal.Rig(), beam.Rig()
         sources["pedestal"] = []
         sources["beam"] = []
@@ -464,12 +468,14 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0, help="pitting: the rig's gear seed")
     ap.add_argument("--kind", action="append", choices=tuple(RIG_POINTS),
                     help="rigs: only this damage kind (repeatable; default both)")
+    ap.add_argument("--model", help="rigs: the twin's model for its runs (default: the scenario's)")
     args = ap.parse_args()
     if args.part == "nodes" and args.depth == 1.0e-3:
         args.depth = 3.0e-4
     result = globals()[f"part_{args.part}"](args)
     OUT.mkdir(exist_ok=True)
-    (OUT / f"degradation_trends_{args.part}.json").write_text(json.dumps(result, indent=1, default=float))
+    suffix = f"_{args.model.rsplit('.', 1)[-1]}" if getattr(args, "model", None) else ""
+    (OUT / f"degradation_trends_{args.part}{suffix}.json").write_text(json.dumps(result, indent=1, default=float))
 
 
 if __name__ == "__main__":
