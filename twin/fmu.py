@@ -130,6 +130,12 @@ def _sha256(path: Path) -> str:
     return h.hexdigest()
 
 
+def _whole(span: float, interval: float) -> bool:
+    """Is ``span`` a whole number of ``interval`` (to rounding)?"""
+    n = span / interval
+    return abs(n - round(n)) <= 1e-9 * max(1.0, n)
+
+
 def _float_or_none(value) -> float | None:
     try:
         f = float(value)
@@ -290,10 +296,12 @@ class FMU:
         """(start, stop, output interval) [s]: the values given, else the model's default experiment.
 
         Start: ``startTime``, else 0.  Stop: ``stopTime``, else start + 1 s.  Output interval, as
-        ``fmpy.simulate_fmu`` chooses it: the FMI 3.0 ``fixedInternalStepSize``, else ``stepSize``,
-        doubled until the run has at most 1000 intervals; else fmpy's automatic interval (500 to
-        1000 samples).  With ``fmpy_grid=False`` (scenarios) the model's ``stepSize`` is taken as
-        it is, never coarsened, so a vibration model keeps its sample rate.
+        ``fmpy.simulate_fmu`` chooses it over the model's own experiment: the FMI 3.0
+        ``fixedInternalStepSize``, else ``stepSize``, doubled until the run has at most 1000
+        intervals (where that does not divide the run, the largest doubling that does: the twin's
+        samples are whole intervals, fmpy would end on a shorter one); else fmpy's automatic
+        interval (500 to 1000 samples).  With a stop time given, or ``fmpy_grid=False``
+        (scenarios), the model's step is taken as it is, so a vibration model keeps its sample rate.
         """
         de = self.default_experiment
         start = float(start_time) if start_time is not None else (de.start_time if de.start_time is not None else 0.0)
@@ -304,10 +312,12 @@ class FMU:
         step = de.step_size if de.step_size is not None and de.step_size > 0 else None
         if output_interval is not None:
             interval = float(output_interval)
-        elif fmpy_grid and (fixed or step):
+        elif fmpy_grid and (fixed or step) and stop_time is None:
             interval = float(fixed or step)
             while (stop - start) / interval > 1000:     # fmpy's rule, so both give the same samples
                 interval *= 2
+            while not _whole(stop - start, interval) and interval > float(fixed or step):
+                interval /= 2                           # fmpy would end on a shorter interval
         elif step:
             interval = step
         elif fixed:

@@ -186,7 +186,8 @@ def test_no_option_grid_follows_fmpy(two_mass_fmu):
     with FMU(two_mass_fmu) as fmu:
         assert fmu.experiment() == (0.0, 10.0, 0.016)
         assert fmu.experiment(fmpy_grid=False) == (0.0, 10.0, 1e-3)
-        assert fmu.experiment(stop_time=0.5) == (0.0, 0.5, 1e-3)        # 500 intervals: kept
+        assert fmu.experiment(stop_time=0.5) == (0.0, 0.5, 1e-3)        # the user's run: the model's step
+        assert fmu.experiment(stop_time=30.0) == (0.0, 30.0, 1e-3)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         result = simulate_fmu(two_mass_fmu)
