@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 
 from twin._progress import progress_bar
+from twin.checks import whole_multiple
 from twin.errors import FMUError, ParameterError, SimulationError, TwinWarning
 from twin.results import SimulationResult
 from twin.variables import Variable, variables_from_description
@@ -128,12 +129,6 @@ def _sha256(path: Path) -> str:
         for chunk in iter(lambda: f.read(1 << 20), b""):
             h.update(chunk)
     return h.hexdigest()
-
-
-def _whole(span: float, interval: float) -> bool:
-    """Is ``span`` a whole number of ``interval`` (to rounding)?"""
-    n = span / interval
-    return abs(n - round(n)) <= 1e-9 * max(1.0, n)
 
 
 def _float_or_none(value) -> float | None:
@@ -316,7 +311,7 @@ class FMU:
             interval = float(fixed or step)
             while (stop - start) / interval > 1000:     # fmpy's rule, so both give the same samples
                 interval *= 2
-            while not _whole(stop - start, interval) and interval > float(fixed or step):
+            while not whole_multiple(stop - start, interval) and interval > float(fixed or step):
                 interval /= 2                           # fmpy would end on a shorter interval
         elif step:
             interval = step
