@@ -411,13 +411,10 @@ def _effects_argument(p: argparse.ArgumentParser) -> None:
 
 
 def _effect_ids(text: str | None) -> list[str] | None:
-    """``--effects a,b``: the catalogue ids tried (None: all); an unknown id is refused by name."""
+    """``--effects a,b``: the catalogue ids tried (None: all); unknown ids are refused by the loop."""
     if text is None:
         return None
     ids = [e.strip() for e in text.split(",") if e.strip()]
-    effects = _lib("twin.effects")
-    for e in ids:
-        effects.effect(e)
     if not ids:
         raise _lib("twin.errors").ParameterError(f"--effects names no effect: {text!r}")
     return ids

@@ -233,6 +233,8 @@ def improve(scenario, measurements, out_dir, *, record: str | None = None, max_s
     ``effects``: the candidate ids tried at each step (default: the whole catalogue).
     """
     from twin.scenario import load_scenario
+    for e in effects or ():
+        get_effect(e)                   # an unknown id is refused before anything is written
     out = _out_dir(out_dir)
     history: list[Step] = []
     for k in range(1, max_steps + 1):
