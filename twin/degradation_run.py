@@ -15,7 +15,9 @@ At each update (stage):
    density), so the load is re-sampled as often as the damage needs;
 4. turn the damage into the FMU's mesh parameters (``k_pair``, ``profile_deviation`` on the
    FMU's ``n_profile`` nodes; for pitting ``pit_profile`` x ``tooth_pit_scale``) and set them on
-   the FMU, so the next window runs on the degraded mesh.  The part of the pits' per-tooth field
+   the FMU, so the next window runs on the degraded mesh (with ``pair_stiffness: contact``, wear
+   sets ``k_pair`` to the LTCA's single-pair secant stiffness at the mean mesh force,
+   :func:`twin.degradation.mapping.contact_k_pair`).  The part of the pits' per-tooth field
    those arrays cannot hold goes into the pinion's broadband roughness,
    ``pinion_roughness.rms = sqrt(rms0^2 + residual_rms^2)`` with rms0 the scenario's (calibrated)
    value (:mod:`twin.degradation.pitting_map`), on a model that has that parameter; on one that has
@@ -149,7 +151,7 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
     """Run the scenario's degradation block; write the stages to ``output`` (HDF5) if given."""
     from twin import _interrupt
     from twin._atomic import partial_path
-    from twin.degradation import GearPair, MeshLoad, TransmittedLoad, mesh_parameters
+    from twin.degradation import GearPair, MeshLoad, TransmittedLoad, contact_k_pair, mesh_parameters
     from twin.degradation.pitting_map import (PINION_ROUGHNESS, ToothScatter, pitting_parameters,
                                               roughness_with_residual)
     from twin.plausibility import check_block, check_parameters
@@ -202,11 +204,17 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
         params = dict(scenario.parameters)
         if stages:
             params.update(stages[-1].parameters)
+        contact_stiffness = model_name == "wear" and spec.get("pair_stiffness", "model") == "contact"
+        torque = float(inputs.get("load_torque", 0.0) or 0.0)
+        nominal = torque / geometry.base_radius_gear if torque > 0 else None
+        if contact_stiffness and not stages and nominal is not None:
+            # the pair law has the LTCA's compliance at the load from the first record on
+            params.update({f"k_pair[{i}]": float(v) for i, v in
+                           enumerate(contact_k_pair(geometry, nominal, n_nodes), start=1)})
         if model_name == "wear" and not stages and (np.any(state.pinion_form > 0) or np.any(state.gear_form > 0)):
             # the flanks' form deviation is in the mesh from the first record on
-            torque = float(inputs.get("load_torque", 0.0) or 0.0)
-            nominal = torque / geometry.base_radius_gear if torque > 0 else None
-            params.update(mesh_parameters(geometry, wear=state, k_pair_healthy=k_healthy, n_nodes=n_nodes,
+            k_now = tuple(params.get(f"k_pair[{i}]", k) for i, k in enumerate(k_healthy, start=1))
+            params.update(mesh_parameters(geometry, wear=state, k_pair_healthy=k_now, n_nodes=n_nodes,
                                           force=nominal).parameters)
         from twin.operating import consistent_start
         start = consistent_start(params, inputs, [v.name for v in fmu.parameters])
@@ -261,7 +269,8 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
                     dn = min(dn, max(stop_cycles - state.cycles, 1.0))
                 state = model.advance(state, load, dn, omega1)
                 if model_name == "wear":
-                    update = mesh_parameters(geometry, wear=state, k_pair_healthy=k_healthy, n_nodes=n_nodes,
+                    k_now = contact_k_pair(geometry, force, n_nodes) if contact_stiffness else k_healthy
+                    update = mesh_parameters(geometry, wear=state, k_pair_healthy=k_now, n_nodes=n_nodes,
                                              force=force)
                     new, trunc_error = update.parameters, dict(update.truncation_error)
                 else:

@@ -160,6 +160,11 @@ SCHEMA: dict[str, Any] = {
                 "max_updates": {"type": "integer", "minimum": 1},
                 "load_window": {**_POS, "description": "s of co-simulation sampled to estimate the mesh load at each update"},
                 "record_duration": {**_NONNEG, "description": "s of vibration stored at each update (0 = none)"},
+                "pair_stiffness": {"enum": ["model", "contact"],
+                                   "description": "wear: k_pair the model's or scenario's values ('model', default), or "
+                                                  "the LTCA's single-pair secant stiffness at each update's mean mesh force "
+                                                  "('contact': the pairs share the load with the compliance of the contact "
+                                                  "analysis that wears the flanks)"},
                 "tooth_scatter": {**_NONNEG, "description": "pitting: log-sd of the per-tooth pitting strength "
                                                            "factors (seeded by 'seed', as are the pit cells; default 0.58, "
                                                            "the Weibull life scatter of gear teeth; 0 = teeth alike)"},

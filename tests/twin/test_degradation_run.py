@@ -68,6 +68,25 @@ def test_wear_moves_the_profile(gearbox_fmu):
     assert dev[0] > dev[5] and dev[-1] > dev[5]
 
 
+def test_wear_with_the_contact_pair_stiffness(gearbox_fmu):
+    """pair_stiffness: contact gives the FMU the LTCA's secant pair stiffness at the load, from
+    the first record on; the default keeps the model's k_pair."""
+    from twin.degradation import GearPair, contact_k_pair
+    sc = load_scenario(REPO / "scenarios" / "dry.yaml")
+    d = dict(sc.degradation)
+    d.update({"max_updates": 2, "load_window": 0.1, "record_duration": 0.0, "pair_stiffness": "contact"})
+    run = run_degradation(sc.with_overrides(degradation=d), None, fmu_path=gearbox_fmu, progress=False)
+    g = GearPair()
+    first = np.array([run.stages[0].parameters[f"k_pair[{i}]"] for i in range(1, 12)])
+    assert np.allclose(first, contact_k_pair(g, 5.0 / g.base_radius_gear, 11), rtol=1e-12)
+    second = np.array([run.stages[1].parameters[f"k_pair[{i}]"] for i in range(1, 12)])
+    assert np.allclose(second, first, rtol=0.05) and run.damage[1] > 0
+    d.pop("pair_stiffness")
+    d["max_updates"] = 1
+    run = run_degradation(sc.with_overrides(degradation=d), None, fmu_path=gearbox_fmu, progress=False)
+    assert run.stages[0].parameters["k_pair[6]"] == pytest.approx(3.0e8)
+
+
 def test_a_run_off_the_default_operating_point_starts_in_contact(gearbox_fmu):
     """dry.yaml runs at 10 Hz / 5 N.m; the model's start parameters say 20 Hz / 20 N.m. Started
     from those, the gear flew ahead of the slowing pinion and, with the mesh damping acting only

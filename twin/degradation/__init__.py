@@ -17,8 +17,8 @@ from twin.degradation.load import MeshLoad, TransmittedLoad
 from twin.degradation.ltca import FlankDamage, LoadedContact
 from twin.degradation.contact_check import ContactCheck, contact_check
 from twin.degradation.wear import FlankWear
-from twin.degradation.mapping import (HEALTHY_K_PAIR, MeshUpdate, mesh_parameters, project_on_nodes, project_wear,
-                                      wear_deviation)
+from twin.degradation.mapping import (HEALTHY_K_PAIR, MeshUpdate, contact_k_pair, mesh_parameters, project_on_nodes,
+                                      project_wear, wear_deviation)
 from twin.degradation.pitting import (DEFAULT_DEPTH_EXPONENT, DEFAULT_PITTING_COEFFICIENT, DEFAULT_STRESS_EXPONENT,
                                       DEFAULT_WEIBULL_SLOPE, FatiguePitting)
 
@@ -26,6 +26,6 @@ __all__ = [
     "ArchardWear", "ContactCheck", "DEFAULT_DEPTH_EXPONENT", "DEFAULT_PITTING_COEFFICIENT", "DEFAULT_STRESS_EXPONENT",
     "DEFAULT_WEAR_COEFFICIENT", "DEFAULT_WEIBULL_SLOPE", "DegradationModel", "FatiguePitting", "FlankDamage",
     "FlankWear", "GearPair", "HEALTHY_K_PAIR", "LoadedContact", "MeshLoad", "MeshUpdate", "PittingState",
-    "TransmittedLoad", "WearState", "contact_check", "flank_mean", "mesh_parameters", "project_on_nodes", "project_wear",
+    "TransmittedLoad", "WearState", "contact_check", "contact_k_pair", "flank_mean", "mesh_parameters", "project_on_nodes", "project_wear",
     "wear_deviation",
 ]

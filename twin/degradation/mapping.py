@@ -32,7 +32,7 @@ from twin.degradation.base import PittingState, WearState
 from twin.degradation.geometry import GearPair
 from twin.errors import ParameterError
 
-__all__ = ["HEALTHY_K_PAIR", "MeshUpdate", "mesh_parameters", "project_on_nodes", "project_wear", "wear_deviation"]
+__all__ = ["HEALTHY_K_PAIR", "MeshUpdate", "contact_k_pair", "mesh_parameters", "project_on_nodes", "project_wear", "wear_deviation"]
 
 #: Roll positions the worn pair's separation is evaluated at before it is fitted on the nodes.
 _SEPARATION_GRID = 201
@@ -205,3 +205,28 @@ def project_wear(wear: WearState, n_nodes: int = 11) -> WearState:
         raise ParameterError(f"n_nodes must be an integer >= 2, got {n_nodes!r}")
     nodes, _ = project_on_nodes(wear.xi, wear.depth, n_nodes)
     return WearState(wear.cycles, wear.xi, interp_nodes(nodes, wear.xi), wear.geometry)
+
+
+def contact_k_pair(geometry: GearPair, force: float, n_nodes: int = 11) -> np.ndarray:
+    """Single-pair stiffness [N/m] at the ``n_nodes`` equally spaced roll positions as the LTCA
+    gives it at the transmitted normal force ``force`` [N]: the secant ``F_j / (approach -
+    separation)`` of a healthy pair carrying the force F_j the healthy load sharing gives it there.
+
+    The FMU's pair law ``k (delta - e)`` is linear; the LTCA's contact (two elastic half-planes)
+    is not: its compliance grows as the load falls (logarithmically with the contact width), so
+    at light load a pair gives way more than a load-independent stiffness (potential energy with
+    a linearised Hertz term) says, 30-40 % more on an 18/35 module-3 pair at 200 N.  With the
+    secant at the operating force, the FMU's pairs share a load of that size the way the LTCA's
+    do, so which pair of worn flanks goes slack is decided by the same compliances.  (n_nodes,).
+    """
+    from twin.degradation.pitting_map import _N_XI, _healthy
+    if not isinstance(geometry, GearPair):
+        raise ParameterError(f"geometry must be a GearPair, got {geometry!r}")
+    if not (isinstance(force, (int, float, np.floating)) and np.isfinite(force) and force > 0):
+        raise ParameterError(f"force must be a finite number > 0 N, got {force!r}")
+    if not (isinstance(n_nodes, (int, np.integer)) and n_nodes >= 2):
+        raise ParameterError(f"n_nodes must be an integer >= 2, got {n_nodes!r}")
+    import math
+    # the healthy LTCA is cached on a 2 % grid of the force, as for pitting
+    _, compliance = _healthy(geometry, 1.02 ** round(math.log(float(force)) / math.log(1.02)))
+    return np.interp(np.linspace(0.0, 1.0, n_nodes), np.linspace(0.0, 1.0, _N_XI), 1.0 / compliance)

@@ -135,3 +135,21 @@ def test_at_load_a_ridge_narrower_than_the_contact_is_bridged():
                                rtol=0, atol=0.2e-6)
     with pytest.raises(ParameterError, match="force"):
         mesh_parameters(GEOMETRY, wear=wear, force=-1.0)
+
+
+def test_contact_pair_stiffness_is_the_ltca_secant_at_the_load():
+    """At 20 N.m the LTCA's pair gives way more than the load-independent potential-energy
+    stiffness says (the half-plane contact's compliance grows as the load falls), and less
+    at a larger load; the pair law with it gives the LTCA's approach of a lone pair."""
+    from twin.degradation.ltca import contact_for
+    from twin.degradation.mapping import contact_k_pair
+    from twin.degradation.stiffness import k_pair_nodes
+    force = 20.0 / GEOMETRY.base_radius_gear
+    k = contact_k_pair(GEOMETRY, force, 11)
+    assert np.all(k < np.array(k_pair_nodes(GEOMETRY, 11)))
+    assert np.all(contact_k_pair(GEOMETRY, 10 * force, 11) > k)
+    # a lone pair at mid path carries the whole force in the healthy load sharing
+    sol = contact_for(GEOMETRY).solve([0.5], force)
+    assert force / k[5] == pytest.approx(sol.approach - sol.pairs[0].separation, rel=0.03)
+    with pytest.raises(ParameterError, match="force"):
+        contact_k_pair(GEOMETRY, -1.0, 11)
