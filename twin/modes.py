@@ -119,7 +119,27 @@ def survey_record(record, *, channels=None, fmin: float | None = None, fmax: flo
         for c in vib:
             surveys.append(replace(analyse_runup(np.asarray(record[c])[keep], record.sample_rate, angle, fmin=fmin,
                                                  fmax=fmax, resolution=resolution), channels=(c,)))
+        if len(vib) > 1:
+            return with_shapes(merge_surveys(surveys), [np.asarray(record[c], float)[keep] for c in vib], vib,
+                               record.sample_rate)
     return merge_surveys(surveys)
+
+
+def with_shapes(survey: ModalSurvey, xs, names, fs: float) -> ModalSurvey:
+    """The survey with each mode's shape at the channels (``evidence["shape"]``, see
+    :mod:`twin.signals.shapes`): cross-spectra over the run-up slices in the bins of its hump."""
+    from twin.signals.shapes import channel_shapes
+
+    if not survey.modes:
+        return survey
+    freqs = np.array([m.frequency for m in survey.modes])
+    damping = np.array([m.damping for m in survey.modes])
+    half = np.where(np.isfinite(damping), freqs * np.nan_to_num(damping), 0.0)
+    nperseg = int(round(fs / survey.resolution))
+    shapes = channel_shapes(xs, list(names), fs, freqs, half, nperseg=nperseg,
+                            exclude_hz=[ln.frequency for ln in survey.lines])
+    return replace(survey, modes=tuple(replace(m, evidence={**m.evidence, "shape": s.to_dict()})
+                                       for m, s in zip(survey.modes, shapes)))
 
 
 def merge_surveys(surveys) -> ModalSurvey:
@@ -171,6 +191,14 @@ def write_survey_json(survey: ModalSurvey, path, **extra) -> Path:
     return Path(path)
 
 
+def shape_text(shape: dict) -> str:
+    """A mode's shape at the channels in a few words: each channel re the reference."""
+    ref = shape["reference"]
+    parts = [f"{c} {v['level_db']:+.1f} dB {v['phase_deg']:+.0f} deg (coherence {v['coherence']:.2f})"
+             for c, v in shape["channels"].items() if c != ref]
+    return f"shape re {ref}: " + ", ".join(parts)
+
+
 def survey_table(survey: ModalSurvey, min_confidence: float = MIN_CONFIDENCE) -> str:
     """The survey as text: modes, lines, orders and notes."""
     rows = [f"{survey.method} survey, band {survey.band[0]:g}-{survey.band[1]:g} Hz, "
@@ -187,6 +215,8 @@ def survey_table(survey: ModalSurvey, min_confidence: float = MIN_CONFIDENCE) ->
                         + (" ..." if len(crossing) > 4 else ""))
         if ev.get("line_on_top_hz"):
             bits.append(f"line on top at {ev['line_on_top_hz']} Hz")
+        if ev.get("shape"):
+            bits.append(shape_text(ev["shape"]))
         damping = f"{m.damping:7.4f}" if np.isfinite(m.damping) else "    n/a"
         rows.append(f"{mark}{m.frequency:10.2f}  {damping}  {m.confidence:10.2f}  {'; '.join(b for b in bits if b)}")
     if not survey.modes:

@@ -327,6 +327,17 @@ def plot_modal_survey(survey, path: str | os.PathLike[str], *, title: str | None
             line(m.frequency, color="tab:red", lw=0.9, alpha=0.4 + 0.6 * m.confidence)
         for ln in survey.lines:
             line(ln.frequency, color="tab:cyan", lw=0.9, ls=":")
+    if horizontal:
+        # each mode's shape at the sensors (level and phase of the other channel re the reference;
+        # grey when the coherence is below 0.5 and the shape is not to be trusted)
+        for m in modes:
+            shape = m.evidence.get("shape")
+            others = [(c, v) for c, v in (shape or {}).get("channels", {}).items() if c != shape["reference"]]
+            if others:
+                text = " ".join(f"{v['level_db']:+.0f}dB/{v['phase_deg']:+.0f}\u00b0" for _, v in others)
+                side.annotate(text, (1.0, m.frequency), xycoords=("axes fraction", "data"), fontsize=6,
+                              ha="right", va="bottom",
+                              color="k" if shape.get("min_coherence", 0) >= 0.5 else "0.6")
     axes[0].set_title(title or f"{survey.method}: {len(modes)} modes (red), {len(survey.lines)} fixed lines "
                       f"(dotted), {len(survey.orders)} orders (dashed)")
     return _save(fig, target)

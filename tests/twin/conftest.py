@@ -25,12 +25,14 @@ def synthetic_runup(*, fs=12800.0, duration=6.0, speeds=(2.0, 20.0),
                     modes=((87.0, 0.02), (218.0, 0.02), (430.0, 0.015), (512.0, 0.025), (767.0, 0.02),
                            (1248.0, 0.02), (1927.0, 0.03)),
                     orders=((1.0, 0.3), (2.0, 0.2), (19.0, 1.0), (38.0, 0.5), (57.0, 0.3), (19 / 52, 0.2)),
-                    lines=((300.0, 3.0),), broadband=1.0, noise=0.02, seed=0):
+                    lines=((300.0, 3.0),), broadband=1.0, noise=0.02, seed=0, weights=None):
     """(x [m/s2], angle [rad], truth) of a run-up from speeds[0] to speeds[1] Hz.
 
     ``orders``: (shaft order, force amplitude at the top speed; grows with speed squared);
     ``lines``: (fixed frequency [Hz], force amplitude) of drive lines;
-    ``broadband``: sd of the white force at the top speed (grows with speed).
+    ``broadband``: sd of the white force at the top speed (grows with speed);
+    ``weights``: (channels, modes) weight of each mode at each channel; then x is (channels, n),
+    each channel with its own noise.
     """
     rng = np.random.default_rng(seed)
     n = int(round(duration * fs))
@@ -43,11 +45,13 @@ def synthetic_runup(*, fs=12800.0, duration=6.0, speeds=(2.0, 20.0),
         force += amp * rel ** 2 * np.cos(order * angle + rng.uniform(0, 2 * np.pi))
     for f, amp in lines:
         force += amp * np.cos(2 * np.pi * f * t + rng.uniform(0, 2 * np.pi))
-    x = np.zeros(n)
-    for fn, zeta in modes:
+    w = np.ones((1, len(modes))) if weights is None else np.asarray(weights, float)
+    x = np.zeros((w.shape[0], n))
+    for k, (fn, zeta) in enumerate(modes):
         b, a = _mode_filter(fn, zeta, fs)
-        x += sps.lfilter(b, a, force)
-    x += noise * np.std(x) * rng.standard_normal(n)
+        x += w[:, k:k + 1] * sps.lfilter(b, a, force)[None, :]
+    x += noise * np.std(x, axis=1, keepdims=True) * rng.standard_normal(x.shape)
+    x = x[0] if weights is None else x
     truth = {"modes": [m for m in modes], "orders": [o for o, _ in orders], "lines": [f for f, _ in lines]}
     return x, angle, truth
 
