@@ -50,6 +50,8 @@ class CalibrationTarget:
     objectives: tuple[str, ...] = ("waveform", "correlation", "frequencies")
     mode_rel_sd: np.ndarray | None = None   # (k,) relative uncertainty of each measured mode ("modes")
     mode_channels: tuple[str, ...] = ()     # sensors the measured modes were seen by (default: channel)
+    mode_shapes: object | None = None       # MeasuredShapes of the measured modes at those sensors, or None
+    mode_pairing: object | None = None      # Pairing at the nominal set (twin.calibration.pairing), or None
 
     @property
     def needs_simulation(self) -> bool:
@@ -113,7 +115,7 @@ def evaluate_candidate(task: EvalTask) -> tuple[np.ndarray, dict]:
         from twin.calibration.modal_fit import modes_objective
         values["modes"], matched = modes_objective(task.fmu_path, task.parameters, tg.natural_frequencies, tg.rel_sd,
                                                    speed_hz=tg.drive_hz, load_nm=tg.load,
-                                                   channels=tg.mode_channels or (tg.channel,))
+                                                   channels=tg.mode_channels or (tg.channel,), shapes=tg.mode_shapes)
         info["matched_frequencies"] = matched.tolist()
     return np.array([values[o] for o in tg.objectives]), info
 
@@ -363,7 +365,8 @@ def _calibrate(fmu_path, space, target, ex, *, algorithm, pop_size, n_gen, seed,
             chosen = space.to_dict(fit_modes(Path(fmu_path), space.names, space.lower, space.upper, nom, nom,
                                              target.natural_frequencies, target.rel_sd, fixed=dict(fixed or {}),
                                              speed_hz=target.drive_hz, load_nm=target.load,
-                                             channels=target.mode_channels or (target.channel,)))
+                                             channels=target.mode_channels or (target.channel,),
+                                             shapes=target.mode_shapes, pairing=target.mode_pairing))
         else:
             chosen = space.to_dict(refine_modes(Path(fmu_path), space, target, start, fixed=fixed))
     return CalibrationResult(space.names, X, F, chosen, space.to_dict(X[knee]),

@@ -38,7 +38,7 @@ Outputs in ``out_dir``:
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -101,8 +101,10 @@ def _block(scenario, modes_from: str | None) -> dict:
 
 def measured_modes(spec: dict, mset, source: str, out_dir: Path, *, with_damping: bool = False):
     """(frequencies [Hz], relative sd, description) of the measured modes the block asks for;
-    with ``with_damping`` also their damping ratios (NaN where unknown), confidences and the
-    channels they were read from (empty when typed)."""
+    with ``with_damping`` also their damping ratios (NaN where unknown), confidences, the
+    channels they were read from (empty when typed) and their shapes at those channels
+    (:class:`twin.calibration.pairing.MeasuredShapes`, None when typed or read from one channel)."""
+    from twin.calibration.pairing import MeasuredShapes
     from twin.modes import MIN_CONFIDENCE, survey_record, write_survey_json
     from twin.signals import remove_foundation_modes
 
@@ -123,6 +125,7 @@ def measured_modes(spec: dict, mset, source: str, out_dir: Path, *, with_damping
         damping = np.array([m.damping for m in used])
         confidence = np.array([m.confidence for m in used])
         channels = tuple(survey.channels)
+        shapes = MeasuredShapes.from_evidence([m.evidence for m in used])
         what = (f"{freqs.size} modes read from record {name!r} ({survey.method}, confidence >= {threshold:g}; "
                 f"{len(survey.lines)} fixed lines and {len(survey.orders)} orders set aside)")
     elif spec.get("natural_frequencies"):
@@ -131,6 +134,7 @@ def measured_modes(spec: dict, mset, source: str, out_dir: Path, *, with_damping
         damping = np.full(freqs.size, np.nan)
         confidence = np.ones(freqs.size)
         channels = ()
+        shapes = None
         what = "typed in the scenario"
     else:
         raise ScenarioError([(source, "calibration.natural_frequencies",
@@ -140,9 +144,11 @@ def measured_modes(spec: dict, mset, source: str, out_dir: Path, *, with_damping
         kept, removed = remove_foundation_modes(freqs, np.asarray(spec["foundation_modes"]))
         keep = np.isin(freqs, kept)
         freqs, rel, damping, confidence = freqs[keep], rel[keep], damping[keep], confidence[keep]
+        if shapes is not None:
+            shapes = replace(shapes, vectors=shapes.vectors[keep], coherence=shapes.coherence[keep])
         print(f"removed foundation modes {list(np.round(removed, 1))} Hz from the measured list")
     if with_damping:
-        return freqs, rel, what, damping, confidence, channels
+        return freqs, rel, what, damping, confidence, channels, shapes
     return freqs, rel, what
 
 
@@ -172,8 +178,8 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
     mset = load_measurements(measurements)
     for note in mset.notes:
         print(f"note: {note}")
-    freqs, rel_sd, modes_what, damping, confidence, seen_by = measured_modes(spec, mset, source, out_dir,
-                                                                             with_damping=True)
+    freqs, rel_sd, modes_what, damping, confidence, seen_by, shapes = measured_modes(spec, mset, source, out_dir,
+                                                                                     with_damping=True)
     steady_name = spec.get("record") or next((n for n in mset.names if n != spec.get("modes_from")), mset.names[0])
     if steady_name not in mset.names:
         raise ScenarioError([(source, "calibration.record", f"no record {steady_name!r} in the measurements")])
@@ -203,7 +209,8 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
     mode_channels = tuple(c for c in seen_by if c in outputs) or (channel,)
     target = CalibrationTarget(np.asarray(rec[channel][-n:], float), rec.sample_rate, float(rec.nominal_speed),
                                float(rec.load), freqs, channel=channel, fmin=band[0], fmax=band[1],
-                               objectives=objectives, mode_rel_sd=rel_sd, mode_channels=mode_channels)
+                               objectives=objectives, mode_rel_sd=rel_sd, mode_channels=mode_channels,
+                               mode_shapes=shapes if len(mode_channels) > 1 else None)
     fixed = dict(scenario.parameters)
     if not auto:       # unknown or non-physical names and bounds: refused before the first evaluation
         check_calibration_parameters(fmu, ParameterSpace.from_bounds(spec["parameters"]),
@@ -215,7 +222,9 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
         sensitivity = None
         if auto:
             sensitivity = mode_sensitivity(fmu, fixed, freqs, speed_hz=target.drive_hz, load_nm=target.load,
-                                           rel_sd=rel_sd, channels=mode_channels, executor=ex)
+                                           rel_sd=rel_sd, channels=mode_channels, executor=ex,
+                                           shapes=target.mode_shapes)
+            target = replace(target, mode_pairing=sensitivity.pairing)
             (out_dir / "sensitivity.json").write_text(json.dumps(sensitivity.to_dict(), indent=2))
             if not sensitivity.chosen:
                 raise ScenarioError([(source, "calibration.parameters", "no parameter is identifiable from the "
@@ -289,8 +298,8 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
     scenario_file = write_calibrated_scenario(scenario, out_dir / "calibrated.yaml", "calibrated.json",
                                               note=f"{Path(measurements).name}, {modes_what}", calibrated=chosen)
     if "modes" in objectives:
-        mb = mode_errors(model_modes(fmu, {**fixed, **nominal}, **kw), freqs, target.rel_sd)[1]
-        ma = mode_errors(model_modes(fmu, full, **kw), freqs, target.rel_sd)[1]
+        mb = mode_errors(model_modes(fmu, {**fixed, **nominal}, **kw), freqs, target.rel_sd, target.mode_shapes)[1]
+        ma = mode_errors(model_modes(fmu, full, **kw), freqs, target.rel_sd, target.mode_shapes)[1]
     else:
         from twin.linearize import natural_frequencies
         b = natural_frequencies(fmu, n=freqs.size + 4, parameters={**fixed, **nominal, **_start(target)})
@@ -374,10 +383,13 @@ def scenario_sensitivity(scenario, measurements: str | Path | None = None, *, mo
     channel = (scenario.outputs or ("accel_pinion_casing",))[0]
     fmu = scenario.fmu_path()
     values = dict(scenario.parameters)
+    channels, shapes = (channel,), None
     if measurements is not None and (spec.get("modes_from") or spec.get("natural_frequencies")):
         mset = load_measurements(measurements)
         with tempfile.TemporaryDirectory() as tmp:
-            freqs, rel, _ = measured_modes(spec, mset, str(scenario.source), Path(tmp))
+            freqs, rel, _, _, _, seen_by, shapes = measured_modes(spec, mset, str(scenario.source), Path(tmp),
+                                                                  with_damping=True)
+        channels = tuple(c for c in seen_by if c in _outputs(fmu)) or (channel,)
         steady = [r for r in mset if r.name != spec.get("modes_from") and r.nominal_speed and r.load is not None]
         if steady:
             speed_hz, load_nm = float(steady[0].nominal_speed), float(steady[0].load)
@@ -388,5 +400,5 @@ def scenario_sensitivity(scenario, measurements: str | Path | None = None, *, mo
         mm = model_modes(fmu, values, speed_hz=speed_hz, load_nm=load_nm, channels=(channel,))
         freqs = mm.frequency[mm.visible][:n_modes]
         rel = np.zeros(freqs.size)
-    return mode_sensitivity(fmu, values, freqs, speed_hz=speed_hz, load_nm=load_nm, rel_sd=rel, channels=(channel,),
-                            executor=executor)
+    return mode_sensitivity(fmu, values, freqs, speed_hz=speed_hz, load_nm=load_nm, rel_sd=rel, channels=channels,
+                            executor=executor, shapes=shapes if len(channels) > 1 else None)

@@ -7,12 +7,13 @@
    3-4; where the model computes a shaft from its geometry, its diameter within -15/+20 % and its
    bearing span within -20/+25 %), narrowed to the model's own ``min``/``max`` when it declares them.
 2. **Modes.** The model is linearised about the operating point (:mod:`twin.linearize`) with
-   the sensor output and the mesh excitation; a model mode counts as *visible* when it makes a
-   peak of the mesh-to-sensor response, the way a measured mode shows in a run-up. Measured modes
-   are matched to visible model modes (minimum total |ln f_model/f_measured| in units of the
-   measurement's uncertainty; a measured mode with no model mode within 15 % stays unmatched).
-3. **Sensitivities** ``S[i, j] = d ln f_i / d ln p_j`` by one-sided differences (2 %), modes
-   followed by their shapes (MAC) so that two crossing modes are not confused.
+   the sensor outputs and the mesh excitation; a model mode counts as *visible* when it makes a
+   peak of the mesh-to-sensor response, the way a measured mode shows in a run-up.
+3. **Sensitivities** ``S[i, j] = d ln f_i / d ln p_j`` of every candidate model mode (visible, or
+   weakly visible down to :data:`twin.calibration.pairing.MIN_LEVEL_DB`) by one-sided differences
+   (2 %), modes followed by their shapes (MAC) so that two crossing modes are not confused.
+   They give each model mode its reach within the bounds, and the measured modes are paired with
+   model modes by frequency, shape at the sensors and reach (:mod:`twin.calibration.pairing`).
 4. **Identifiable subset** by QR with column pivoting on the weighted matrix
    ``S[i, j] * h_j / s_i`` (``h_j`` half the log-range of the bounds, ``s_i`` the relative
    uncertainty of mode i): a column is kept while the information it adds beyond the columns
@@ -29,6 +30,9 @@ from pathlib import Path
 
 import numpy as np
 from scipy.optimize import linear_sum_assignment
+
+from twin.calibration.pairing import (MATCH_REACH, MeasuredShapes, Pairing, candidate_modes, mode_reach, pair_modes,
+                                      shape_mismatch)
 
 #: (unit, words in the description, relative bounds [lower, upper] about the nominal, reason); the
 #: first rule whose unit matches and whose words (if any) occur in the description applies
@@ -52,8 +56,6 @@ PHYSICS_BOUNDS: tuple[tuple[str, tuple[str, ...], tuple[float, float], str], ...
 MIN_INFORMATION = 4.0
 #: Relative model-form uncertainty of a model mode [-], added in quadrature to the measurement's.
 MODEL_FORM = 0.01
-#: A measured mode with no visible model mode within this relative distance stays unmatched.
-MATCH_REACH = 0.15
 #: Parameters moved together to form a transmission error (mesh excitation) in GearTwin models.
 MESH_EXCITATION = "profile_deviation"
 #: Levels of the broadband sources of GearTwin.Gearbox21Measured, set to zero to linearise.
@@ -192,25 +194,11 @@ def model_modes(fmu_path, parameters: Mapping[str, float], *, speed_hz: float, l
                       tuple(classify(shapes, table)), mm.residues[:, 0, keep], tuple(channels))
 
 
-def match_measured(model: ModelModes, measured: np.ndarray, rel_sd: np.ndarray | None = None) -> np.ndarray:
-    """Index of the visible model mode matched to each measured mode, -1 where none is within reach."""
-    measured = np.asarray(measured, float)
-    rel_sd = np.full(measured.size, MODEL_FORM) if rel_sd is None else np.asarray(rel_sd, float)
-    idx = np.flatnonzero(model.visible)
-    out = np.full(measured.size, -1, dtype=int)
-    if idx.size == 0 or measured.size == 0:
-        return out
-    dist = np.abs(np.log(model.frequency[idx][None, :] / measured[:, None]))
-    cost = dist / rel_sd[:, None]
-    big = 1e6
-    cost = np.where(dist <= MATCH_REACH, cost, big)
-    # dummy columns: leaving a measured mode unmatched costs as much as the reach itself
-    dummy = np.full((measured.size, measured.size), MATCH_REACH / rel_sd.min() * 2)
-    rows, cols = linear_sum_assignment(np.hstack([cost, dummy]))
-    for r, c in zip(rows, cols):
-        if c < idx.size and cost[r, c] < big:
-            out[r] = idx[c]
-    return out
+def match_measured(model: ModelModes, measured: np.ndarray, rel_sd: np.ndarray | None = None, *,
+                   shapes: MeasuredShapes | None = None, reach: np.ndarray | None = None) -> np.ndarray:
+    """Index of the model mode paired with each measured mode, -1 where none can be: by frequency,
+    shape at the sensors and reach (:func:`twin.calibration.pairing.pair_modes`)."""
+    return pair_modes(model, measured, rel_sd, shapes=shapes, reach=reach)
 
 
 def _mac(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -254,6 +242,10 @@ class Sensitivity:
     condition: float                      # of the weighted, chosen columns
     unmatched_hz: tuple[float, ...] = ()
     notes: tuple[str, ...] = field(default_factory=tuple)
+    reach: np.ndarray | None = None       # (k, 2) how far (down, up) in ln f each paired model mode can move
+    shape_mismatch: np.ndarray | None = None   # (k,) coherence x (1 - MAC) of each pairing (0: no shape)
+    gain_db: np.ndarray | None = None     # (k,) peak gain of each paired model mode, dB re the most visible
+    pairing: Pairing | None = None        # of all the measured modes (unpaired: -1), at the nominal set
 
     def bounds(self) -> dict[str, list[float]]:
         by = {c.name: c for c in self.candidates}
@@ -273,7 +265,7 @@ class Sensitivity:
         for n, why in self.left_out.items():
             rows.append(f"  not identifiable: {n}: {why}")
         if self.unmatched_hz:
-            rows.append("  measured modes the model has no visible mode for (within 15 %): "
+            rows.append("  measured modes no model mode can reach within the bounds: "
                         + ", ".join(f"{f:.1f} Hz" for f in self.unmatched_hz))
         rows += [f"note: {n}" for n in self.notes]
         return "\n".join(rows)
@@ -286,28 +278,28 @@ class Sensitivity:
                                 "chosen": c.name in self.chosen, "left_out": self.left_out.get(c.name)}
                                for j, c in enumerate(self.candidates)],
                 "chosen": list(self.chosen), "condition": self.condition,
-                "unmatched_measured_hz": list(self.unmatched_hz), "notes": list(self.notes)}
+                "unmatched_measured_hz": list(self.unmatched_hz), "notes": list(self.notes),
+                "pairing": [{"measured_hz": float(fm), "model_hz": float(f),
+                             "model_gain_db": None if self.gain_db is None else float(self.gain_db[i]),
+                             "reach_ln_f": None if self.reach is None else [float(v) for v in self.reach[i]],
+                             "shape_mismatch": None if self.shape_mismatch is None else float(self.shape_mismatch[i])}
+                            for i, (fm, f) in enumerate(zip(self.measured_hz, self.modes_hz))]}
 
 
 def mode_sensitivity(fmu_path, values: Mapping[str, float], measured_hz, *, speed_hz: float, load_nm: float,
                      rel_sd=None, channels: Sequence[str] = ("accel_pinion_casing",),
                      candidates: Sequence[Candidate] | None = None, step: float = 0.02,
-                     executor=None) -> Sensitivity:
-    """Sensitivities of the measured modes' model counterparts and the identifiable subset."""
+                     executor=None, shapes: MeasuredShapes | None = None) -> Sensitivity:
+    """Sensitivities of the measured modes' model counterparts and the identifiable subset.
+
+    ``shapes``: the measured modes' shapes at the channels (``twin modes``), for the pairing."""
     measured = np.asarray(measured_hz, float)
     rel = np.sqrt((np.full(measured.size, 0.0) if rel_sd is None else np.asarray(rel_sd, float)) ** 2
                   + MODEL_FORM ** 2)
     cands = list(candidates) if candidates is not None else candidate_parameters(fmu_path, values)
     kw = dict(speed_hz=speed_hz, load_nm=load_nm, channels=tuple(channels))
     base = model_modes(fmu_path, values, **kw)
-    match = match_measured(base, measured, rel)
-    ok = match >= 0
-    which = match[ok]
     notes = []
-    if not ok.any():
-        raise ValueError("no measured mode has a visible model mode within 15 %: the model and the record "
-                         f"do not share a mode (measured {np.round(measured, 1).tolist()} Hz, visible model "
-                         f"{np.round(base.frequency[base.visible], 1).tolist()} Hz)")
     tasks = [(str(fmu_path), {**values, c.name: c.nominal * (1 + step)}, kw) for c in cands]
     if executor is not None:
         moved = executor.map(_modes_task, tasks, desc="sensitivities")
@@ -319,12 +311,26 @@ def mode_sensitivity(fmu_path, values: Mapping[str, float], measured_hz, *, spee
         name, err = failed[0]
         raise SimulationError(f"{len(failed)} of {len(cands)} sensitivity runs failed; first ({name} moved by "
                               f"{100 * step:g} %): {err}")
-    S = np.empty((which.size, len(cands)))
+    # every candidate model mode's sensitivities, so that each has its own reach for the pairing
+    cols = candidate_modes(base)
+    S_all = np.zeros((base.frequency.size, len(cands)))
     for j, mv in enumerate(moved):
-        S[:, j] = np.log(follow(base, mv, which) / base.frequency[which]) / math.log(1 + step)
+        S_all[cols, j] = np.log(follow(base, mv, cols) / base.frequency[cols]) / math.log(1 + step)
+    reach = mode_reach(S_all, cands)
+    match = match_measured(base, measured, rel, shapes=shapes, reach=reach)
+    ok = match >= 0
+    which = match[ok]
+    if not ok.any():
+        raise ValueError("no measured mode is within the reach of a model mode: the model and the record "
+                         f"do not share a mode (measured {np.round(measured, 1).tolist()} Hz, visible model "
+                         f"{np.round(base.frequency[base.visible], 1).tolist()} Hz)")
+    mismatch = (shape_mismatch(base, shapes, which)[np.flatnonzero(ok), np.arange(which.size)]
+                if shapes is not None else np.zeros(which.size))
+    S = S_all[which]
     chosen, left_out, info, cond = select_identifiable(S, cands, rel[ok])
     return Sensitivity(base.frequency[which], measured[ok], rel[ok], tuple(cands), S, chosen, left_out, info, cond,
-                       tuple(float(f) for f in measured[~ok]), tuple(notes))
+                       tuple(float(f) for f in measured[~ok]), tuple(notes), reach[which], mismatch,
+                       base.gain_db[which], Pairing(base, match))
 
 
 def _modes_task(task):

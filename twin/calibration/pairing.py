@@ -1,0 +1,169 @@
+"""Which model mode each measured mode is: pairing by frequency, shape at the sensors, and reach.
+
+A measured mode is paired with a model mode when the model can *become* it: the model mode must
+be able to reach the measured frequency within the physical bounds of the parameters, and its
+shape at the casing sensors must look like the measured one.
+
+* **Candidates.** Every model mode that makes a peak at a sensor (*visible*) and every mode whose
+  own peak gain is at least :data:`MIN_LEVEL_DB` below the most visible mode's: a shaft's lateral
+  mode seen through a stiff casing peaks 40-65 dB down, and it is still the mode a rig's shaft
+  mode must be fitted with.
+* **Reach.** Model mode j can move down by ``down_j`` and up by ``up_j`` (in ln f):
+  ``up_j = sum_p max(0, S_jp ln(upper_p / p_p), S_jp ln(lower_p / p_p))`` (each parameter at the
+  bound that raises it most; ``down_j`` likewise), from the first-order sensitivities
+  ``S = d ln f / d ln p`` (:func:`twin.calibration.sensitivity.mode_sensitivity`). Without
+  sensitivities every mode reaches :data:`MATCH_REACH` either way. A measured mode further from
+  a model mode than its reach (plus twice its uncertainty) is never paired with it.
+* **Cost** of pairing measured mode i with model mode j:
+  ``max(0, |ln(f_i / f_j)| - 2 s_i) / reach_j`` (the share of its reach the model mode must use;
+  0 within the measurement's uncertainty) plus ``SHAPE_WEIGHT * coherence_i * (1 - MAC_ij)``,
+  where MAC is the modal assurance criterion between the measured shape at the channels (level
+  and phase re a reference, :mod:`twin.signals.shapes`) and the model's residues at the same
+  channels (``ModelModes.sensor_shapes``), and ``coherence_i`` the measured shape's lowest
+  coherence: a shape that is not trustworthy does not count.
+* **Assignment.** One-to-one with least total cost (Hungarian algorithm); a measured mode is left
+  unpaired at cost :data:`UNPAIRED`, more than any feasible pairing.
+"""
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+
+#: Without sensitivities, each model mode reaches this far either way (relative, in ln f).
+MATCH_REACH = 0.15
+#: Model modes whose peak gain is at least this far below the most visible mode's [dB] are candidates.
+MIN_LEVEL_DB = -70.0
+#: Weight of a full shape mismatch (1 - MAC = 1, coherence 1) against a model mode's whole reach.
+SHAPE_WEIGHT = 1.0
+#: Cost of leaving a measured mode unpaired (above every feasible pairing's: at most 1 + SHAPE_WEIGHT).
+UNPAIRED = 1.0 + SHAPE_WEIGHT + 1.0
+
+
+@dataclass(frozen=True)
+class MeasuredShapes:
+    """Shapes of the measured modes at the channels (from ``twin modes``).
+
+    channels : (c,) names; vectors : (k, c) complex, level and phase re each mode's reference
+    (NaN where a channel has no estimate); coherence : (k,) lowest coherence with the reference.
+    """
+
+    channels: tuple[str, ...]
+    vectors: np.ndarray
+    coherence: np.ndarray
+
+    @classmethod
+    def from_evidence(cls, evidence: Sequence[dict]) -> "MeasuredShapes | None":
+        """From the modes' ``evidence["shape"]`` (``twin modes`` JSON); None when no mode has one."""
+        shaped = [e.get("shape") for e in evidence]
+        names: list[str] = []
+        for s in shaped:
+            for c in (s or {}).get("channels", {}):
+                if c not in names:
+                    names.append(c)
+        if len(names) < 2:
+            return None
+        vec = np.full((len(shaped), len(names)), np.nan, complex)
+        coh = np.zeros(len(shaped))
+        for i, s in enumerate(shaped):
+            if not s:
+                continue
+            for c, v in s["channels"].items():
+                vec[i, names.index(c)] = 10 ** (v["level_db"] / 20) * np.exp(1j * np.radians(v["phase_deg"]))
+            coh[i] = float(s.get("min_coherence", 0.0))
+        return cls(tuple(names), vec, coh)
+
+
+@dataclass(frozen=True, eq=False)
+class Pairing:
+    """A pairing made at one parameter set: ``index`` (k,) of the model mode of ``model`` (a
+    ``ModelModes``) paired with each measured mode, -1 where none."""
+
+    model: object
+    index: np.ndarray
+
+    def at(self, other) -> np.ndarray:
+        """The same pairing in ``other`` (the model at nearby parameters), each mode followed by its
+        shape and frequency (:func:`twin.calibration.sensitivity.follow_index`)."""
+        from twin.calibration.sensitivity import follow_index
+
+        out = np.full(self.index.size, -1, dtype=int)
+        ok = self.index >= 0
+        if ok.any():
+            out[ok] = follow_index(self.model, other, self.index[ok])
+        return out
+
+
+def mac(a: np.ndarray, b: np.ndarray) -> float:
+    """Modal assurance criterion |a^H b|^2 / (|a|^2 |b|^2) of two complex vectors, in [0, 1]."""
+    den = float(np.sum(np.abs(a) ** 2) * np.sum(np.abs(b) ** 2))
+    return float(np.abs(np.vdot(a, b)) ** 2 / den) if den > 0 else 0.0
+
+
+def shape_mismatch(model, shapes: MeasuredShapes | None, cols: np.ndarray) -> np.ndarray:
+    """(k, len(cols)) coherence-weighted shape mismatch ``coherence_i (1 - MAC_ij)`` (0 without shapes)."""
+    k = 0 if shapes is None else shapes.vectors.shape[0]
+    out = np.zeros((k, cols.size))
+    if shapes is None or model.sensor_shapes is None:
+        return out
+    for i in range(k):
+        known = [c for c, v in zip(shapes.channels, shapes.vectors[i]) if np.isfinite(v) and c in model.channels]
+        if len(known) < 2 or shapes.coherence[i] <= 0:
+            continue
+        m = np.array([shapes.vectors[i, shapes.channels.index(c)] for c in known])
+        for jj, j in enumerate(cols):
+            out[i, jj] = shapes.coherence[i] * (1.0 - mac(m, model.sensor_shape(int(j), known)))
+    return out
+
+
+def mode_reach(S: np.ndarray, candidates) -> np.ndarray:
+    """(m, 2) how far (down, up) in ln f each mode can move within the candidates' bounds, to first
+    order; ``S`` (m, p) is d ln f / d ln p of the modes, ``candidates`` (p,) have nominal and bounds."""
+    lo = np.array([np.log(c.lower / c.nominal) for c in candidates])
+    hi = np.array([np.log(c.upper / c.nominal) for c in candidates])
+    a, b = S * hi[None, :], S * lo[None, :]
+    up = np.sum(np.maximum(0.0, np.maximum(a, b)), axis=1)
+    down = np.sum(np.maximum(0.0, -np.minimum(a, b)), axis=1)
+    return np.column_stack([down, up])
+
+
+def candidate_modes(model, min_level_db: float = MIN_LEVEL_DB) -> np.ndarray:
+    """Indices of the model modes a measured mode may be paired with (visible, or not far below)."""
+    return np.flatnonzero(model.visible | (model.gain_db >= min_level_db))
+
+
+def pairing_cost(model, measured: np.ndarray, rel_sd: np.ndarray, cols: np.ndarray, *,
+                 shapes: MeasuredShapes | None = None, reach: np.ndarray | None = None) -> np.ndarray:
+    """(k, len(cols)) cost of each pairing (see the module docstring); inf where out of reach."""
+    lr = np.log(measured[:, None] / model.frequency[cols][None, :])           # > 0: the model mode must rise
+    r = np.full((cols.size, 2), MATCH_REACH) if reach is None else np.asarray(reach, float)[cols]
+    side = np.where(lr > 0, r[None, :, 1], r[None, :, 0])
+    excess = np.maximum(0.0, np.abs(lr) - 2 * rel_sd[:, None])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        used = np.where(excess > 0, excess / np.maximum(side, 1e-12), 0.0)
+    cost = used + (SHAPE_WEIGHT * shape_mismatch(model, shapes, cols) if shapes is not None else 0.0)
+    return np.where(used <= 1.0, cost, np.inf)
+
+
+def pair_modes(model, measured, rel_sd=None, *, shapes: MeasuredShapes | None = None,
+               reach: np.ndarray | None = None, min_level_db: float = MIN_LEVEL_DB) -> np.ndarray:
+    """Index of the model mode paired with each measured mode, -1 where none can be (see the module
+    docstring); ``reach`` (m, 2) is :func:`mode_reach` of all the model's modes, or None."""
+    from twin.calibration.sensitivity import MODEL_FORM
+
+    measured = np.asarray(measured, float)
+    rel_sd = np.full(measured.size, MODEL_FORM) if rel_sd is None else np.asarray(rel_sd, float)
+    cols = candidate_modes(model, min_level_db)
+    out = np.full(measured.size, -1, dtype=int)
+    if cols.size == 0 or measured.size == 0:
+        return out
+    cost = pairing_cost(model, measured, rel_sd, cols, shapes=shapes, reach=reach)
+    big = 1e6
+    dummy = np.full((measured.size, measured.size), UNPAIRED)
+    rows, picked = linear_sum_assignment(np.hstack([np.where(np.isfinite(cost), cost, big), dummy]))
+    for r, c in zip(rows, picked):
+        if c < cols.size and np.isfinite(cost[r, c]):
+            out[r] = cols[c]
+    return out
