@@ -13,10 +13,12 @@ shape at the casing sensors must look like the measured one.
   bound that raises it most; ``down_j`` likewise), from the first-order sensitivities
   ``S = d ln f / d ln p`` (:func:`twin.calibration.sensitivity.mode_sensitivity`). Without
   sensitivities every mode reaches :data:`MATCH_REACH` either way. A measured mode further from
-  a model mode than its reach (plus twice its uncertainty) is never paired with it.
+  a model mode than its reach (plus twice its uncertainty) is never paired with it. The reach is
+  what the bounds allow, not what is likely (every parameter at its most favourable bound): it
+  decides which pairings are possible, not which is best.
 * **Cost** of pairing measured mode i with model mode j:
-  ``max(0, |ln(f_i / f_j)| - 2 s_i) / reach_j`` (the share of its reach the model mode must use;
-  0 within the measurement's uncertainty) plus ``SHAPE_WEIGHT * coherence_i * (1 - MAC_ij)``,
+  ``max(0, |ln(f_i / f_j)| - 2 s_i) / MATCH_REACH`` (0 within the measurement's uncertainty; a
+  15 % gap costs 1) plus ``SHAPE_WEIGHT * coherence_i * (1 - MAC_ij)``,
   where MAC is the modal assurance criterion between the measured shape at the channels (level
   and phase re a reference, :mod:`twin.signals.shapes`) and the model's residues at the same
   channels (``ModelModes.sensor_shapes``), and ``coherence_i`` the measured shape's lowest
@@ -36,10 +38,11 @@ from scipy.optimize import linear_sum_assignment
 MATCH_REACH = 0.15
 #: Model modes whose peak gain is at least this far below the most visible mode's [dB] are candidates.
 MIN_LEVEL_DB = -70.0
-#: Weight of a full shape mismatch (1 - MAC = 1, coherence 1) against a model mode's whole reach.
+#: Weight of a full shape mismatch (1 - MAC = 1, coherence 1) against a 15 % frequency gap.
 SHAPE_WEIGHT = 1.0
-#: Cost of leaving a measured mode unpaired (above every feasible pairing's: at most 1 + SHAPE_WEIGHT).
-UNPAIRED = 1.0 + SHAPE_WEIGHT + 1.0
+#: Cost of leaving a measured mode unpaired: a pairing that costs more (a gap of more than about
+#: 45 % with the right shape) is not made even within reach.
+UNPAIRED = 3.0
 
 
 @dataclass(frozen=True)
@@ -141,10 +144,8 @@ def pairing_cost(model, measured: np.ndarray, rel_sd: np.ndarray, cols: np.ndarr
     r = np.full((cols.size, 2), MATCH_REACH) if reach is None else np.asarray(reach, float)[cols]
     side = np.where(lr > 0, r[None, :, 1], r[None, :, 0])
     excess = np.maximum(0.0, np.abs(lr) - 2 * rel_sd[:, None])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        used = np.where(excess > 0, excess / np.maximum(side, 1e-12), 0.0)
-    cost = used + (SHAPE_WEIGHT * shape_mismatch(model, shapes, cols) if shapes is not None else 0.0)
-    return np.where(used <= 1.0, cost, np.inf)
+    cost = excess / MATCH_REACH + (SHAPE_WEIGHT * shape_mismatch(model, shapes, cols) if shapes is not None else 0.0)
+    return np.where(excess <= side, cost, np.inf)
 
 
 def pair_modes(model, measured, rel_sd=None, *, shapes: MeasuredShapes | None = None,
