@@ -82,6 +82,17 @@ def rms(x) -> float:
     return float(np.sqrt(np.mean((x - x.mean()) ** 2)))
 
 
+def pinion_errors(seed: int, teeth: int) -> dict:
+    """Seeded pitch deviations and run-out of a real pinion, of the order of ISO 1328-1 class 6
+    (single pitch deviations sd 2 um, run-out 10 um peak to peak), as ``tooth_deviation_offset``
+    values; the same at every stage of a run."""
+    rng = np.random.default_rng(seed)
+    j = np.arange(teeth)
+    errors = 2e-6 * rng.standard_normal(teeth) + 5e-6 * (1 + np.cos(2 * np.pi * j / teeth + rng.uniform(0, 2 * np.pi)))
+    errors -= errors.min()
+    return {f"tooth_deviation_offset[{k + 1}]": float(v) for k, v in enumerate(errors)}
+
+
 # ---- build -----------------------------------------------------------------------------------
 def part_build(args) -> dict:
     import tempfile
@@ -172,11 +183,16 @@ def part_wear(args) -> dict:
     fresh = model.initial_state(geometry)
     force = 10.0 * 18 / 35 / geometry.base_radius_pinion
     check = set(np.unique(np.linspace(0, len(run.stages) - 1, 8).astype(int)))
+    # the RMS records are of a real pinion: its pitch deviations and run-out (as in ``pitting``
+    # and ``rigs``) make the teeth lose contact one by one rather than all alike; the contact
+    # check keeps the teeth alike, as the LTCA has them
+    manufacturing = pinion_errors(args.seed, 18)
     for i, s in enumerate(run.stages):
         row = {"cycles": s.cycles, "depth": s.damage, "max_depth": s.max_damage,
                "gear_max_depth": float(np.max(s.gear_field)) if s.gear_field is not None else 0.0,
                # as an inspection would: several records at slightly different speed and load
-               "rms": float(np.mean([steady_rms(fmu, s.parameters, 15.0 * (1 + ds), 10.0 * (1 + dl))
+               "rms": float(np.mean([steady_rms(fmu, {**s.parameters, **manufacturing}, 15.0 * (1 + ds),
+                                                10.0 * (1 + dl))
                                      for ds, dl in ((0.0, 0.0), (0.01, -0.05), (-0.01, 0.05))]))}
         if i in check:
             state = WearState(s.cycles, s.field_xi, s.field, geometry, s.gear_field,
@@ -201,8 +217,8 @@ def part_wear(args) -> dict:
     ratio = level[-1] / level[0]
     print(f"Machine: {machine()}\n")
     print(f"18/35, module 3, 15 Hz / 10 N.m, form deviation {form * 1e6:.1f} um (ISO 1328-1 class 7), "
-          f"{len(rows)} stages in {wall:.0f} s (coupled run); RMS: mean of three 0.4 s records at "
-          f"15 Hz / 10 N.m, +1 % / -5 %, -1 % / +5 %\n")
+          f"{len(rows)} stages in {wall:.0f} s (coupled run); RMS: mean of three 0.4 s records (6 pinion "
+          f"revolutions) at 15 Hz / 10 N.m, +1 % / -5 %, -1 % / +5 %, pinion with class-6 pitch deviations and run-out\n")
     print("Pairs unloaded: share of pair-in-path samples with load; FMU / LTCA at each sample's elastic mesh "
           "force and roll positions / FMU unloaded where that LTCA loads (unexplained)\n")
     print("| mean depth [um] | max depth pinion / gear [um] | casing RMS [m/s2] | 15 Hz: no pair touching | "
@@ -306,13 +322,8 @@ def part_pitting(args) -> dict:
     # the rig as a black box through its public function: casing acceleration per record
     rig_records = simulate_ltca(rig, np.full(n, 20.0), np.full(n, 20.0), np.array(DENSITIES), "pitting_density",
                                 2.0, gear_seed=args.seed, nominal_load=20.0, settle=0.3)
-    # every real pinion has pitch deviations and run-out: seeded, of the order of ISO 1328-1
-    # class 6 (single pitch deviations sd 2 um, run-out 10 um peak to peak), the same at every stage
-    rng = np.random.default_rng(args.seed)
-    teeth = np.arange(19)
-    errors = 2e-6 * rng.standard_normal(19) + 5e-6 * (1 + np.cos(2 * np.pi * teeth / 19 + rng.uniform(0, 2 * np.pi)))
-    errors -= errors.min()
-    manufacturing = {f"tooth_deviation_offset[{j + 1}]": float(v) for j, v in enumerate(errors)}
+    # every real pinion has pitch deviations and run-out, the same at every stage
+    manufacturing = pinion_errors(args.seed, 19)
     for r_i, dens in enumerate(DENSITIES):
         i = int(np.argmin(np.abs(damage - dens)))
         params = {**run.stages[i].parameters, **manufacturing}
@@ -388,11 +399,7 @@ def part_rigs(args) -> dict:
     duration = 1.0
     # the twin gets the same seeded pitch deviations and run-out as in ``pitting`` (ISO 1328-1
     # class 6 order): a healthy real pinion has them, and without them it has no sidebands
-    rng = np.random.default_rng(args.seed)
-    teeth = np.arange(19)
-    errors = 2e-6 * rng.standard_normal(19) + 5e-6 * (1 + np.cos(2 * np.pi * teeth / 19 + rng.uniform(0, 2 * np.pi)))
-    errors -= errors.min()
-    manufacturing = {f"tooth_deviation_offset[{j + 1}]": float(v) for j, v in enumerate(errors)}
+    manufacturing = pinion_errors(args.seed, 19)
     result = {}
     print(f"Machine: {machine()}\n")
     for kind, (damages, speed, load, scenario) in RIG_POINTS.items():
@@ -477,7 +484,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("part", choices=("build", "wear", "nodes", "pitting", "speed", "rigs"))
     ap.add_argument("--depth", type=float, default=1.0e-3, help="wear: mean pinion depth to reach [m]")
-    ap.add_argument("--seed", type=int, default=0, help="pitting: the rig's gear seed")
+    ap.add_argument("--seed", type=int, default=0, help="pitting: the rig's gear seed; the twin pinion's pitch deviations and run-out")
     ap.add_argument("--kind", action="append", choices=tuple(RIG_POINTS),
                     help="rigs: only this damage kind (repeatable; default both)")
     ap.add_argument("--model", help="rigs: the twin's model for its runs (default: the scenario's)")
