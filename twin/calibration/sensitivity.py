@@ -5,7 +5,9 @@
    (:data:`PHYSICS_BOUNDS`: masses and inertias come from the geometry to within about 30 %,
    shaft stiffnesses to within a factor 1.6, couplings, bearings and supports to within a factor
    3-4; where the model computes a shaft from its geometry, its diameter within -15/+20 % and its
-   bearing span within -20/+25 %), narrowed to the model's own ``min``/``max`` when it declares them.
+   bearing span within -20/+25 %; where it computes casing walls from a plate geometry, the wall
+   thickness within -20/+40 % and each panel size within -20/+20 %), narrowed to the model's own
+   ``min``/``max`` when it declares them.
 2. **Modes.** The model is linearised about the operating point (:mod:`twin.linearize`) with
    the sensor outputs and the mesh excitation; a model mode counts as *visible* when it makes a
    peak of the mesh-to-sensor response, the way a measured mode shows in a run-up.
@@ -48,6 +50,10 @@ PHYSICS_BOUNDS: tuple[tuple[str, tuple[str, ...], tuple[float, float], str], ...
      "shaft diameter: the effective bending diameter (shoulders, keyways, the hub's stiffening), -15/+20 %"),
     ("m", ("bearing span",), (0.8, 1.25),
      "bearing span: where a bearing's support acts within its width and housing, -20/+25 %"),
+    ("m", ("wall thickness",), (0.8, 1.4),
+     "cast wall thickness: casting tolerance (about 1 mm on 8 mm) and the ribs and bosses that stiffen a panel, -20/+40 %"),
+    ("m", ("wall panel size",), (0.8, 1.2),
+     "wall panel size: where the clamped edges act (fillets, flanges, ribs), -20/+20 %"),
     ("", ("calibration multiplier", "pair stiffness"), (0.6, 1.5),
      "mesh stiffness: ISO 6336 single-pair stiffness is good to about -40/+50 %"),
 )
