@@ -13,9 +13,10 @@ For each rig and seed: one gearbox with its base parameters scattered +-12 %
    Reported: how many extracted modes lie within 2 % of a rig mode (any), how many observable
    rig modes have an extracted mode within 2 %, and the errors of those pairs.
 2. ``twin calibrate`` (parameters auto, modes from the run-up, steady record for the spectrum,
-   model ``--model``, default ``GearTwin.Gearbox21Shafts``). The rig's first six observable modes against the
-   nearest mode the calibrated twin shows at its sensor (acceptance: all within 3 %), the
-   parameters left on a bound, and the wall time of modes + calibrate.
+   model ``--model``, default ``GearTwin.Gearbox21Shafts``; ``GearTwin.Gearbox21Walls`` adds flexible
+   casing walls). The rig's first six observable modes against the nearest mode the calibrated
+   twin shows at its sensor (acceptance: all within 3 %), the parameters left on a bound, and the
+   wall time of modes + calibrate.
 3. The spectrum of the steady record against the twin's (default ``GearTwin.Gearbox21``, and the
    calibrated twin) by the floor-aware, gain-free log-spectral distance of
    ``bench/spectral_distance.py`` (no ``twin.compare``).
@@ -199,7 +200,8 @@ def main() -> None:
     ap.add_argument("--rigs", nargs="+", default=["pedestal", "beam"])
     ap.add_argument("--seeds", nargs="+", type=int, default=[6, 7, 8, 9, 10])
     ap.add_argument("--model", default="GearTwin.Gearbox21Shafts",
-                    help="the twin's model (GearTwin.Gearbox21Measured: pedestals on rigid ground)")
+                    help="the twin's model (GearTwin.Gearbox21Walls: flexible casing walls; GearTwin.Gearbox21Measured: "
+                         "pedestals on rigid ground)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--out", type=Path, default=REPO / "bench_out" / "calibration_rigs")
     ap.add_argument("--explain", action="store_true",
