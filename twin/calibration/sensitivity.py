@@ -268,6 +268,14 @@ class Sensitivity:
             rows.append(f"{mark} {n:<16s}" + "".join(f"{v:9.3f}" for v in self.S[:, j])
                         + f"   [{by[n].lower:.4g}, {by[n].upper:.4g}]")
         rows.append(f"chosen (*): {', '.join(self.chosen) or 'none'}; condition number {self.condition:.3g}")
+        if self.reach is not None:
+            rows.append("pairing (measured -> model mode: its level re the most visible, its reach within the "
+                        "bounds, shape mismatch):")
+            for i, (fm, f) in enumerate(zip(self.measured_hz, self.modes_hz)):
+                level = f"{self.gain_db[i]:6.1f} dB" if self.gain_db is not None else "      -"
+                mis = f"{self.shape_mismatch[i]:.2f}" if self.shape_mismatch is not None else "-"
+                rows.append(f"  {fm:9.1f} -> {f:9.1f} Hz  {level}  {-100 * (1 - math.exp(-self.reach[i, 0])):+.0f}/"
+                            f"{100 * (math.exp(self.reach[i, 1]) - 1):+.0f} %  {mis}")
         for n, why in self.left_out.items():
             rows.append(f"  not identifiable: {n}: {why}")
         if self.unmatched_hz:

@@ -66,3 +66,6 @@ def test_the_twins_own_modes_identify_one_parameter_per_mode_group(gearbox_fmu):
     bounds = sens.bounds()
     assert all(lo < hi for lo, hi in bounds.values()) and set(bounds) == set(sens.chosen)
     assert "not identifiable" in sens.table() and sens.to_dict()["chosen"] == list(sens.chosen)
+    # the model's own modes pair with themselves, each within its reach
+    assert np.allclose(sens.modes_hz, freqs) and "pairing (measured -> model mode" in sens.table()
+    assert np.all(sens.reach > 0) and [p["model_hz"] for p in sens.to_dict()["pairing"]] == sens.modes_hz.tolist()
