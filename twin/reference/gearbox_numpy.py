@@ -68,7 +68,7 @@ DEFAULT_INPUTS: dict[str, float] = {
 }
 
 _ARRAY_FIELDS = ("k_pair", "profile_deviation", "pit_profile", "tooth_stiffness_factor", "tooth_deviation_offset",
-                 "tooth_pit_scale",
+                 "tooth_pit_scale", "tooth_pit_field",
                  "wheel_tooth_deviation_offset", "effect_tooth_stiffness_factor", "effect_tooth_offset",
                  "effect_profile_deviation")
 #: Structural Integer parameters of the model: FMU constants, never set as start values.
@@ -106,6 +106,7 @@ class GearboxParams:
     tooth_deviation_offset: tuple[float, ...] = (0.0,) * 19                     # m
     pit_profile: tuple[float, ...] = (0.0,) * 11                                # m, at tooth pit scale 1
     tooth_pit_scale: tuple[float, ...] = (0.0,) * 19                            # -
+    tooth_pit_field: tuple[float, ...] = (0.0,) * (19 * 11)                     # m, tooth-major (z1 * n_profile)
     wheel_tooth_deviation_offset: tuple[float, ...] = (0.0,) * 52               # m, per gear tooth
     # parameter hooks of the effect catalogue (neutral here; they compose with the three above)
     effect_tooth_stiffness_factor: tuple[float, ...] = (1.0,) * 19              # -
@@ -199,6 +200,9 @@ class GearboxParams:
                      "effect_tooth_offset", "tooth_pit_scale"):
             if len(getattr(self, name)) != self.z1:
                 raise ValueError(f"{name} needs z1={self.z1} entries, got {len(getattr(self, name))}")
+        if len(self.tooth_pit_field) != self.z1 * self.n_profile:
+            raise ValueError(f"tooth_pit_field needs z1*n_profile={self.z1 * self.n_profile} entries, "
+                             f"got {len(self.tooth_pit_field)}")
         if len(self.wheel_tooth_deviation_offset) != round(self.z2):
             raise ValueError(f"wheel_tooth_deviation_offset needs z2={self.z2} entries, "
                              f"got {len(self.wheel_tooth_deviation_offset)}")
@@ -316,6 +320,7 @@ class _Constants:
         self.tooth_offset = np.asarray(p.tooth_deviation_offset) + np.asarray(p.effect_tooth_offset)
         self.pit_profile = np.asarray(p.pit_profile)                         # (n_profile,)
         self.tooth_pit_scale = np.asarray(p.tooth_pit_scale)                 # (z1,)
+        self.tooth_pit_field = np.asarray(p.tooth_pit_field).reshape(p.z1, p.n_profile)  # (z1, n_profile)
         tooth_node = 2 * PI * np.arange(p.z1) / p.z1
         self.tooth_node_cos = np.cos(tooth_node)                              # (z1,)
         self.tooth_node_sin = np.sin(tooth_node)                              # (z1,)
@@ -421,6 +426,9 @@ def _mesh(c: _Constants, x: np.ndarray) -> dict[str, np.ndarray]:
     pair_deviation = dev_profile + select @ c.tooth_offset
     if c.tooth_pit_scale.any():
         pair_deviation = pair_deviation + (select @ c.tooth_pit_scale) * (hat @ c.pit_profile)
+    if c.tooth_pit_field.any():
+        # each pair reads the field of the tooth it holds, interpolated along the roll
+        pair_deviation = pair_deviation + np.einsum("...j,jn,...n->...", select, c.tooth_pit_field, hat)
     if c.wheel_offset.any():
         # The variant's gear tooth of each pair: the same completed mesh cycles, on z2 teeth.
         wheel_ang = (mesh_angle - 2 * PI * cycle) / c.wheel_teeth + c.pair_wheel_shift[extra]

@@ -36,7 +36,8 @@ def degraded_params() -> tuple[GearboxParams, dict[str, float]]:
     """Non-default parameters that exercise every branch of the mesh model, plus inputs.
 
     A weak tooth (factor 0.6), a tooth with 2 um extra material loss, tip relief on the
-    profile and pits on teeth 3-5 (and a tooth pitted less than the mean) make pairs lose
+    profile, pits on teeth 3-5 (and a tooth pitted less than the mean) and a per-tooth pit field
+    that differs along the profile on teeth 2, 5, 6 make pairs lose
     contact part of the time; rotated sensors, a mesh phase offset,
     and inputs that differ from the pre-load complete the set.
     """
@@ -46,8 +47,14 @@ def degraded_params() -> tuple[GearboxParams, dict[str, float]]:
     offset[7] = 2e-6
     pit_scale = [0.0] * 19
     pit_scale[2:5] = (1.0, 0.4, -0.3)
+    # per-tooth pit field: pits at different places on teeth 2, 5 and 6 (tooth 5 also has pit_scale)
+    field = np.zeros((19, 11))
+    field[1, 2:6] = (0.3e-6, 1.2e-6, 0.9e-6, 0.2e-6)
+    field[4, 6:9] = (0.5e-6, 1.4e-6, 0.4e-6)
+    field[5, :] = -0.2e-6
     p = GearboxParams(tooth_stiffness_factor=factor, tooth_deviation_offset=offset,
                       pit_profile=(0, 0, 0.2e-6, 0.8e-6, 1.5e-6, 0.6e-6, 0, 0, 0, 0, 0), tooth_pit_scale=pit_scale,
+                      tooth_pit_field=field.ravel(),
                       profile_deviation=(0, 0, 0, 0, 0, 0, 0, 0, 0.5e-6, 1.5e-6, 3e-6),
                       sensor_angle_pinion=math.pi / 2, sensor_angle_gear=0.7, mesh_phase0=0.3,
                       c_mesh=800.0, mesh_stiffness_scale=0.9, load_start=30.0, I5=2.8e-4, m5=0.7)
