@@ -14,17 +14,13 @@ At each update (stage):
    increment reaches ``max_increment`` (default 3 um of wear depth or 0.01 of pitting
    density), so the load is re-sampled as often as the damage needs;
 4. turn the damage into the FMU's mesh parameters (``k_pair``, ``profile_deviation`` on the
-   FMU's ``n_profile`` nodes; for pitting ``pit_profile`` x ``tooth_pit_scale``) and set them on
+   FMU's ``n_profile`` nodes; for pitting the per-tooth field ``tooth_pit_field``) and set them on
    the FMU, so the next window runs on the degraded mesh (with ``pair_stiffness: contact``, wear
    sets ``k_pair`` to the LTCA's single-pair secant stiffness at the mean mesh force,
-   :func:`twin.degradation.mapping.contact_k_pair`).  The part of the pits' per-tooth field
-   those arrays cannot hold goes into the pinion's broadband roughness,
-   ``pinion_roughness.rms = sqrt(rms0^2 + residual_rms^2)`` with rms0 the scenario's (calibrated)
-   value (:mod:`twin.degradation.pitting_map`), on a model that has that parameter; on one that has
-   none (``GearTwin.Gearbox21``) it is skipped and only its size is recorded (the stage's
-   ``truncation_error["pit_residual_rms"]`` [m], on every model).  Wear has no such term: its
-   flanks are alike on every tooth, so its node-fit residual repeats at every mesh (mesh
-   harmonics, not random-phase shaft orders) and is reported as a truncation error only.
+   :func:`twin.degradation.mapping.contact_k_pair`).  The pits' field goes to the FMU whole,
+   every tooth's own profile on the nodes (:mod:`twin.degradation.pitting_map`), so its
+   tooth-to-tooth differences reach the mesh as shaft-order sidebands; the node fit's relative
+   error is the stage's ``truncation_error["tooth_pit_field"]``.
 
 The run stops on the scenario's criterion (pitting density, wear depth or cycles) or after
 ``max_updates``.  After every stage the stages so far are rewritten atomically to
@@ -152,8 +148,7 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
     from twin import _interrupt
     from twin._atomic import partial_path
     from twin.degradation import GearPair, MeshLoad, TransmittedLoad, contact_k_pair, mesh_parameters
-    from twin.degradation.pitting_map import (PINION_ROUGHNESS, ToothScatter, pitting_parameters,
-                                              roughness_with_residual)
+    from twin.degradation.pitting_map import ToothScatter, pitting_parameters
     from twin.plausibility import check_block, check_parameters
 
     spec = scenario.degradation
@@ -188,10 +183,10 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
         k_healthy = tuple(scenario.parameters.get(f"k_pair[{i}]", fmu.variable(f"k_pair[{i}]").start)
                           for i in range(1, n_nodes + 1))
         state = model.initial_state(geometry)
-        # the pinion roughness that carries the pits' residual, undamaged: the scenario's value
-        # (a calibrated one), else the model's; None when the model has no such parameter
-        rough0 = (float(scenario.parameters.get(PINION_ROUGHNESS, fmu.variable(PINION_ROUGHNESS).start))
-                  if model_name == "pitting" and PINION_ROUGHNESS in fmu.variables else None)
+        if model_name == "pitting" and f"tooth_pit_field[{geometry.z1 * n_nodes}]" not in fmu.variables:
+            raise ScenarioError([(str(fmu_file), "degradation.model",
+                                  f"pitting needs the per-tooth field tooth_pit_field[1..{geometry.z1 * n_nodes}]"
+                                  " (GearTwin.Gearbox21 and the models built on it); this FMU has none")])
         scatter = ToothScatter.draw(geometry.z1, float(spec.get("tooth_scatter", DEFAULT_TOOTH_SCATTER)),
                                     scenario.seed) if model_name == "pitting" else None
         source = next((p for p in (partial, path) if p is not None and p.exists()), None) if resume else None
@@ -248,11 +243,8 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
                 current.update({f"profile_deviation[{i}]": fmu.get(f"profile_deviation[{i}]")
                                 for i in range(1, n_nodes + 1)})
                 if model_name == "pitting":
-                    current.update({f"pit_profile[{i}]": fmu.get(f"pit_profile[{i}]") for i in range(1, n_nodes + 1)})
-                    current.update({f"tooth_pit_scale[{j}]": fmu.get(f"tooth_pit_scale[{j}]")
-                                    for j in range(1, geometry.z1 + 1)})
-                    if rough0 is not None:
-                        current[PINION_ROUGHNESS] = fmu.get(PINION_ROUGHNESS)
+                    current.update({f"tooth_pit_field[{k}]": fmu.get(f"tooth_pit_field[{k}]")
+                                    for k in range(1, geometry.z1 * n_nodes + 1)})
                 trunc = stages[-1].truncation_error if stages else {}
                 gear = np.asarray(state.gear_depth) if model_name == "wear" else None
                 stages.append(Stage(u, float(state.cycles), damage, dmax, current, np.asarray(xi), np.asarray(fld),
@@ -277,10 +269,7 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
                     mapped = pitting_parameters(geometry, state, force, k_healthy, scatter=scatter,
                                                 weibull_slope=model.m)
                     new, trunc_error = dict(mapped.parameters), {"k_pair": mapped.truncation_error,
-                                                                 "pit_profile": mapped.pit_truncation_error,
-                                                                 "pit_residual_rms": mapped.residual_rms}
-                    if rough0 is not None:
-                        new[PINION_ROUGHNESS] = roughness_with_residual(rough0, mapped.residual_rms)
+                                                                 "tooth_pit_field": mapped.pit_truncation_error}
                 fmu.set(new)
                 stages[-1] = Stage(**{**stages[-1].__dict__, "truncation_error": trunc_error})
             else:

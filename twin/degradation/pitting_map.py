@@ -34,28 +34,20 @@ f_j is the pitted share of the face weighted by the overlap of each cell with th
 it gives way by ``e_j(xi) = F (c_j - c_typical)`` more than the tooth ``k_pair`` describes; where
 the pits leave no support across the face the contact reaches the pit bottom, and the extra
 approach over the healthy tooth is at most the pit depth, the law's crack depth
-``z0 = 0.786 b`` (Eq. 13).  The FMU takes these per-tooth deviations as one shape along the path
-times one scale per tooth (``pit_profile[1..n]`` [m] x ``tooth_pit_scale[1..z1]``, the leading
-singular pair of the (z1, N) field e_j(xi)); the rank-1 residual is reported as a truncation
-error.  ``tooth_stiffness_factor`` is left to the scenario (it is no longer written).
+``z0 = 0.786 b`` (Eq. 13).  The FMU takes the whole (z1, N) field e_j(xi): each tooth's row is
+fitted on the ``n_profile`` nodes along the path (least squares on the FMU's hat functions) and
+written as ``tooth_pit_field[(j - 1) n_profile + n]`` [m] (tooth-major), which each pair reads for
+the pinion tooth it holds.  The node fit along xi is the only approximation;
+:attr:`PittingMap.pit_truncation_error` is its relative error.  ``tooth_stiffness_factor``,
+``pit_profile`` and ``tooth_pit_scale`` are left to the scenario (they are not written).
 
-**What the arrays cannot hold.**  The residual r_j(xi) of that fit (pits at different places on
-different teeth: 45-70 % of the field's norm) is not dropped.  It is a transmission error that
-differs from tooth to tooth and along the path with no common shape, so over a pinion revolution it
-is a sum of many shaft orders, and, as the pits' places are random, with random phases: the same
-kind of excitation as the flank roughness of the pinion.  :attr:`PittingMap.residual_rms` is its
-RMS over the teeth and the (uniform-in-time) roll positions, and a model with a broadband roughness
-transmission error of the pinion (``pinion_roughness.rms``, GearTwin.Excitation.
-RoughnessTransmissionError) carries it there, added in quadrature to the calibrated roughness:
-``rms = sqrt(rms0^2 + residual_rms^2)`` (:func:`roughness_with_residual`; independent random-phase
-sums add their powers).  The residual is that of a single pair's approach, so where two pairs
-share the load it overstates the transmission error somewhat.  The roughness block holds shaft orders
-8..264 with amplitudes falling as 1/n.  A 0.5 mm pit on the 19-tooth pinion's pitch circle (180 mm
-round) spans 1/360 of a revolution, so a single pit's edges reach about order 360; but the field
-e_j(xi) is resolved by 41 roll positions over the path of contact (contact ratio ~1.6 of the 19
-pitches), i.e. up to about order 20 / (1.6 / 19) = 240, inside the block's range.  The block is not
-widened: what the field resolves fits in it, and its order range is part of every calibrated
-model (the level calibration fits its spectral shape).
+**Why the whole field.**  Pits sit at different places on different teeth, so the field has no
+common shape: its leading singular pair (a shape times a scale per tooth) leaves 45-70 % of its
+norm out.  That remainder differs from tooth to tooth and repeats every pinion revolution, so it is
+a transmission error at shaft orders locked to the mesh: the sidebands of the mesh harmonics a
+pitted pinion shows, with phases fixed by where the pits are, not a random-phase roughness.  The
+field on 11 nodes resolves the path of contact (contact ratio ~1.6 of the 19 pitches) up to about
+order 5 / (1.6 / 19) = 60 per tooth; the 41-point field's finer detail is the node-fit error.
 
 For a contact whose pitted fraction is uniform across the contact width, the LTCA's cells all
 carry their force on ``L (1 - D)``: the contact is that of a modulus ``E* (1 - D)``, wider by
@@ -133,7 +125,7 @@ class PittingMap:
     Attributes
     ----------
     parameters : dict
-        ``k_pair[1..n]`` [N/m], ``pit_profile[1..n]`` [m] and ``tooth_pit_scale[1..z1]`` [-].
+        ``k_pair[1..n]`` [N/m] and ``tooth_pit_field[1..z1 n]`` [m] (tooth-major).
     compliance_change : (N,) the LTCA's dc(xi) of the typical tooth [m/N] on ``xi``.
     tooth_compliance_change : (z1, N) dc of each tooth [m/N].
     tooth_deviation : (z1, N) e_j(xi), each tooth's extra approach over the typical tooth [m].
@@ -141,8 +133,7 @@ class PittingMap:
     pit_depth : (N,) depth of a pit at xi [m].
     xi : (N,) roll positions.
     truncation_error : max |k(xi) - interp(nodes)(xi)| / k_healthy(xi).
-    pit_truncation_error : ||e - scale x interp(pit_profile)|| / ||e|| (rank-1 and node fit; 0 if e = 0).
-    residual_rms : RMS of that residual over the teeth and xi [m] (module docstring).
+    pit_truncation_error : ||e - interp(tooth_pit_field)|| / ||e||, the node fit along xi (0 if e = 0).
     """
 
     parameters: dict
@@ -154,22 +145,6 @@ class PittingMap:
     xi: np.ndarray
     truncation_error: float
     pit_truncation_error: float
-    residual_rms: float = 0.0
-
-
-#: The model parameter that carries the pits' residual: the pinion flanks' roughness RMS [m].
-PINION_ROUGHNESS = "pinion_roughness.rms"
-
-
-def roughness_with_residual(rms0: float, residual_rms: float) -> float:
-    """Roughness RMS [m] carrying the pits' residual: sqrt(rms0^2 + residual_rms^2).
-
-    Both are random-phase sums of shaft orders of the same gear, independent of each other, so their
-    powers add.  ``rms0`` is the model's undamaged (calibrated) roughness RMS."""
-    for name, v in (("rms0", rms0), ("residual_rms", residual_rms)):
-        if not (isinstance(v, (int, float, np.floating)) and math.isfinite(v) and v >= 0):
-            raise ParameterError(f"{name} must be a finite number >= 0 m, got {v!r}")
-    return float(math.hypot(rms0, residual_rms))
 
 
 def pitting_parameters(geometry: GearPair, pitting: PittingState, force: float, k_pair_healthy,
@@ -241,11 +216,9 @@ def pitting_parameters(geometry: GearPair, pitting: PittingState, force: float, 
     # the differences between the teeth: their mean is the law's typical tooth, which k_pair
     # carries (the cells' mean departs from it only by their sampling of D(xi))
     deviation = extra - np.mean(extra, axis=0)[None, :]
-    profile, scale, pit_err, residual = _rank_one(deviation, xi, n_nodes)
-    params.update({f"pit_profile[{i}]": float(v) for i, v in enumerate(profile, start=1)})
-    params.update({f"tooth_pit_scale[{j}]": float(v) for j, v in enumerate(scale, start=1)})
-    return PittingMap(params, dc, dc_tooth, deviation, share, depth, xi, err, pit_err,
-                      float(np.sqrt(np.mean(residual ** 2))))
+    nodes, pit_err = _fit_teeth(deviation, xi, n_nodes)
+    params.update({f"tooth_pit_field[{k}]": float(v) for k, v in enumerate(nodes.ravel(), start=1)})
+    return PittingMap(params, dc, dc_tooth, deviation, share, depth, xi, err, pit_err)
 
 
 def pitted_share(geometry: GearPair, pitting: PittingState, scatter: ToothScatter, xi, pair_force) -> np.ndarray:
@@ -271,23 +244,16 @@ def pitted_share(geometry: GearPair, pitting: PittingState, scatter: ToothScatte
     return face_share @ overlap.T
 
 
-def _rank_one(field: np.ndarray, xi: np.ndarray, n_nodes: int):
-    """Node profile (n_nodes,) [m] and per-tooth scales (z1,) of the leading singular pair of
-    ``field`` (z1, N) on ``xi``, the scales' largest magnitude 1; the relative residual; and the
-    residual field (z1, N) [m]."""
+def _fit_teeth(field: np.ndarray, xi: np.ndarray, n_nodes: int):
+    """Node values (z1, n_nodes) [m] whose hat interpolation fits each tooth's row of ``field``
+    (z1, N) on ``xi`` in least squares, and the relative error of that fit (0 if the field is 0)."""
     from twin.degradation._nodes import hat_matrix
     norm = float(np.linalg.norm(field))
     if norm == 0.0:
-        return np.zeros(n_nodes), np.zeros(field.shape[0]), 0.0, np.zeros_like(field)
-    u, s, vt = np.linalg.svd(field, full_matrices=False)
-    big = float(np.max(np.abs(u[:, 0])))
-    scale, shape = u[:, 0] / big, vt[0] * s[0] * big
-    if shape.sum() < 0:
-        scale, shape = -scale, -shape
-    basis = hat_matrix(xi, n_nodes)
-    profile = np.linalg.lstsq(basis, shape, rcond=None)[0]
-    residual = field - scale[:, None] * (basis @ profile)[None, :]
-    return profile, scale, float(np.linalg.norm(residual) / norm), residual
+        return np.zeros((field.shape[0], n_nodes)), 0.0
+    basis = hat_matrix(xi, n_nodes)                                                    # (N, n_nodes)
+    nodes = np.linalg.lstsq(basis, field.T, rcond=None)[0].T
+    return nodes, float(np.linalg.norm(field - nodes @ basis.T) / norm)
 
 
 def pitted_contact_compliance(geometry: GearPair, contact_compliance, pitted):

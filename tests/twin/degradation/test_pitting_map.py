@@ -5,8 +5,7 @@ import numpy as np
 import pytest
 
 from twin.degradation import HEALTHY_K_PAIR, FatiguePitting, GearPair, MeshLoad
-from twin.degradation.pitting_map import (ToothScatter, gear_density, pitting_parameters,
-                                          roughness_with_residual)
+from twin.degradation.pitting_map import ToothScatter, gear_density, pitting_parameters
 from twin.errors import ParameterError
 
 G = GearPair()
@@ -25,18 +24,16 @@ def _k(params, n=11):
 
 
 def _pits(params, z1=19, n=11):
-    return (np.array([params[f"pit_profile[{i}]"] for i in range(1, n + 1)]),
-            np.array([params[f"tooth_pit_scale[{j}]"] for j in range(1, z1 + 1)]))
+    """The written field as (z1, n) node values [m] (tooth-major in the parameters)."""
+    return np.array([params[f"tooth_pit_field[{k}]"] for k in range(1, z1 * n + 1)]).reshape(z1, n)
 
 
 def test_no_pits_leaves_the_mesh_healthy():
     state = FatiguePitting().initial_state(G)
     m = pitting_parameters(G, state, F, HEALTHY_K_PAIR, scatter=ToothScatter.draw(19, 0.3, 1))
     np.testing.assert_allclose(_k(m.parameters), HEALTHY_K_PAIR, rtol=1e-12)
-    profile, scale = _pits(m.parameters)
-    assert np.all(profile == 0) and np.all(scale == 0)
-    assert m.residual_rms == 0.0
-    assert not any(k.startswith("tooth_stiffness_factor") for k in m.parameters)
+    assert np.all(_pits(m.parameters) == 0) and m.pit_truncation_error == 0.0
+    assert not any(k.startswith(("tooth_stiffness_factor", "pit_profile", "tooth_pit_scale")) for k in m.parameters)
 
 
 def test_pits_soften_only_the_contact(pitted):
@@ -63,39 +60,36 @@ def test_teeth_pit_in_discrete_cells(pitted):
     np.testing.assert_allclose(m.tooth_deviation.mean(axis=0), 0.0, atol=1e-15)
     # a tooth never gives way more than a pit is deep over the healthy tooth
     assert np.all(m.tooth_deviation <= m.pit_depth[None, :] + 1e-12) and np.all(np.isfinite(m.tooth_deviation))
-    # the FMU's rank-1 form reproduces the field to its stated residual
-    profile, scale = _pits(m.parameters)
+    # the FMU gets the whole field, fitted on the nodes tooth by tooth, to its stated error
     from twin.degradation._nodes import interp_nodes
-    approx = scale[:, None] * interp_nodes(profile, m.xi)[None, :]
-    resid = np.linalg.norm(m.tooth_deviation - approx) / np.linalg.norm(m.tooth_deviation)
-    assert resid == pytest.approx(m.pit_truncation_error, rel=1e-9) and resid < 1
-    assert np.max(np.abs(scale)) == pytest.approx(1.0)
-    # what the arrays cannot hold is kept as an RMS [m], for the pinion's broadband roughness
-    rms = np.sqrt(np.mean((m.tooth_deviation - approx) ** 2))
-    assert m.residual_rms == pytest.approx(rms, rel=1e-9) and m.residual_rms > 0
+    nodes = _pits(m.parameters)
+    approx = np.array([interp_nodes(row, m.xi) for row in nodes])
+    fit = np.linalg.norm(m.tooth_deviation - approx) / np.linalg.norm(m.tooth_deviation)
+    assert fit == pytest.approx(m.pit_truncation_error, rel=1e-9)
+    # the teeth's differences have no common shape on the nodes: a rank-1 (shape x scale) form of
+    # the fitted field would lose a large part of it, the written field loses none of it
+    s = np.linalg.svd(nodes, compute_uv=False)
+    assert np.sqrt(np.sum(s[1:] ** 2)) / np.linalg.norm(s) > 0.3
+    u, s, vt = np.linalg.svd(nodes, full_matrices=False)
+    rank_one = np.array([interp_nodes(row, m.xi) for row in s[0] * np.outer(u[:, 0], vt[0])])
+    assert fit < np.linalg.norm(m.tooth_deviation - rank_one) / np.linalg.norm(m.tooth_deviation) - 0.1
 
 
-def test_the_residual_rms_of_a_hand_made_field():
+def test_the_node_fit_of_a_hand_made_field():
     from twin.degradation._nodes import hat_matrix
-    from twin.degradation.pitting_map import _rank_one
+    from twin.degradation.pitting_map import _fit_teeth
     xi = np.linspace(0.0, 1.0, 41)
-    # a shape the 11 nodes hold exactly on 19 teeth, and a smaller field orthogonal to it in both
-    # the teeth and the roll: the fit keeps the first, the residual is exactly the second
-    shape = hat_matrix(xi, 11) @ np.array([0, 1, 3, 2, 4, 6, 5, 3, 2, 1, 0], dtype=float) * 1e-6
-    teeth = np.linspace(-1.0, 1.0, 19)
-    other_xi = np.cos(2 * np.pi * 7 * xi)
-    other_xi -= shape * (other_xi @ shape) / (shape @ shape)
-    other_teeth = np.where(np.arange(19) % 2 == 0, 1.0, -1.0)
-    other_teeth -= teeth * (other_teeth @ teeth) / (teeth @ teeth)
-    small = 0.2e-6 * np.outer(other_teeth, other_xi) / np.sqrt(np.mean(np.outer(other_teeth, other_xi) ** 2))
-    profile, scale, rel, residual = _rank_one(np.outer(teeth, shape) + small, xi, 11)
-    np.testing.assert_allclose(residual, small, atol=1e-12)
-    assert np.sqrt(np.mean(residual ** 2)) == pytest.approx(0.2e-6, rel=1e-6)
-    # independent random-phase sums add their powers
-    assert roughness_with_residual(0.3e-6, 0.4e-6) == pytest.approx(0.5e-6)
-    assert roughness_with_residual(5e-8, 0.0) == 5e-8
-    with pytest.raises(ParameterError, match="residual_rms"):
-        roughness_with_residual(5e-8, float("nan"))
+    rng = np.random.default_rng(4)
+    # teeth with different shapes the 11 nodes hold exactly (rank > 1): the fit returns their nodes
+    nodes = rng.normal(0.0, 1e-6, (19, 11))
+    held, err = _fit_teeth(nodes @ hat_matrix(xi, 11).T, xi, 11)
+    np.testing.assert_allclose(held, nodes, atol=1e-15)
+    assert err < 1e-12
+    # a shape finer than the nodes: the fit keeps what they hold and reports the rest
+    fine = np.outer(np.ones(19), np.cos(2 * np.pi * 9 * xi)) * 1e-6
+    _, err = _fit_teeth(fine, xi, 11)
+    assert 0.3 < err < 1.0
+    assert _fit_teeth(np.zeros((19, 41)), xi, 11)[1] == 0.0
 
 
 def test_a_face_pitted_through_reaches_the_pit_bottom():
@@ -105,7 +99,7 @@ def test_a_face_pitted_through_reaches_the_pit_bottom():
     m = pitting_parameters(G, late, F, HEALTHY_K_PAIR, scatter=ToothScatter.draw(19, 0.58, 0))
     assert np.any(m.pitted_share > 0.999)
     e = m.tooth_deviation
-    assert np.all(np.isfinite(e)) and np.isfinite(m.residual_rms)
+    assert np.all(np.isfinite(e)) and np.isfinite(m.pit_truncation_error)
     # over the healthy tooth each tooth gives way by 0 .. the pit depth; so the teeth differ by no more
     assert np.all(np.ptp(e, axis=0) <= m.pit_depth + 1e-12)
 
