@@ -52,6 +52,8 @@ def test_variant_builds_with_its_own_stiffness_and_geometry(pair_18_35):
         k = [fmu.variable(f"k_pair[{i}]").start for i in range(1, 12)]
         assert k == pytest.approx(k_pair_nodes(GearPair(z1=18, z2=35), 11), rel=1e-12)
         assert len([v for v in fmu.parameters if v.name.startswith("tooth_stiffness_factor[")]) == 18
+        # the per-tooth pit field is sized z1 x n_profile
+        assert len([v for v in fmu.parameters if v.name.startswith("tooth_pit_field[")]) == 18 * 11
     text = describe(pair_18_35)
     assert "Structural (3" in text and "z1 = 18, z2 = 35" in text
     assert "Contact ratio 1.6082" in text and "ISO 6336-1" in text and "potential energy" in text
