@@ -29,7 +29,7 @@ common interface, nominal gearbox, committed defaults) at the centres of their o
 (10 Hz / 5 N.m, dry, 0-240 um) and pitting stages (20 Hz / 20 N.m, 2-20 %), and the twin (base
 19/52 model, coupled runs of ``scenarios/dry.yaml`` and ``scenarios/lubricated.yaml``) at the same
 damage (``--model``: another twin model for those runs, e.g. ``GearTwin.Gearbox21Measured`` with its
-flank roughness, whose pinion RMS carries the pits' per-tooth residual): casing RMS, mesh-harmonic level (first three) and pinion-order sideband level, each
+flank roughness and broadband excitation): casing RMS, mesh-harmonic level (first three) and pinion-order sideband level, each
 against damage (Spearman, worn/healthy), and the per-stage Spearman of the 15 harmonic and
 sideband changes of the twin against each rig's.
 
