@@ -343,7 +343,8 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
         scenario = scenario.with_overrides(executor={"type": "local", "workers": args.workers})
     report = _lib("twin.calibration.run").run_calibration(scenario, Path(args.measurements), Path(args.out),
                                                           progress=not args.no_progress, seed=args.seed,
-                                                          resume=args.resume, modes_from=args.modes_from)
+                                                          resume=args.resume, modes_from=args.modes_from,
+                                                          pairing=args.pairing)
     print(f"modes: {report.modes_source}")
     print(report.table())
     for n in report.notes:
@@ -363,7 +364,7 @@ def _cmd_sensitivity(args: argparse.Namespace) -> int:
     scenario = _lib("twin.scenario").load_scenario(Path(args.scenario))
     sens = _lib("twin.calibration.run").scenario_sensitivity(
         scenario, Path(args.measurements) if args.measurements else None, modes_from=args.modes_from,
-        n_modes=args.modes, executor=_executor(args.workers))
+        n_modes=args.modes, executor=_executor(args.workers), pairing=args.pairing)
     print(sens.table())
     if args.json is not None:
         import json
@@ -383,7 +384,14 @@ def _add_sensitivity_parser(sub) -> None:
                    help="without measurements: the model's first N visible modes (default: 8)")
     p.add_argument("--workers", type=_positive_int, help="local worker processes (default: one)")
     p.add_argument("--json", type=Path, help="write the sensitivities and the choice here")
+    _add_pairing_option(p)
     p.set_defaults(handler=_cmd_sensitivity)
+
+
+def _add_pairing_option(p) -> None:
+    p.add_argument("--pairing", choices=("frequency", "shape"),
+                   help="pair measured with model modes by frequency (the nearest visible model mode within 15 %%; "
+                        "default) or by frequency, shape at the sensors and reach; overrides calibration.pairing")
 
 
 def _cmd_compare(args: argparse.Namespace) -> int:
@@ -676,6 +684,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--modes-from", metavar="RECORD",
                    help="read the measured modes from this run-up or hammer record (see twin modes); without a "
                         "calibration block the parameters are chosen automatically")
+    _add_pairing_option(p)
     p.add_argument("--no-progress", action="store_true", help="quiet")
     p.set_defaults(handler=_cmd_calibrate)
 

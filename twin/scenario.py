@@ -89,6 +89,10 @@ CALIBRATION_SCHEMA: dict[str, Any] = {
         "settle_time": {"type": "number", "minimum": 0},
         "band": {"type": "array", "items": {"type": "number", "minimum": 0}, "minItems": 2, "maxItems": 2},
         "refine": {"type": "boolean", "description": "polish the pick by least squares on the modes (default true)"},
+        "pairing": {"enum": ["frequency", "shape"],
+                    "description": "how measured modes are paired with model modes: frequency (the nearest visible "
+                                   "model mode within 15 %, default) or shape (frequency, shape at the sensors and "
+                                   "reach)"},
         "evaluation_timeout": {"type": "number", "exclusiveMinimum": 0,
                                "description": "s; an evaluation still running then is stopped and scored infeasible "
                                               "(default 600)"},

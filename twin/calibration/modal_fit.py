@@ -1,15 +1,15 @@
 """The modes objective and its least-squares fit in log-parameters, with the physical bounds as prior.
 
 Each measured mode ``i`` (uncertainty ``s_i``, relative) is compared with the model mode paired
-with it by frequency and shape (:func:`twin.calibration.sensitivity.match_measured`):
-``z_i = ln(f_model / f_measured) / s_i``, and when the measured mode's shape at the sensors is
-known, ``z_i^2`` gains ``(m_i * 0.15 / s_i)^2`` with ``m_i = coherence_i (1 - MAC)`` the pairing's
-shape mismatch: a model mode of the wrong shape near the right frequency costs as much as one of
+with it (:func:`twin.calibration.sensitivity.match_measured`; by default the nearest visible model
+mode by frequency): ``z_i = ln(f_model / f_measured) / s_i``. With the opt-in shape pairing
+(``pairing="shape"``), when the measured mode's shape at the sensors is known, ``z_i^2`` gains
+``(m_i * 0.15 / s_i)^2`` with ``m_i = coherence_i (1 - MAC)`` the pairing's shape mismatch: a model mode of the wrong shape near the right frequency costs as much as one of
 the right shape 15 % off, so the objective does not reward the wrong physics. A measured mode left
 without a model mode within 15 % costs ``(0.15 / s_i)^2``, so a candidate cannot improve by losing
 a mode.
 
-The objective of a population member matches by frequency at that member. The fit instead
+The objective of a population member pairs the modes at that member. The fit instead
 matches once, at its start, and follows each model mode by its shape (MAC) from step to step:
 re-matching by frequency at every step would let two modes swap identities whenever that lowers
 the cost, and the fit would then chase the wrong mode. It re-matches at its own solution and
@@ -32,13 +32,14 @@ from twin.calibration.pairing import MeasuredShapes, Pairing, shape_mismatch
 from twin.calibration.sensitivity import MATCH_REACH, ModelModes, follow_index, match_measured, model_modes
 
 
-def mode_errors(model: ModelModes, measured: np.ndarray, rel_sd: np.ndarray, shapes: MeasuredShapes | None = None
-                ) -> tuple[np.ndarray, np.ndarray]:
-    """(z (k,), matched model frequency (k,) [Hz], NaN where unmatched), paired by frequency and shape."""
-    idx = match_measured(model, measured, rel_sd, shapes=shapes)
+def mode_errors(model: ModelModes, measured: np.ndarray, rel_sd: np.ndarray, shapes: MeasuredShapes | None = None,
+                *, pairing: str = "frequency") -> tuple[np.ndarray, np.ndarray]:
+    """(z (k,), matched model frequency (k,) [Hz], NaN where unmatched); ``shapes`` count only with
+    ``pairing="shape"``."""
+    idx = match_measured(model, measured, rel_sd, pairing=pairing, shapes=shapes)
     matched = np.where(idx >= 0, model.frequency[np.maximum(idx, 0)], np.nan)
     z = np.where(idx >= 0, np.log(np.where(idx >= 0, matched, 1.0) / measured) / rel_sd, MATCH_REACH / rel_sd)
-    if shapes is not None and (idx >= 0).any():
+    if pairing == "shape" and shapes is not None and (idx >= 0).any():
         ok = np.flatnonzero(idx >= 0)
         m = shape_mismatch(model, shapes, idx[ok])[ok, np.arange(ok.size)]
         z[ok] = np.where(z[ok] >= 0, 1.0, -1.0) * np.hypot(z[ok], m * MATCH_REACH / rel_sd[ok])
@@ -46,27 +47,29 @@ def mode_errors(model: ModelModes, measured: np.ndarray, rel_sd: np.ndarray, sha
 
 
 def modes_objective(fmu_path, values: Mapping[str, float], measured, rel_sd, *, speed_hz: float, load_nm: float,
-                    channels=("accel_pinion_casing",), shapes: MeasuredShapes | None = None
-                    ) -> tuple[float, np.ndarray]:
+                    channels=("accel_pinion_casing",), shapes: MeasuredShapes | None = None,
+                    pairing: str = "frequency") -> tuple[float, np.ndarray]:
     """Mean squared z over the measured modes, and the matched model frequencies [Hz]."""
     mm = model_modes(fmu_path, values, speed_hz=speed_hz, load_nm=load_nm, channels=channels)
-    z, matched = mode_errors(mm, np.asarray(measured, float), np.asarray(rel_sd, float), shapes)
+    z, matched = mode_errors(mm, np.asarray(measured, float), np.asarray(rel_sd, float), shapes, pairing=pairing)
     return float(np.mean(z ** 2)), matched
 
 
 def fit_modes(fmu_path, names, lower, upper, nominal, x0, measured, rel_sd, *, fixed: Mapping[str, float],
               speed_hz: float, load_nm: float, channels=("accel_pinion_casing",), max_iter: int = 15,
-              shapes: MeasuredShapes | None = None, pairing: Pairing | None = None) -> np.ndarray:
+              shapes: MeasuredShapes | None = None, pairing: str = "frequency",
+              start_pairing: Pairing | None = None) -> np.ndarray:
     """Fit of the parameters ``names`` to the measured modes by damped Gauss-Newton (Levenberg-
     Marquardt) in log-parameters with the bounds' prior; returns the values (d,).
 
-    The modes are paired by frequency and shape at ``x0`` and followed step by step from there: each
-    accepted step becomes the reference for the next, so a mode keeps its identity through
-    changes far larger than one step, where a single shape comparison could confuse two modes
-    that veer. At the solution the match by frequency is made again; if it differs, the fit goes
-    on from there with the new match (at most twice). ``pairing`` (from the sensitivity study, where
-    each model mode's reach is known) replaces the first match: it may pair a measured mode with a
-    model mode further than 15 % away that the bounds let reach it.
+    The modes are paired at ``x0`` (by the rule ``pairing``, see :func:`mode_errors`) and followed
+    step by step from there: each accepted step becomes the reference for the next, so a mode
+    keeps its identity through changes far larger than one step, where a single shape comparison
+    could confuse two modes that veer. At the solution the pairing is made again; if it differs,
+    the fit goes on from there with the new pairing (at most twice). ``start_pairing`` (from the
+    shape pairing's sensitivity study, where each model mode's reach is known) replaces the first
+    pairing: it may pair a measured mode with a model mode further than 15 % away that the bounds
+    let reach it.
     """
     lower, upper, nominal = (np.asarray(v, float) for v in (lower, upper, nominal))
     lo, hi = np.log(lower / nominal), np.log(upper / nominal)
@@ -88,10 +91,11 @@ def fit_modes(fmu_path, names, lower, upper, nominal, x0, measured, rel_sd, *, f
 
     u = np.clip(np.log(np.asarray(x0, float) / nominal), lo, hi)
     ref = at(u)
-    which = pairing.at(ref) if pairing is not None else match_measured(ref, measured, rel_sd, shapes=shapes)
+    which = (start_pairing.at(ref) if start_pairing is not None
+             else match_measured(ref, measured, rel_sd, pairing=pairing, shapes=shapes))
     for _ in range(3):
         u, ref, which = _levenberg_marquardt(at, residual, u, ref, which, lo, hi, half, max_iter)
-        again = match_measured(ref, measured, rel_sd, shapes=shapes)
+        again = match_measured(ref, measured, rel_sd, pairing=pairing, shapes=shapes)
         if np.array_equal(again, which):
             break
         which = again

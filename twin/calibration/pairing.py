@@ -1,6 +1,12 @@
-"""Which model mode each measured mode is: pairing by frequency, shape at the sensors, and reach.
+"""Which model mode each measured mode is: two pairing rules (:data:`PAIRINGS`).
 
-A measured mode is paired with a model mode when the model can *become* it: the model mode must
+``frequency`` (the default, :func:`pair_by_frequency`): each measured mode is paired with a
+*visible* model mode (one that makes a peak at a sensor) by least total
+``|ln(f_model / f_measured)| / s_i`` (one-to-one, Hungarian algorithm); a measured mode with no
+visible model mode within :data:`MATCH_REACH` stays unpaired.
+
+``shape`` (opt-in, :func:`pair_modes`; scored worse on the rigs, see docs/experiments.md): a
+measured mode is paired with a model mode when the model can *become* it: the model mode must
 be able to reach the measured frequency within the physical bounds of the parameters, and its
 shape at the casing sensors must look like the measured one.
 
@@ -34,7 +40,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-#: Without sensitivities, each model mode reaches this far either way (relative, in ln f).
+#: The pairing rules: by frequency among the visible modes (default), or by frequency, shape and reach.
+PAIRINGS = ("frequency", "shape")
+#: Frequency-only pairing: no model mode further than this (relative, in ln f) is paired; shape
+#: pairing without sensitivities: each model mode reaches this far either way.
 MATCH_REACH = 0.15
 #: Model modes whose peak gain is at least this far below the most visible mode's [dB] are candidates.
 MIN_LEVEL_DB = -70.0
@@ -167,4 +176,34 @@ def pair_modes(model, measured, rel_sd=None, *, shapes: MeasuredShapes | None = 
     for r, c in zip(rows, picked):
         if c < cols.size and np.isfinite(cost[r, c]):
             out[r] = cols[c]
+    return out
+
+
+def check_pairing(pairing: str) -> str:
+    """``pairing`` if it is one of :data:`PAIRINGS`; ValueError naming it otherwise."""
+    if pairing not in PAIRINGS:
+        raise ValueError(f"unknown pairing {pairing!r} (expected one of: {', '.join(PAIRINGS)})")
+    return pairing
+
+
+def pair_by_frequency(model, measured, rel_sd=None) -> np.ndarray:
+    """Index of the visible model mode paired with each measured mode by frequency alone, -1 where
+    none is within :data:`MATCH_REACH` (the default rule; see the module docstring)."""
+    from twin.calibration.sensitivity import MODEL_FORM
+
+    measured = np.asarray(measured, float)
+    rel_sd = np.full(measured.size, MODEL_FORM) if rel_sd is None else np.asarray(rel_sd, float)
+    idx = np.flatnonzero(model.visible)
+    out = np.full(measured.size, -1, dtype=int)
+    if idx.size == 0 or measured.size == 0:
+        return out
+    dist = np.abs(np.log(model.frequency[idx][None, :] / measured[:, None]))
+    big = 1e6
+    cost = np.where(dist <= MATCH_REACH, dist / rel_sd[:, None], big)
+    # dummy columns: leaving a measured mode unpaired costs as much as twice the reach
+    dummy = np.full((measured.size, measured.size), MATCH_REACH / rel_sd.min() * 2)
+    rows, cols = linear_sum_assignment(np.hstack([cost, dummy]))
+    for r, c in zip(rows, cols):
+        if c < idx.size and cost[r, c] < big:
+            out[r] = idx[c]
     return out

@@ -51,7 +51,8 @@ class CalibrationTarget:
     mode_rel_sd: np.ndarray | None = None   # (k,) relative uncertainty of each measured mode ("modes")
     mode_channels: tuple[str, ...] = ()     # sensors the measured modes were seen by (default: channel)
     mode_shapes: object | None = None       # MeasuredShapes of the measured modes at those sensors, or None
-    mode_pairing: object | None = None      # Pairing at the nominal set (twin.calibration.pairing), or None
+    mode_pairing: object | None = None      # Pairing at the nominal set (shape pairing), or None
+    pairing: str = "frequency"              # how measured and model modes are paired (frequency or shape)
 
     @property
     def needs_simulation(self) -> bool:
@@ -115,7 +116,8 @@ def evaluate_candidate(task: EvalTask) -> tuple[np.ndarray, dict]:
         from twin.calibration.modal_fit import modes_objective
         values["modes"], matched = modes_objective(task.fmu_path, task.parameters, tg.natural_frequencies, tg.rel_sd,
                                                    speed_hz=tg.drive_hz, load_nm=tg.load,
-                                                   channels=tg.mode_channels or (tg.channel,), shapes=tg.mode_shapes)
+                                                   channels=tg.mode_channels or (tg.channel,), shapes=tg.mode_shapes,
+                                                   pairing=tg.pairing)
         info["matched_frequencies"] = matched.tolist()
     return np.array([values[o] for o in tg.objectives]), info
 
@@ -262,6 +264,8 @@ def calibration_identity(fmu_path: Path, space: ParameterSpace, target: Calibrat
             h.update(chunk)
     fields = {k: getattr(target, k) for k in ("sample_rate", "drive_hz", "load", "channel", "fmin", "fmax", "shaft_hz",
                                               "teeth", "objectives") if hasattr(target, k)}
+    if getattr(target, "pairing", "frequency") != "frequency":     # the default keeps earlier identities
+        fields["pairing"] = target.pairing
     h.update(json.dumps({"names": list(space.names), "lower": space.lower.tolist(), "upper": space.upper.tolist(),
                          "settings": {k: (dict(v) if isinstance(v, Mapping) else v) for k, v in settings.items()},
                          "target": fields,
@@ -366,7 +370,8 @@ def _calibrate(fmu_path, space, target, ex, *, algorithm, pop_size, n_gen, seed,
                                              target.natural_frequencies, target.rel_sd, fixed=dict(fixed or {}),
                                              speed_hz=target.drive_hz, load_nm=target.load,
                                              channels=target.mode_channels or (target.channel,),
-                                             shapes=target.mode_shapes, pairing=target.mode_pairing))
+                                             shapes=target.mode_shapes, pairing=target.pairing,
+                                             start_pairing=target.mode_pairing))
         else:
             chosen = space.to_dict(refine_modes(Path(fmu_path), space, target, start, fixed=fixed))
     return CalibrationResult(space.names, X, F, chosen, space.to_dict(X[knee]),

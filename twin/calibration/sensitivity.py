@@ -11,11 +11,14 @@
 2. **Modes.** The model is linearised about the operating point (:mod:`twin.linearize`) with
    the sensor outputs and the mesh excitation; a model mode counts as *visible* when it makes a
    peak of the mesh-to-sensor response, the way a measured mode shows in a run-up.
-3. **Sensitivities** ``S[i, j] = d ln f_i / d ln p_j`` of every candidate model mode (visible, or
-   weakly visible down to :data:`twin.calibration.pairing.MIN_LEVEL_DB`) by one-sided differences
-   (2 %), modes followed by their shapes (MAC) so that two crossing modes are not confused.
-   They give each model mode its reach within the bounds, and the measured modes are paired with
-   model modes by frequency, shape at the sensors and reach (:mod:`twin.calibration.pairing`).
+3. **Pairing and sensitivities** ``S[i, j] = d ln f_i / d ln p_j`` by one-sided differences (2 %),
+   modes followed by their shapes (MAC) so that two crossing modes are not confused
+   (:mod:`twin.calibration.pairing`). With ``pairing="frequency"`` (default) the measured modes
+   are paired with visible model modes by frequency alone (none further than 15 %) and the paired
+   modes' sensitivities are computed. With ``pairing="shape"`` the sensitivities of every
+   candidate model mode (visible, or weakly visible down to
+   :data:`twin.calibration.pairing.MIN_LEVEL_DB`) give each its reach within the bounds, and the
+   measured modes are paired by frequency, shape at the sensors and reach.
 4. **Identifiable subset** by QR with column pivoting on the weighted matrix
    ``S[i, j] * h_j / s_i`` (``h_j`` half the log-range of the bounds, ``s_i`` the relative
    uncertainty of mode i): a column is kept while the information it adds beyond the columns
@@ -33,8 +36,8 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-from twin.calibration.pairing import (MATCH_REACH, MeasuredShapes, Pairing, candidate_modes, mode_reach, pair_modes,
-                                      shape_mismatch)
+from twin.calibration.pairing import (MATCH_REACH, MeasuredShapes, Pairing, candidate_modes, check_pairing,
+                                      mode_reach, pair_by_frequency, pair_modes, shape_mismatch)
 
 #: (unit, words in the description, relative bounds [lower, upper] about the nominal, reason); the
 #: first rule whose unit matches and whose words (if any) occur in the description applies
@@ -201,9 +204,14 @@ def model_modes(fmu_path, parameters: Mapping[str, float], *, speed_hz: float, l
 
 
 def match_measured(model: ModelModes, measured: np.ndarray, rel_sd: np.ndarray | None = None, *,
-                   shapes: MeasuredShapes | None = None, reach: np.ndarray | None = None) -> np.ndarray:
-    """Index of the model mode paired with each measured mode, -1 where none can be: by frequency,
-    shape at the sensors and reach (:func:`twin.calibration.pairing.pair_modes`)."""
+                   pairing: str = "frequency", shapes: MeasuredShapes | None = None,
+                   reach: np.ndarray | None = None) -> np.ndarray:
+    """Index of the model mode paired with each measured mode, -1 where none is: with
+    ``pairing="frequency"`` the nearest visible model modes within 15 %
+    (:func:`twin.calibration.pairing.pair_by_frequency`; ``shapes`` and ``reach`` unused), with
+    ``"shape"`` by frequency, shape at the sensors and reach (:func:`twin.calibration.pairing.pair_modes`)."""
+    if check_pairing(pairing) == "frequency":
+        return pair_by_frequency(model, measured, rel_sd)
     return pair_modes(model, measured, rel_sd, shapes=shapes, reach=reach)
 
 
@@ -252,6 +260,7 @@ class Sensitivity:
     shape_mismatch: np.ndarray | None = None   # (k,) coherence x (1 - MAC) of each pairing (0: no shape)
     gain_db: np.ndarray | None = None     # (k,) peak gain of each paired model mode, dB re the most visible
     pairing: Pairing | None = None        # of all the measured modes (unpaired: -1), at the nominal set
+    pairing_rule: str = "frequency"       # how the modes were paired (twin.calibration.pairing.PAIRINGS)
 
     def bounds(self) -> dict[str, list[float]]:
         by = {c.name: c for c in self.candidates}
@@ -268,6 +277,8 @@ class Sensitivity:
             rows.append(f"{mark} {n:<16s}" + "".join(f"{v:9.3f}" for v in self.S[:, j])
                         + f"   [{by[n].lower:.4g}, {by[n].upper:.4g}]")
         rows.append(f"chosen (*): {', '.join(self.chosen) or 'none'}; condition number {self.condition:.3g}")
+        rows.append("pairing: by frequency, among the visible model modes" if self.pairing_rule == "frequency"
+                    else "pairing: by frequency, shape at the sensors and reach")
         if self.reach is not None:
             rows.append("pairing (measured -> model mode: its level re the most visible, its reach within the "
                         "bounds, shape mismatch):")
@@ -278,7 +289,10 @@ class Sensitivity:
                             f"{100 * (math.exp(self.reach[i, 1]) - 1):+.0f} %  {mis}")
         for n, why in self.left_out.items():
             rows.append(f"  not identifiable: {n}: {why}")
-        if self.unmatched_hz:
+        if self.unmatched_hz and self.pairing_rule == "frequency":
+            rows.append("  measured modes the model has no visible mode for (within 15 %): "
+                        + ", ".join(f"{f:.1f} Hz" for f in self.unmatched_hz))
+        elif self.unmatched_hz:
             rows.append("  measured modes no model mode can reach within the bounds: "
                         + ", ".join(f"{f:.1f} Hz" for f in self.unmatched_hz))
         rows += [f"note: {n}" for n in self.notes]
@@ -293,6 +307,7 @@ class Sensitivity:
                                for j, c in enumerate(self.candidates)],
                 "chosen": list(self.chosen), "condition": self.condition,
                 "unmatched_measured_hz": list(self.unmatched_hz), "notes": list(self.notes),
+                "pairing_rule": self.pairing_rule,
                 "pairing": [{"measured_hz": float(fm), "model_hz": float(f),
                              "model_gain_db": None if self.gain_db is None else float(self.gain_db[i]),
                              "reach_ln_f": None if self.reach is None else [float(v) for v in self.reach[i]],
@@ -303,10 +318,13 @@ class Sensitivity:
 def mode_sensitivity(fmu_path, values: Mapping[str, float], measured_hz, *, speed_hz: float, load_nm: float,
                      rel_sd=None, channels: Sequence[str] = ("accel_pinion_casing",),
                      candidates: Sequence[Candidate] | None = None, step: float = 0.02,
-                     executor=None, shapes: MeasuredShapes | None = None) -> Sensitivity:
+                     executor=None, shapes: MeasuredShapes | None = None,
+                     pairing: str = "frequency") -> Sensitivity:
     """Sensitivities of the measured modes' model counterparts and the identifiable subset.
 
-    ``shapes``: the measured modes' shapes at the channels (``twin modes``), for the pairing."""
+    ``pairing``: ``"frequency"`` (default) or ``"shape"`` (see the module docstring); ``shapes``:
+    the measured modes' shapes at the channels (``twin modes``), used by the shape pairing."""
+    check_pairing(pairing)
     measured = np.asarray(measured_hz, float)
     rel = np.sqrt((np.full(measured.size, 0.0) if rel_sd is None else np.asarray(rel_sd, float)) ** 2
                   + MODEL_FORM ** 2)
@@ -314,6 +332,12 @@ def mode_sensitivity(fmu_path, values: Mapping[str, float], measured_hz, *, spee
     kw = dict(speed_hz=speed_hz, load_nm=load_nm, channels=tuple(channels))
     base = model_modes(fmu_path, values, **kw)
     notes = []
+    if pairing == "frequency":      # paired before the runs: only the paired modes' sensitivities are needed
+        match = match_measured(base, measured, rel)
+        if not (match >= 0).any():
+            raise ValueError("no measured mode has a visible model mode within 15 %: the model and the record "
+                             f"do not share a mode (measured {np.round(measured, 1).tolist()} Hz, visible model "
+                             f"{np.round(base.frequency[base.visible], 1).tolist()} Hz)")
     tasks = [(str(fmu_path), {**values, c.name: c.nominal * (1 + step)}, kw) for c in cands]
     if executor is not None:
         moved = executor.map(_modes_task, tasks, desc="sensitivities")
@@ -325,13 +349,22 @@ def mode_sensitivity(fmu_path, values: Mapping[str, float], measured_hz, *, spee
         name, err = failed[0]
         raise SimulationError(f"{len(failed)} of {len(cands)} sensitivity runs failed; first ({name} moved by "
                               f"{100 * step:g} %): {err}")
+    if pairing == "frequency":
+        ok = match >= 0
+        which = match[ok]
+        S = np.empty((which.size, len(cands)))
+        for j, mv in enumerate(moved):
+            S[:, j] = np.log(follow(base, mv, which) / base.frequency[which]) / math.log(1 + step)
+        chosen, left_out, info, cond = select_identifiable(S, cands, rel[ok])
+        return Sensitivity(base.frequency[which], measured[ok], rel[ok], tuple(cands), S, chosen, left_out, info,
+                           cond, tuple(float(f) for f in measured[~ok]), tuple(notes), gain_db=base.gain_db[which])
     # every candidate model mode's sensitivities, so that each has its own reach for the pairing
     cols = candidate_modes(base)
     S_all = np.zeros((base.frequency.size, len(cands)))
     for j, mv in enumerate(moved):
         S_all[cols, j] = np.log(follow(base, mv, cols) / base.frequency[cols]) / math.log(1 + step)
     reach = mode_reach(S_all, cands)
-    match = match_measured(base, measured, rel, shapes=shapes, reach=reach)
+    match = match_measured(base, measured, rel, pairing="shape", shapes=shapes, reach=reach)
     ok = match >= 0
     which = match[ok]
     if not ok.any():
@@ -344,7 +377,7 @@ def mode_sensitivity(fmu_path, values: Mapping[str, float], measured_hz, *, spee
     chosen, left_out, info, cond = select_identifiable(S, cands, rel[ok])
     return Sensitivity(base.frequency[which], measured[ok], rel[ok], tuple(cands), S, chosen, left_out, info, cond,
                        tuple(float(f) for f in measured[~ok]), tuple(notes), reach[which], mismatch,
-                       base.gain_db[which], Pairing(base, match))
+                       base.gain_db[which], Pairing(base, match), "shape")
 
 
 def _modes_task(task):

@@ -1,4 +1,5 @@
-"""Pairing measured modes with model modes by frequency, shape at the sensors and reach."""
+"""Pairing measured modes with model modes: by frequency among the visible modes (default), or by
+frequency, shape at the sensors and reach (opt-in)."""
 from __future__ import annotations
 
 import math
@@ -7,9 +8,10 @@ import numpy as np
 import pytest
 
 from twin.calibration.modal_fit import mode_errors
-from twin.calibration.pairing import (MATCH_REACH, MeasuredShapes, Pairing, mac, mode_reach, pair_modes,
+from twin.calibration.pairing import (MATCH_REACH, PAIRINGS, MeasuredShapes, Pairing, mac, mode_reach, pair_modes,
                                       shape_mismatch)
-from twin.calibration.sensitivity import Candidate, ModelModes
+from twin.calibration.sensitivity import Candidate, ModelModes, match_measured
+from twin.scenario import CALIBRATION_SCHEMA
 from twin.signals.shapes import ChannelShape
 
 CHANNELS = ("accel_pinion_casing", "accel_gear_casing")
@@ -95,8 +97,8 @@ def test_shapes_from_the_twin_modes_evidence():
 def test_the_objective_charges_a_wrong_shape_like_a_missing_mode():
     model = _model([1000.0, 1400.0], [[1.0, 1.0], [1.0, 1.0]], [0.0, 0.0], [True, True])
     sd = np.array([0.01])
-    z0, _ = mode_errors(model, np.array([1000.0]), sd)
-    z, matched = mode_errors(model, np.array([1000.0]), sd, _measured([[1.0, -1.0]], [1.0]))
+    z0, _ = mode_errors(model, np.array([1000.0]), sd, pairing="shape")
+    z, matched = mode_errors(model, np.array([1000.0]), sd, _measured([[1.0, -1.0]], [1.0]), pairing="shape")
     assert z0 == pytest.approx([0.0]) and matched.tolist() == [1000.0]
     assert abs(z[0]) == pytest.approx(MATCH_REACH / 0.01)
 
@@ -107,3 +109,36 @@ def test_a_pairing_is_followed_to_a_nearby_parameter_set():
                        np.eye(2, dtype=complex)[:, ::-1], np.array([-50.0, 0.0]), (),
                        np.array([[3e-3, 1.0], [-0.9e-3, 1.0]], complex), CHANNELS)
     assert Pairing(base, np.array([1, -1])).at(moved).tolist() == [0, -1]
+
+
+#: visible modes at 1000, 1300 and 2000 Hz; a mode at 1040 Hz 50 dB down that makes no peak
+FOUR = dict(freqs=[1000.0, 1040.0, 1300.0, 2000.0], sensor=[[1.0, 1e-3, 1.0, 1.0], [1.0, -1e-3, -1.0, 1.0]],
+            gain_db=[0.0, -50.0, -3.0, -6.0], visible=[True, False, True, True])
+
+
+def test_by_default_each_measured_mode_pairs_with_the_nearest_visible_mode_within_the_reach():
+    model = _model(**FOUR)
+    measured = np.array([1035.0, 1290.0, 1500.0, 2250.0])
+    # 1035 Hz: the visible 1000 Hz mode, not the closer one that makes no peak; 1500 Hz: 1300 Hz is
+    # within 15 % but taken by the closer 1290 Hz (one-to-one), 2000 Hz is 29 % off; 2250 Hz: 12 % off
+    assert match_measured(model, measured).tolist() == [0, 2, -1, 3]
+    assert match_measured(model, measured, np.full(4, 0.01), pairing="frequency").tolist() == [0, 2, -1, 3]
+    # nothing further than MATCH_REACH, whatever the uncertainty
+    assert match_measured(model, [2000.0 * math.exp(MATCH_REACH + 0.01)], [0.5]).tolist() == [-1]
+    # a measured shape changes nothing by default: neither the pairing nor the objective
+    wrong = _measured([[1.0, 1.0]] * 4, [1.0] * 4)
+    assert match_measured(model, measured, shapes=wrong).tolist() == [0, 2, -1, 3]
+    in_phase = _measured([[1.0, 1.0]], [1.0])          # the 1300 Hz mode is out of phase at the sensors
+    z, matched = mode_errors(model, np.array([1300.0]), np.array([0.01]), in_phase)
+    assert z.tolist() == [0.0] and matched.tolist() == [1300.0]
+    assert mode_errors(model, np.array([1300.0]), np.array([0.01]), in_phase, pairing="shape")[0][0] != 0.0
+    # the opt-in shape rule takes the weakly visible mode at 1040 Hz
+    assert match_measured(model, measured, pairing="shape").tolist() == pair_modes(model, measured).tolist()
+    assert pair_modes(model, measured).tolist()[0] == 1
+
+
+def test_an_unknown_pairing_is_refused_by_name():
+    assert PAIRINGS == ("frequency", "shape")
+    assert tuple(CALIBRATION_SCHEMA["properties"]["pairing"]["enum"]) == PAIRINGS
+    with pytest.raises(ValueError, match="unknown pairing 'nearest'"):
+        match_measured(_model(**FOUR), [1000.0], pairing="nearest")

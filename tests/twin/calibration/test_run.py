@@ -84,6 +84,10 @@ def test_bad_calibration_block_lists_problems(gearbox_fmu, rig, tmp_path):
     assert len(info.value.problems) >= 2
     with pytest.raises(ScenarioError, match="natural_frequencies"):
         _scenario(gearbox_fmu, natural_frequencies=[])
+    with pytest.raises(ScenarioError, match=r"calibration\.pairing: 'nearest' is not one of \['frequency', 'shape'\]"):
+        _scenario(gearbox_fmu, pairing="nearest")
+    with pytest.raises(ScenarioError, match=r"calibration\.pairing: 'nearest' is not one of"):
+        run_calibration(_scenario(gearbox_fmu), rig, tmp_path / "o3", progress=False, pairing="nearest")
     bare = scenario_from_dict({"version": 1, "name": "c", "fmu": str(gearbox_fmu), "stop_time": 1.0})
     with pytest.raises(ScenarioError, match="no calibration block"):
         run_calibration(bare, rig, tmp_path / "o2", progress=False)

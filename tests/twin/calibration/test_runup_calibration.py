@@ -142,6 +142,8 @@ def test_cli_calibrate_with_modes_from_and_no_calibration_block(gearbox_fmu, rig
     assert "no record 'nope'" in capsys.readouterr().err
     assert main(["calibrate", str(sc), "--out", str(tmp_path / "o")]) == 2
     assert "the following arguments are required: --measurements" in capsys.readouterr().err
+    assert main(["calibrate", str(sc), "--measurements", str(path), "--pairing", "nearest"]) == 2
+    assert "argument --pairing: invalid choice: 'nearest'" in capsys.readouterr().err
 
 
 def test_cli_sensitivity_from_a_runup(gearbox_fmu, rig_file, tmp_path, capsys):
@@ -156,3 +158,5 @@ def test_cli_sensitivity_from_a_runup(gearbox_fmu, rig_file, tmp_path, capsys):
     data = json.loads((tmp_path / "s.json").read_text())
     assert data["chosen"] and len(data["measured_hz"]) >= 4
     assert main(["sensitivity", str(sc), "--json", str(tmp_path / "missing" / "s.json")]) == 2
+    assert main(["sensitivity", str(sc), "--pairing", "by-shape"]) == 2
+    assert "argument --pairing: invalid choice: 'by-shape'" in capsys.readouterr().err

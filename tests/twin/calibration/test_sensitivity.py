@@ -66,6 +66,16 @@ def test_the_twins_own_modes_identify_one_parameter_per_mode_group(gearbox_fmu):
     bounds = sens.bounds()
     assert all(lo < hi for lo, hi in bounds.values()) and set(bounds) == set(sens.chosen)
     assert "not identifiable" in sens.table() and sens.to_dict()["chosen"] == list(sens.chosen)
+    # by default the model's own modes pair with themselves by frequency: no reach, no pairing to follow
+    assert np.allclose(sens.modes_hz, freqs) and "pairing: by frequency, among the visible" in sens.table()
+    assert sens.reach is None and sens.pairing is None and sens.to_dict()["pairing_rule"] == "frequency"
+
+
+def test_the_shape_pairing_gives_each_paired_mode_its_reach(gearbox_fmu):
+    mm = model_modes(gearbox_fmu, {}, speed_hz=20.0, load_nm=20.0)
+    freqs = mm.frequency[mm.visible][:6]
+    sens = mode_sensitivity(gearbox_fmu, {}, freqs, speed_hz=20.0, load_nm=20.0, pairing="shape")
     # the model's own modes pair with themselves, each within its reach
     assert np.allclose(sens.modes_hz, freqs) and "pairing (measured -> model mode" in sens.table()
     assert np.all(sens.reach > 0) and [p["model_hz"] for p in sens.to_dict()["pairing"]] == sens.modes_hz.tolist()
+    assert sens.pairing_rule == "shape" and sens.pairing.index.tolist() == np.flatnonzero(mm.visible)[:6].tolist()
