@@ -1,7 +1,8 @@
 """Benchmark: calibration to gearboxes the twin did not generate (rigs/pedestal, rigs/beam).
 
     python bench/calibration_rigs.py [--rigs pedestal beam] [--seeds 6 7 8 9 10] [--workers 2]
-                                     [--model GearTwin.Gearbox21Shafts] [--out bench_out/calibration_rigs]
+                                     [--model GearTwin.Gearbox21Shafts] [--pairing frequency]
+                                     [--out bench_out/calibration_rigs]
 
 For each rig and seed: one gearbox with its base parameters scattered +-12 %
 (``Rig().scattered(seed, 0.12)``); a 2 s steady record at 20 Hz / 20 N.m and a 6 s run-up from 2 to
@@ -14,7 +15,8 @@ For each rig and seed: one gearbox with its base parameters scattered +-12 %
    rig modes have an extracted mode within 2 %, and the errors of those pairs.
 2. ``twin calibrate`` (parameters auto, modes from the run-up, steady record for the spectrum,
    model ``--model``, default ``GearTwin.Gearbox21Shafts``; ``GearTwin.Gearbox21Walls`` adds flexible
-   casing walls). The rig's first six observable modes against the nearest mode the calibrated
+   casing walls; ``--pairing shape`` pairs the modes by frequency, shape and reach instead of
+   frequency alone). The rig's first six observable modes against the nearest mode the calibrated
    twin shows at its sensor (acceptance: all within 3 %), the parameters left on a bound, and the
    wall time of modes + calibrate.
 3. The spectrum of the steady record against the twin's (default ``GearTwin.Gearbox21``, and the
@@ -47,14 +49,14 @@ SPEED, LOAD = 20.0, 20.0
 CHANNEL = "accel_pinion_casing"
 
 
-def _scenario(path: Path, fs: float, workers: int, model: str) -> Path:
+def _scenario(path: Path, fs: float, workers: int, model: str, pairing: str = "frequency") -> Path:
     path.write_text(json.dumps({
         "version": 1, "name": "rig-calibration", "fmu": model, "stop_time": 2.0,
         "output": {"sample_rate": fs, "variables": [CHANNEL]},
         "operating": {"speed": SPEED, "load": LOAD}, "seed": 0,
         "executor": {"type": "local", "workers": workers},
         "calibration": {"parameters": "auto", "modes_from": "runup", "record": "steady",
-                        "pop_size": 12, "n_gen": 6}}, indent=2))
+                        "pop_size": 12, "n_gen": 6, "pairing": pairing}}, indent=2))
     return path
 
 
@@ -125,7 +127,7 @@ def _nearest(values, f):
     return float(values[np.argmin(np.abs(values - f))]) if values.size else float("nan")
 
 
-def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str) -> dict:
+def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str, pairing: str = "frequency") -> dict:
     from spectral_distance import spectral_distance_report
 
     from fmu_build import build_fmu
@@ -158,7 +160,7 @@ def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str) -
     rec_err = [abs(f - _nearest(extracted, f)) / f for f in observable]
 
     scenario = load_scenario(_scenario(out / f"{rig_name}_{seed}.yaml", float(load_measurements(h5)[0].sample_rate),
-                                       workers, model))
+                                       workers, model, pairing))
     t0 = time.perf_counter()
     report = run_calibration(scenario, h5, out / f"{rig_name}_{seed}_cal", progress=False)
     t_cal = time.perf_counter() - t0
@@ -202,6 +204,8 @@ def main() -> None:
     ap.add_argument("--model", default="GearTwin.Gearbox21Shafts",
                     help="the twin's model (GearTwin.Gearbox21Walls: flexible casing walls; GearTwin.Gearbox21Measured: "
                          "pedestals on rigid ground)")
+    ap.add_argument("--pairing", choices=("frequency", "shape"), default="frequency",
+                    help="how twin calibrate pairs measured with model modes (calibration.pairing)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--out", type=Path, default=REPO / "bench_out" / "calibration_rigs")
     ap.add_argument("--explain", action="store_true",
@@ -218,7 +222,7 @@ def main() -> None:
     for rig in args.rigs:
         for seed in args.seeds:
             t = time.perf_counter()
-            r = one_gearbox(rig, seed, args.out, args.workers, args.model)
+            r = one_gearbox(rig, seed, args.out, args.workers, args.model, args.pairing)
             r["load_after"] = os.getloadavg()
             r["first6_explained"] = explain_modes(rig, seed, r, args.out)
             rows.append(r)
