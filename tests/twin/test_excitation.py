@@ -136,3 +136,7 @@ def test_modes_no_gearbox_mode_reaches_go_to_the_casing_path(measured_fmu, gearb
     assert all(path[f"sensor_pinion.panel_participation[{i}]"] == 1.0 for i in (1, 2, 3))
     assert casing_path(gearbox_fmu, "accel_pinion_casing", (1700.0,), freqs, damping, confidence) == {}
     assert casing_path(measured_fmu, "accel_pinion_casing", (), freqs, damping, confidence) == {}
+    # a mode below the panels' declared range (50 Hz) never becomes a panel the FMU would refuse
+    low = casing_path(measured_fmu, "accel_pinion_casing", (13.2, 1700.0), np.array([13.2, 1700.0]),
+                      np.array([0.02, 0.02]), np.array([0.9, 0.5]))
+    assert low["sensor_pinion.panel_frequency[1]"] == 1700.0 and "sensor_pinion.panel_frequency[2]" not in low

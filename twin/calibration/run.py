@@ -337,7 +337,9 @@ def casing_path(fmu, channel: str, unmatched_hz, freqs, damping, confidence, *, 
     PANEL_SLOTS, become the path's panel modes: frequency and damping as measured, the sensor on
     the modal mass (participation 1; 1/``shared`` when the modes were read at several sensors,
     whose paths all get them, since a run-up does not say which sensor's casing they belong to).
-    Empty when the model has no such path.
+    A mode outside the range the model declares for a panel (a 13 Hz hump is no casing panel) is
+    left out rather than written as a parameter the FMU refuses. Empty when the model has no such
+    path.
     """
     from twin.calibration.levels import SENSOR_OF_CHANNEL
     from twin.fmu import FMU
@@ -348,7 +350,11 @@ def casing_path(fmu, channel: str, unmatched_hz, freqs, damping, confidence, *, 
     with FMU(fmu) as f:
         if f"{sensor}.panel_frequency[1]" not in f.variables:
             return {}
-    picks = [i for i in np.argsort(-np.asarray(confidence)) if np.any(np.isclose(freqs[i], unmatched_hz))]
+        sv = {v.name: v for v in f.model_description.modelVariables}[f"{sensor}.panel_frequency[1]"]
+    lo = float(sv.min) if getattr(sv, "min", None) is not None else 0.0
+    hi = float(sv.max) if getattr(sv, "max", None) is not None else np.inf
+    picks = [i for i in np.argsort(-np.asarray(confidence))
+             if np.any(np.isclose(freqs[i], unmatched_hz)) and lo <= freqs[i] <= hi]
     out = {}
     for slot, i in enumerate(sorted(picks[:PANEL_SLOTS], key=lambda i: freqs[i]), start=1):
         zeta = float(damping[i]) if np.isfinite(damping[i]) else 0.02
