@@ -29,5 +29,9 @@ demo: venv
 	$(VENV)/bin/twin demo --out $(DEMO) --rig-records $(DEMO)/rigs/lumped.h5 $(DEMO)/rigs/ltca.h5 \
 		--calibration-records $(DEMO)/rigs/pedestal_steady.h5 $(DEMO)/rigs/pedestal_runup.h5
 
+# Two worker processes, whole test files to each (module fixtures are computed once); the session
+# FMUs are built once and shared (tests/conftest.py). `-n 0` in PYTEST_ARGS runs in one process.
+PYTEST_ARGS ?= -n 2 --dist loadfile
+
 test: venv
-	$(VENV)/bin/python -m pytest
+	$(VENV)/bin/python -m pytest $(PYTEST_ARGS)

@@ -1,6 +1,13 @@
-"""Session fixtures: the FMUs are built once per test session into a temporary directory."""
+"""Session fixtures: the FMUs are built once per test run into a temporary directory.
+
+``make test`` runs the suite in two pytest-xdist worker processes (``-n 2 --dist loadfile``).
+The workers share one FMU directory and build each FMU under a file lock, so an FMU is built
+once per run, not once per worker (:func:`build_shared`).
+"""
 from __future__ import annotations
 
+import hashlib
+import os
 from pathlib import Path
 
 import pytest
@@ -8,38 +15,66 @@ import pytest
 REPO = Path(__file__).resolve().parents[1]
 MODELICA = REPO / "modelica"
 
+if os.environ.get("PYTEST_XDIST_WORKER"):
+    # Two workers on two cores: one BLAS/OpenMP/torch thread each (and in their worker
+    # processes, which inherit this), instead of two each fighting over the same cores.
+    # Set before numpy or torch is imported, which read these at import.
+    for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+        os.environ.setdefault(_var, "1")
+
+
+def build_shared(model: str, out_dir: Path, **options) -> Path:
+    """:func:`fmu_build.build_fmu` of ``model`` into ``out_dir`` under a file lock, so that
+    xdist workers asking for the same FMU at once build it once: the first builds, the others
+    wait and then find it in the builder's cache (``options`` as for ``build_fmu``)."""
+    from filelock import FileLock
+
+    from fmu_build import build_fmu
+    out_dir.mkdir(parents=True, exist_ok=True)
+    key = hashlib.sha256(repr((model, sorted(options.items(), key=str))).encode()).hexdigest()[:16]
+    with FileLock(str(out_dir / f".build-{key}.lock")):
+        return build_fmu(model, MODELICA, out_dir, **options)
+
+
+@pytest.fixture(scope="session")
+def shared_build():
+    """:func:`build_shared`, for the FMU fixtures of other conftest and test files."""
+    return build_shared
+
 
 @pytest.fixture(scope="session")
 def fmu_dir(tmp_path_factory) -> Path:
+    """Where the session FMUs are built: one directory per run, shared by the xdist workers
+    (each worker's base temporary directory is a child of the run's)."""
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        shared = tmp_path_factory.getbasetemp().parent / "fmus"
+        shared.mkdir(exist_ok=True)
+        return shared
     return tmp_path_factory.mktemp("fmus")
 
 
 @pytest.fixture(scope="session")
 def gearbox_fmu(fmu_dir) -> Path:
     """The 21-DOF gearbox FMU built from modelica/ (GearTwin.Gearbox21)."""
-    from fmu_build import build_fmu
-    return build_fmu("GearTwin.Gearbox21", MODELICA, fmu_dir)
+    return build_shared("GearTwin.Gearbox21", fmu_dir)
 
 
 @pytest.fixture(scope="session")
 def measured_fmu(fmu_dir) -> Path:
     """The gearbox as its casing accelerometers measure it (GearTwin.Gearbox21Measured)."""
-    from fmu_build import build_fmu
-    return build_fmu("GearTwin.Gearbox21Measured", MODELICA, fmu_dir)
+    return build_shared("GearTwin.Gearbox21Measured", fmu_dir)
 
 
 @pytest.fixture(scope="session")
 def casing_fmu(fmu_dir) -> Path:
     """The gearbox on a casing that moves on its mounts, sensors on the casing (GearTwin.Gearbox21Casing)."""
-    from fmu_build import build_fmu
-    return build_fmu("GearTwin.Gearbox21Casing", MODELICA, fmu_dir)
+    return build_shared("GearTwin.Gearbox21Casing", fmu_dir)
 
 
 @pytest.fixture(scope="session")
 def shafts_fmu(fmu_dir) -> Path:
     """The casing model with shafts that bend, from their geometry (GearTwin.Gearbox21Shafts)."""
-    from fmu_build import build_fmu
-    return build_fmu("GearTwin.Gearbox21Shafts", MODELICA, fmu_dir)
+    return build_shared("GearTwin.Gearbox21Shafts", fmu_dir)
 
 
 @pytest.fixture(scope="session")
@@ -52,29 +87,25 @@ def walls_fmu(fmu_dir) -> Path:
 @pytest.fixture(scope="session")
 def wheel_fmu(fmu_dir) -> Path:
     """The variant with the gear's own tooth errors (GearTwin.Variants.Gearbox21WheelErrors)."""
-    from fmu_build import build_fmu
-    return build_fmu("GearTwin.Variants.Gearbox21WheelErrors", MODELICA, fmu_dir)
+    return build_shared("GearTwin.Variants.Gearbox21WheelErrors", fmu_dir)
 
 
 @pytest.fixture(scope="session")
 def two_mass_fmu(fmu_dir) -> Path:
     """A second, small model built by the same pipeline (GearTwin.Examples.TwoMassOscillator)."""
-    from fmu_build import build_fmu
-    return build_fmu("GearTwin.Examples.TwoMassOscillator", MODELICA, fmu_dir)
+    return build_shared("GearTwin.Examples.TwoMassOscillator", fmu_dir)
 
 
 @pytest.fixture(scope="session")
 def gearbox_fmu3(fmu_dir) -> Path:
     """GearTwin.Gearbox21 built as an FMI 3.0 FMU (same code and solver as gearbox_fmu)."""
-    from fmu_build import build_fmu
-    return build_fmu("GearTwin.Gearbox21", MODELICA, fmu_dir / "fmi3", fmi_version=3)
+    return build_shared("GearTwin.Gearbox21", fmu_dir / "fmi3", fmi_version=3)
 
 
 @pytest.fixture(scope="session")
 def two_mass_fmu3(fmu_dir) -> Path:
     """GearTwin.Examples.TwoMassOscillator built as an FMI 3.0 FMU."""
-    from fmu_build import build_fmu
-    return build_fmu("GearTwin.Examples.TwoMassOscillator", MODELICA, fmu_dir / "fmi3", fmi_version=3)
+    return build_shared("GearTwin.Examples.TwoMassOscillator", fmu_dir / "fmi3", fmi_version=3)
 
 
 def _thirdparty_builder():

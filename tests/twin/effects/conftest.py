@@ -5,13 +5,10 @@ from pathlib import Path
 
 import pytest
 
-REPO = Path(__file__).resolve().parents[3]
-
 
 @pytest.fixture(scope="session")
-def candidates_fmu(fmu_dir) -> Path:
-    from fmu_build import build_fmu
-    return build_fmu("GearTwin.Variants.Gearbox21Candidates", REPO / "modelica", fmu_dir)
+def candidates_fmu(fmu_dir, shared_build) -> Path:
+    return shared_build("GearTwin.Variants.Gearbox21Candidates", fmu_dir)
 
 
 @pytest.fixture(scope="session")

@@ -9,13 +9,21 @@ import pytest
 REPO = Path(__file__).resolve().parents[3]
 
 
+@pytest.fixture(scope="module")
+def calibrated_case(gearbox_fmu, candidates_fmu):
+    """The seeded record with a hidden local tooth damage and the twin calibrated to it: the same
+    for every test here (seeded), so simulated and calibrated once; each test writes its own files."""
+    from twin.effects.synthetic import calibrate_base, make_case
+    case = make_case("local_tooth_damage", 3, candidates_fmu=candidates_fmu)
+    return case, calibrate_base(case, gearbox_fmu)
+
+
 @pytest.fixture
-def case_files(tmp_path, gearbox_fmu, candidates_fmu):
+def case_files(tmp_path, gearbox_fmu, calibrated_case):
     import yaml
 
-    from twin.effects.synthetic import calibrate_base, make_case, write_case
-    case = make_case("local_tooth_damage", 3, candidates_fmu=candidates_fmu)
-    params = calibrate_base(case, gearbox_fmu)
+    from twin.effects.synthetic import write_case
+    case, params = calibrated_case
     meas = write_case(case, tmp_path / "measured.h5")
     scen = tmp_path / "twin.yaml"
     scen.write_text(yaml.safe_dump({"version": 1, "name": "rig", "fmu": str(gearbox_fmu), "stop_time": 1.0,
