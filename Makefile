@@ -29,9 +29,10 @@ demo: venv
 	$(VENV)/bin/twin demo --out $(DEMO) --rig-records $(DEMO)/rigs/lumped.h5 $(DEMO)/rigs/ltca.h5 \
 		--calibration-records $(DEMO)/rigs/pedestal_steady.h5 $(DEMO)/rigs/pedestal_runup.h5
 
-# Two worker processes, whole test files to each (module fixtures are computed once); the session
-# FMUs are built once and shared (tests/conftest.py). `-n 0` in PYTEST_ARGS runs in one process.
-PYTEST_ARGS ?= -n 2 --dist loadfile
+# Two worker processes, whole test files to each (module fixtures are computed once), the files
+# with slow tests first (tests/conftest.py; xdist would otherwise send the largest files first);
+# the session FMUs are built once and shared. `make test PYTEST_ARGS=-n0` runs in one process.
+PYTEST_ARGS ?= -n 2 --dist loadfile --no-loadscope-reorder
 
 test: venv
 	$(VENV)/bin/python -m pytest $(PYTEST_ARGS)

@@ -138,3 +138,11 @@ def typecov_fmus(tmp_path_factory) -> dict[tuple[str, int], Path]:
     root = tmp_path_factory.mktemp("typecov")
     return {(model, version): builder.build_typecov(model, version, root / f"fmi{version}")
             for version in (2, 3) for model in builder.TYPECOV_MODELS}
+
+
+def pytest_collection_modifyitems(config, items):
+    """Under xdist, the files with ``slow`` tests go first: each takes minutes on one worker,
+    and started last they would leave the other worker idle at the end of the run."""
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        slow_files = {item.path for item in items if item.get_closest_marker("slow")}
+        items.sort(key=lambda item: item.path not in slow_files)     # stable: order kept within files
