@@ -80,8 +80,7 @@ def shafts_fmu(fmu_dir) -> Path:
 @pytest.fixture(scope="session")
 def walls_fmu(fmu_dir) -> Path:
     """The shafts model with flexible casing walls under the housings (GearTwin.Gearbox21Walls)."""
-    from fmu_build import build_fmu
-    return build_fmu("GearTwin.Gearbox21Walls", MODELICA, fmu_dir)
+    return build_shared("GearTwin.Gearbox21Walls", fmu_dir)
 
 
 @pytest.fixture(scope="session")
