@@ -26,9 +26,7 @@ model Gearbox21 "21-DOF lumped model of the UNSW spur-gear test rig (Feng et al.
   parameter Real profile_deviation[n_profile](each unit = "m", each nominal = 1e-6) = fill(0.0, n_profile) "Material missing from the pinion flank (wear depth, relief) at the same nodes, common to all teeth";
   parameter Real tooth_stiffness_factor[z1] = fill(1.0, z1) "Per-pinion-tooth multiplier of the pair stiffness (crack, spall, pitting of one tooth)";
   parameter Real tooth_deviation_offset[z1](each unit = "m") = fill(0.0, z1) "Per-pinion-tooth extra material loss, added to profile_deviation";
-  parameter Real pit_profile[n_profile](each unit = "m", each nominal = 1e-6) = fill(0.0, n_profile) "Equivalent material loss of pitting along the path at the profile nodes, for a pinion tooth of pit scale 1 (the extra approach its pits give under the operating load, at most the pit depth)";
-  parameter Real tooth_pit_scale[z1] = fill(0.0, z1) "Per-pinion-tooth multiplier of pit_profile (negative: a tooth pitted less than the one k_pair describes)";
-  parameter Real tooth_pit_field[z1 * n_profile](each unit = "m", each nominal = 1e-6) = fill(0.0, z1 * n_profile) "Equivalent material loss of pitting of each pinion tooth at the profile nodes, tooth-major: element (j - 1) * n_profile + n is tooth j at node n (pits at different places on different teeth); added to pit_profile x tooth_pit_scale";
+  parameter Real tooth_pit_field[z1 * n_profile](each unit = "m", each nominal = 1e-6) = fill(0.0, z1 * n_profile) "Equivalent material loss of pitting of each pinion tooth at the profile nodes, tooth-major: element (j - 1) * n_profile + n is tooth j at node n (pits at different places on different teeth)";
   parameter Integer tooth_prev[z1] = {if j == 1 then z1 else j - 1 for j in 1:z1} "Index of the tooth ahead of tooth j (structural)";
   parameter Integer tooth_next[z1] = {if j == z1 then 1 else j + 1 for j in 1:z1} "Index of the tooth behind tooth j (structural)";
   parameter Real mesh_stiffness_scale(min = 0) = 1.0 "Calibration multiplier of all pair stiffnesses";
@@ -173,7 +171,6 @@ model Gearbox21 "21-DOF lumped model of the UNSW spur-gear test rig (Feng et al.
   Real tooth_weight[z1] "1 for the pinion tooth of the current pair, 0 for the others";
   Real pair_tooth_factor[3] "tooth_stiffness_factor of the pinion tooth in each pair";
   Real pair_tooth_offset[3](each unit = "m") "tooth_deviation_offset of the pinion tooth in each pair";
-  Real pair_pit_scale[3] "tooth_pit_scale of the pinion tooth in each pair";
   Real pair_pit_field[3](each unit = "m") "tooth_pit_field of the pinion tooth in each pair, interpolated at its contact point";
   Real pair_stiffness[3](each unit = "N/m") "Stiffness of each tooth pair";
   Real pair_deviation[3](each unit = "m") "Profile deviation at the contact point of each pair";
@@ -241,12 +238,11 @@ equation
   tooth_weight = {noEvent(max(0.0, 1 - ((cos(tooth_angle) - cos(2 * GearTwin.pi * (j - 1) / z1)) ^ 2 + (sin(tooth_angle) - sin(2 * GearTwin.pi * (j - 1) / z1)) ^ 2) / sin(GearTwin.pi / z1) ^ 2)) for j in 1:z1};
   pair_tooth_factor = {sum(tooth_stiffness_factor[tooth_prev[j]] * effect_tooth_stiffness_factor[tooth_prev[j]] * tooth_weight[j] for j in 1:z1), sum(tooth_stiffness_factor[j] * effect_tooth_stiffness_factor[j] * tooth_weight[j] for j in 1:z1), sum(tooth_stiffness_factor[tooth_next[j]] * effect_tooth_stiffness_factor[tooth_next[j]] * tooth_weight[j] for j in 1:z1)};
   pair_tooth_offset = {sum((tooth_deviation_offset[tooth_prev[j]] + effect_tooth_offset[tooth_prev[j]]) * tooth_weight[j] for j in 1:z1), sum((tooth_deviation_offset[j] + effect_tooth_offset[j]) * tooth_weight[j] for j in 1:z1), sum((tooth_deviation_offset[tooth_next[j]] + effect_tooth_offset[tooth_next[j]]) * tooth_weight[j] for j in 1:z1)};
-  pair_pit_scale = {sum(tooth_pit_scale[tooth_prev[j]] * tooth_weight[j] for j in 1:z1), sum(tooth_pit_scale[j] * tooth_weight[j] for j in 1:z1), sum(tooth_pit_scale[tooth_next[j]] * tooth_weight[j] for j in 1:z1)};
   // Each pair reads the field of the tooth it holds (same tooth weights and profile hats as above).
   pair_pit_field = {sum(sum(tooth_pit_field[(tooth_prev[j] - 1) * n_profile + n] * tooth_weight[j] for j in 1:z1) * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[1]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile), sum(sum(tooth_pit_field[(j - 1) * n_profile + n] * tooth_weight[j] for j in 1:z1) * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[2]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile), sum(sum(tooth_pit_field[(tooth_next[j] - 1) * n_profile + n] * tooth_weight[j] for j in 1:z1) * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[3]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile)};
   // Piecewise-linear interpolation along the profile: hat functions on n_profile nodes.
   pair_stiffness = {mesh_stiffness_scale * window[i] * pair_tooth_factor[i] * sum(k_pair[n] * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[i]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile) for i in 1:3};
-  pair_deviation = {pair_tooth_offset[i] + effect_pair_deviation[i] + pair_pit_field[i] + sum((profile_deviation[n] + effect_profile_deviation[n] + pair_pit_scale[i] * pit_profile[n]) * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[i]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile) for i in 1:3};
+  pair_deviation = {pair_tooth_offset[i] + effect_pair_deviation[i] + pair_pit_field[i] + sum((profile_deviation[n] + effect_profile_deviation[n]) * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[i]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile) for i in 1:3};
   mesh_deflection = rb1 * theta5 - rb2 * theta10 + (x5 - x10) * sin(alpha) + (y5 - y10) * cos(alpha) + effect_mesh_displacement + excitation_mesh_displacement;
   mesh_deflection_rate = rb1 * omega5 - rb2 * omega10 + (vx5 - vx10) * sin(alpha) + (vy5 - vy10) * cos(alpha) + effect_mesh_displacement_rate + excitation_mesh_displacement_rate;
   // A pair whose flanks are apart (deviation larger than the approach) carries no load.

@@ -38,8 +38,8 @@ approach over the healthy tooth is at most the pit depth, the law's crack depth
 fitted on the ``n_profile`` nodes along the path (least squares on the FMU's hat functions) and
 written as ``tooth_pit_field[(j - 1) n_profile + n]`` [m] (tooth-major), which each pair reads for
 the pinion tooth it holds.  The node fit along xi is the only approximation;
-:attr:`PittingMap.pit_truncation_error` is its relative error.  ``tooth_stiffness_factor``,
-``pit_profile`` and ``tooth_pit_scale`` are left to the scenario (they are not written).
+:attr:`PittingMap.pit_truncation_error` is its relative error.  ``tooth_stiffness_factor`` is
+left to the scenario (it is not written).
 
 **Why the whole field.**  Pits sit at different places on different teeth, so the field has no
 common shape: its leading singular pair (a shape times a scale per tooth) leaves 45-70 % of its

@@ -67,8 +67,8 @@ DEFAULT_INPUTS: dict[str, float] = {
     "load_torque": 20.0,              # N.m
 }
 
-_ARRAY_FIELDS = ("k_pair", "profile_deviation", "pit_profile", "tooth_stiffness_factor", "tooth_deviation_offset",
-                 "tooth_pit_scale", "tooth_pit_field",
+_ARRAY_FIELDS = ("k_pair", "profile_deviation", "tooth_stiffness_factor", "tooth_deviation_offset",
+                 "tooth_pit_field",
                  "wheel_tooth_deviation_offset", "effect_tooth_stiffness_factor", "effect_tooth_offset",
                  "effect_profile_deviation")
 #: Structural Integer parameters of the model: FMU constants, never set as start values.
@@ -104,8 +104,6 @@ class GearboxParams:
     profile_deviation: tuple[float, ...] = (0.0,) * 11                          # m
     tooth_stiffness_factor: tuple[float, ...] = (1.0,) * 19                     # -
     tooth_deviation_offset: tuple[float, ...] = (0.0,) * 19                     # m
-    pit_profile: tuple[float, ...] = (0.0,) * 11                                # m, at tooth pit scale 1
-    tooth_pit_scale: tuple[float, ...] = (0.0,) * 19                            # -
     tooth_pit_field: tuple[float, ...] = (0.0,) * (19 * 11)                     # m, tooth-major (z1 * n_profile)
     wheel_tooth_deviation_offset: tuple[float, ...] = (0.0,) * 52               # m, per gear tooth
     # parameter hooks of the effect catalogue (neutral here; they compose with the three above)
@@ -192,12 +190,12 @@ class GearboxParams:
         for name in _ARRAY_FIELDS:
             value = tuple(float(v) for v in np.asarray(getattr(self, name), dtype=float).ravel())
             object.__setattr__(self, name, value)
-        for name in ("k_pair", "profile_deviation", "effect_profile_deviation", "pit_profile"):
+        for name in ("k_pair", "profile_deviation", "effect_profile_deviation"):
             if len(getattr(self, name)) != self.n_profile:
                 raise ValueError(f"{name} needs n_profile={self.n_profile} entries, "
                                  f"got {len(getattr(self, name))}")
         for name in ("tooth_stiffness_factor", "tooth_deviation_offset", "effect_tooth_stiffness_factor",
-                     "effect_tooth_offset", "tooth_pit_scale"):
+                     "effect_tooth_offset"):
             if len(getattr(self, name)) != self.z1:
                 raise ValueError(f"{name} needs z1={self.z1} entries, got {len(getattr(self, name))}")
         if len(self.tooth_pit_field) != self.z1 * self.n_profile:
@@ -318,8 +316,6 @@ class _Constants:
         self.node_index = np.arange(p.n_profile, dtype=float)                # (n_profile,)
         self.tooth_factor = np.asarray(p.tooth_stiffness_factor) * np.asarray(p.effect_tooth_stiffness_factor)
         self.tooth_offset = np.asarray(p.tooth_deviation_offset) + np.asarray(p.effect_tooth_offset)
-        self.pit_profile = np.asarray(p.pit_profile)                         # (n_profile,)
-        self.tooth_pit_scale = np.asarray(p.tooth_pit_scale)                 # (z1,)
         self.tooth_pit_field = np.asarray(p.tooth_pit_field).reshape(p.z1, p.n_profile)  # (z1, n_profile)
         tooth_node = 2 * PI * np.arange(p.z1) / p.z1
         self.tooth_node_cos = np.cos(tooth_node)                              # (z1,)
@@ -424,8 +420,6 @@ def _mesh(c: _Constants, x: np.ndarray) -> dict[str, np.ndarray]:
                            c.inv_chord2)                                      # (3, ..., z1)
     pair_stiffness = window * k_profile * (select @ c.tooth_factor)
     pair_deviation = dev_profile + select @ c.tooth_offset
-    if c.tooth_pit_scale.any():
-        pair_deviation = pair_deviation + (select @ c.tooth_pit_scale) * (hat @ c.pit_profile)
     if c.tooth_pit_field.any():
         # each pair reads the field of the tooth it holds, interpolated along the roll
         pair_deviation = pair_deviation + np.einsum("...j,jn,...n->...", select, c.tooth_pit_field, hat)

@@ -45,15 +45,14 @@ def degraded_params() -> tuple[GearboxParams, dict[str, float]]:
     factor[3] = 0.6
     offset = [0.0] * 19
     offset[7] = 2e-6
-    pit_scale = [0.0] * 19
-    pit_scale[2:5] = (1.0, 0.4, -0.3)
-    # per-tooth pit field: pits at different places on teeth 2, 5 and 6 (tooth 5 also has pit_scale)
+    # per-tooth pit field: pits at different places on teeth 2, 5 and 6, and one shape at three
+    # scales on teeth 3-5 (tooth 5 has both; a negative scale: pitted less than k_pair describes)
     field = np.zeros((19, 11))
     field[1, 2:6] = (0.3e-6, 1.2e-6, 0.9e-6, 0.2e-6)
     field[4, 6:9] = (0.5e-6, 1.4e-6, 0.4e-6)
     field[5, :] = -0.2e-6
+    field[2:5] += np.outer((1.0, 0.4, -0.3), (0, 0, 0.2e-6, 0.8e-6, 1.5e-6, 0.6e-6, 0, 0, 0, 0, 0))
     p = GearboxParams(tooth_stiffness_factor=factor, tooth_deviation_offset=offset,
-                      pit_profile=(0, 0, 0.2e-6, 0.8e-6, 1.5e-6, 0.6e-6, 0, 0, 0, 0, 0), tooth_pit_scale=pit_scale,
                       tooth_pit_field=field.ravel(),
                       profile_deviation=(0, 0, 0, 0, 0, 0, 0, 0, 0.5e-6, 1.5e-6, 3e-6),
                       sensor_angle_pinion=math.pi / 2, sensor_angle_gear=0.7, mesh_phase0=0.3,
