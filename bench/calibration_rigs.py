@@ -16,7 +16,8 @@ For each rig and seed: one gearbox with its base parameters scattered +-12 %
 2. ``twin calibrate`` (parameters auto, modes from the run-up, steady record for the spectrum,
    model ``--model``, default ``GearTwin.Gearbox21Shafts``; ``GearTwin.Gearbox21Walls`` adds flexible
    casing walls; ``--pairing shape`` pairs the modes by frequency, shape and reach instead of
-   frequency alone). The rig's first six observable modes against the nearest mode the calibrated
+   frequency alone, and refuses a well-measured shape unlike the model mode's). The rig's first
+   six observable modes against the nearest mode the calibrated
    twin shows at its sensor (acceptance: all within 3 %), the parameters left on a bound, and the
    wall time of modes + calibrate.
 3. The spectrum of the steady record against the twin's (default ``GearTwin.Gearbox21``, and the
@@ -184,7 +185,9 @@ def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str, p
                                      settle=0.2, duration=min(dur, 2.0), channels=[CHANNEL],
                                      output_interval=1.0 / fs)[:, 0]
         spectrum[label] = spectral_distance_report(y, x[-y.size:], fs, fmin=20.0, fmax=5000.0)
-    return {"rig": rig_name, "seed": seed, "rig_wall_s": rig_wall,
+    sens_file = out / f"{rig_name}_{seed}_cal" / "sensitivity.json"
+    refusals = json.loads(sens_file.read_text()).get("refused_by_shape", []) if sens_file.exists() else []
+    return {"rig": rig_name, "seed": seed, "rig_wall_s": rig_wall, "refused_by_shape": refusals,
             "observable_hz": observable.tolist(), "extracted_hz": extracted.tolist(),
             "extracted_within_2pc": int(sum(e <= 0.02 for e in ext_err)), "extracted": int(extracted.size),
             "extracted_errors_pc": [100 * e for e in ext_err],
@@ -228,7 +231,8 @@ def main() -> None:
             rows.append(r)
             print(f"{rig} seed {seed}: {time.perf_counter() - t:.0f} s; first six "
                   f"{'PASS' if r['first6_pass'] else 'FAIL'} (max {max(r['first6_errors_pc']):.1f} %), "
-                  f"{len(r['on_bounds'])} on bounds", flush=True)
+                  f"{len(r['on_bounds'])} on bounds, {len(r['refused_by_shape'])} refused for their shape",
+                  flush=True)
             (args.out / "results.json").write_text(json.dumps(rows, indent=2))
     cpu = next((ln.split(":", 1)[1].strip() for ln in open("/proc/cpuinfo") if ln.startswith("model name")), "?")
     print(f"\nMachine: {cpu}, {len(os.sched_getaffinity(0))} cores, Python {platform.python_version()}, "

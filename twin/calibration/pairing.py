@@ -29,6 +29,16 @@ shape at the casing sensors must look like the measured one.
   and phase re a reference, :mod:`twin.signals.shapes`) and the model's residues at the same
   channels (``ModelModes.sensor_shapes``), and ``coherence_i`` the measured shape's lowest
   coherence: a shape that is not trustworthy does not count.
+* **Refusal.** A pairing whose shape is clearly wrong is not made at any cost: when the measured
+  shape is well measured (lowest coherence at least :data:`REFUSE_COHERENCE`) and the model mode's
+  shape differs from it by more than :data:`REFUSE_MISMATCH` (``1 - MAC``). At coherence 0.8 the
+  random error of a measured level ratio is at most about 35 % even from one average (Bendat and
+  Piersol: ``sqrt((1 - g) / (2 g n))``), which makes ``1 - MAC`` of two-channel shapes at most about
+  0.06; a mismatch above 0.5 (the shapes less alike than unlike) is then the physics, not the
+  estimate. Below that coherence a neighbouring mode or the noise may have bent the shape, and
+  the mismatch only costs. A refused measured mode goes to another model mode of its shape
+  within reach, or stays unpaired (and may become a sensor-path panel mode,
+  :func:`twin.calibration.run.casing_path`); :func:`shape_refusals` lists them.
 * **Assignment.** One-to-one with least total cost (Hungarian algorithm); a measured mode is left
   unpaired at cost :data:`UNPAIRED`, more than any feasible pairing.
 """
@@ -52,6 +62,10 @@ SHAPE_WEIGHT = 1.0
 #: Cost of leaving a measured mode unpaired: a pairing that costs more (a gap of more than about
 #: 45 % with the right shape) is not made even within reach.
 UNPAIRED = 3.0
+#: A measured shape counts as well measured from this lowest coherence with its reference [-].
+REFUSE_COHERENCE = 0.8
+#: A well-measured shape is never paired with a model mode whose shape differs more than this (1 - MAC).
+REFUSE_MISMATCH = 0.5
 
 
 @dataclass(frozen=True)
@@ -114,10 +128,11 @@ def mac(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.abs(np.vdot(a, b)) ** 2 / den) if den > 0 else 0.0
 
 
-def shape_mismatch(model, shapes: MeasuredShapes | None, cols: np.ndarray) -> np.ndarray:
-    """(k, len(cols)) coherence-weighted shape mismatch ``coherence_i (1 - MAC_ij)`` (0 without shapes)."""
+def raw_mismatch(model, shapes: MeasuredShapes | None, cols: np.ndarray) -> np.ndarray:
+    """(k, len(cols)) shape mismatch ``1 - MAC_ij`` at the channels both know; NaN where the measured
+    mode has no shape at two such channels, or a coherence of 0 (all NaN without shapes)."""
     k = 0 if shapes is None else shapes.vectors.shape[0]
-    out = np.zeros((k, cols.size))
+    out = np.full((k, cols.size), np.nan)
     if shapes is None or model.sensor_shapes is None:
         return out
     for i in range(k):
@@ -126,8 +141,26 @@ def shape_mismatch(model, shapes: MeasuredShapes | None, cols: np.ndarray) -> np
             continue
         m = np.array([shapes.vectors[i, shapes.channels.index(c)] for c in known])
         for jj, j in enumerate(cols):
-            out[i, jj] = shapes.coherence[i] * (1.0 - mac(m, model.sensor_shape(int(j), known)))
+            out[i, jj] = 1.0 - mac(m, model.sensor_shape(int(j), known))
     return out
+
+
+def shape_mismatch(model, shapes: MeasuredShapes | None, cols: np.ndarray) -> np.ndarray:
+    """(k, len(cols)) coherence-weighted shape mismatch ``coherence_i (1 - MAC_ij)`` (0 without shapes)."""
+    raw = raw_mismatch(model, shapes, cols)
+    if shapes is None:
+        return np.nan_to_num(raw)
+    return np.nan_to_num(shapes.coherence[:, None] * raw)
+
+
+def refused(model, shapes: MeasuredShapes | None, cols: np.ndarray) -> np.ndarray:
+    """(k, len(cols)) True where a pairing is refused: the measured shape well measured (coherence
+    >= :data:`REFUSE_COHERENCE`) and ``1 - MAC`` above :data:`REFUSE_MISMATCH`."""
+    raw = raw_mismatch(model, shapes, cols)
+    if shapes is None:
+        return np.zeros(raw.shape, bool)
+    coherent = shapes.coherence[:, None] >= REFUSE_COHERENCE
+    return coherent & (np.nan_to_num(raw) > REFUSE_MISMATCH)
 
 
 def mode_reach(S: np.ndarray, candidates) -> np.ndarray:
@@ -148,13 +181,22 @@ def candidate_modes(model, min_level_db: float = MIN_LEVEL_DB) -> np.ndarray:
 
 def pairing_cost(model, measured: np.ndarray, rel_sd: np.ndarray, cols: np.ndarray, *,
                  shapes: MeasuredShapes | None = None, reach: np.ndarray | None = None) -> np.ndarray:
-    """(k, len(cols)) cost of each pairing (see the module docstring); inf where out of reach."""
+    """(k, len(cols)) cost of each pairing (see the module docstring); inf where out of reach or
+    refused for its shape (:func:`refused`)."""
+    excess, within = _gap(model, measured, rel_sd, cols, reach)
+    if shapes is None:
+        return np.where(within, excess / MATCH_REACH, np.inf)
+    cost = excess / MATCH_REACH + SHAPE_WEIGHT * shape_mismatch(model, shapes, cols)
+    return np.where(within & ~refused(model, shapes, cols), cost, np.inf)
+
+
+def _gap(model, measured: np.ndarray, rel_sd: np.ndarray, cols: np.ndarray, reach: np.ndarray | None):
+    """(k, len(cols)) frequency gap beyond twice the uncertainty [ln f], and whether it is within reach."""
     lr = np.log(measured[:, None] / model.frequency[cols][None, :])           # > 0: the model mode must rise
     r = np.full((cols.size, 2), MATCH_REACH) if reach is None else np.asarray(reach, float)[cols]
     side = np.where(lr > 0, r[None, :, 1], r[None, :, 0])
     excess = np.maximum(0.0, np.abs(lr) - 2 * rel_sd[:, None])
-    cost = excess / MATCH_REACH + (SHAPE_WEIGHT * shape_mismatch(model, shapes, cols) if shapes is not None else 0.0)
-    return np.where(excess <= side, cost, np.inf)
+    return excess, excess <= side
 
 
 def pair_modes(model, measured, rel_sd=None, *, shapes: MeasuredShapes | None = None,
@@ -176,6 +218,33 @@ def pair_modes(model, measured, rel_sd=None, *, shapes: MeasuredShapes | None = 
     for r, c in zip(rows, picked):
         if c < cols.size and np.isfinite(cost[r, c]):
             out[r] = cols[c]
+    return out
+
+
+def shape_refusals(model, measured, index: np.ndarray, rel_sd=None, *, shapes: MeasuredShapes | None = None,
+                   reach: np.ndarray | None = None, min_level_db: float = MIN_LEVEL_DB) -> list[dict]:
+    """The measured modes left unpaired (``index`` -1, from :func:`pair_modes`) although a model mode
+    was within reach, because every such mode's shape was refused: for each, the nearest refused
+    model mode (``measured_hz``, ``model_hz``, ``model_gain_db``, ``shape_mismatch`` = 1 - MAC,
+    ``coherence`` of the measured shape)."""
+    from twin.calibration.sensitivity import MODEL_FORM
+
+    measured = np.asarray(measured, float)
+    rel_sd = np.full(measured.size, MODEL_FORM) if rel_sd is None else np.asarray(rel_sd, float)
+    cols = candidate_modes(model, min_level_db)
+    if shapes is None or cols.size == 0:
+        return []
+    _, within = _gap(model, measured, rel_sd, cols, reach)
+    no = refused(model, shapes, cols) & within
+    raw = raw_mismatch(model, shapes, cols)
+    out = []
+    for i in np.flatnonzero((np.asarray(index) < 0) & no.any(axis=1)):
+        jj = np.flatnonzero(no[i])
+        jj = jj[np.argmin(np.abs(np.log(measured[i] / model.frequency[cols[jj]])))]
+        j = int(cols[jj])
+        out.append({"measured_hz": float(measured[i]), "model_hz": float(model.frequency[j]),
+                    "model_gain_db": float(model.gain_db[j]), "shape_mismatch": float(raw[i, jj]),
+                    "coherence": float(shapes.coherence[i])})
     return out
 
 

@@ -234,8 +234,8 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
                                            rel_sd=rel_sd, channels=mode_channels, executor=ex,
                                            shapes=target.mode_shapes, pairing=pairing)
             target = replace(target, mode_pairing=sensitivity.pairing)
-            (out_dir / "sensitivity.json").write_text(json.dumps(sensitivity.to_dict(), indent=2))
             if not sensitivity.chosen:
+                (out_dir / "sensitivity.json").write_text(json.dumps(sensitivity.to_dict(), indent=2))
                 raise ScenarioError([(source, "calibration.parameters", "no parameter is identifiable from the "
                                       "measured modes:\n" + sensitivity.table())])
             if progress:
@@ -246,13 +246,15 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
             for ch in mode_channels:
                 path.update(casing_path(fmu, ch, sensitivity.unmatched_hz, freqs, damping, confidence,
                                         shared=len(mode_channels)))
+            attributed = sorted({v for k, v in path.items() if "panel_frequency" in k})
             if path:
                 fixed.update(path)
-                attributed = sorted({v for k, v in path.items() if "panel_frequency" in k})
-                path_note = ("attributed to casing panel modes in the sensor path (no gearbox mode within 15 %): "
+                path_note = ("attributed to casing panel modes in the sensor path (no gearbox mode paired): "
                              + ", ".join(f"{f:.1f} Hz" for f in attributed))
                 if progress:
                     print(path_note)
+            (out_dir / "sensitivity.json").write_text(json.dumps(sensitivity.to_dict(sensor_path_hz=attributed),
+                                                                 indent=2))
         else:
             bounds = spec["parameters"]
             nominal = {}
@@ -330,8 +332,9 @@ def casing_path(fmu, channel: str, unmatched_hz, freqs, damping, confidence, *, 
                 ) -> dict[str, float]:
     """Parameters that put the measured modes no gearbox mode can reach into the sensor's casing path.
 
-    A measured mode with no visible mode of the gearbox model within 15 % is something the
-    gearbox model does not have; at a casing accelerometer the casing wall between the bearings
+    A measured mode with no visible mode of the gearbox model within 15 % (with the shape
+    pairing: none within reach whose shape is not refused) is something the gearbox model does
+    not have; at a casing accelerometer the casing wall between the bearings
     and the sensor is what it most likely is (the rig's counterpart of the paper's foundation
     modes, which were measured apart and removed). The most confident of them, at most
     PANEL_SLOTS, become the path's panel modes: frequency and damping as measured, the sensor on

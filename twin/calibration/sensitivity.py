@@ -18,7 +18,8 @@
    modes' sensitivities are computed. With ``pairing="shape"`` the sensitivities of every
    candidate model mode (visible, or weakly visible down to
    :data:`twin.calibration.pairing.MIN_LEVEL_DB`) give each its reach within the bounds, and the
-   measured modes are paired by frequency, shape at the sensors and reach.
+   measured modes are paired by frequency, shape at the sensors and reach; a pairing whose shape
+   is clearly wrong (well measured and unlike) is refused and listed (``refused_by_shape``).
 4. **Identifiable subset** by QR with column pivoting on the weighted matrix
    ``S[i, j] * h_j / s_i`` (``h_j`` half the log-range of the bounds, ``s_i`` the relative
    uncertainty of mode i): a column is kept while the information it adds beyond the columns
@@ -36,8 +37,9 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-from twin.calibration.pairing import (MATCH_REACH, MeasuredShapes, Pairing, candidate_modes, check_pairing,
-                                      mode_reach, pair_by_frequency, pair_modes, shape_mismatch)
+from twin.calibration.pairing import (MATCH_REACH, REFUSE_COHERENCE, REFUSE_MISMATCH, MeasuredShapes, Pairing,
+                                      candidate_modes, check_pairing, mode_reach, pair_by_frequency, pair_modes,
+                                      shape_mismatch, shape_refusals)
 
 #: (unit, words in the description, relative bounds [lower, upper] about the nominal, reason); the
 #: first rule whose unit matches and whose words (if any) occur in the description applies
@@ -261,6 +263,7 @@ class Sensitivity:
     gain_db: np.ndarray | None = None     # (k,) peak gain of each paired model mode, dB re the most visible
     pairing: Pairing | None = None        # of all the measured modes (unpaired: -1), at the nominal set
     pairing_rule: str = "frequency"       # how the modes were paired (twin.calibration.pairing.PAIRINGS)
+    refused: tuple[dict, ...] = ()        # measured modes left unpaired for their shape (pairing.shape_refusals)
 
     def bounds(self) -> dict[str, list[float]]:
         by = {c.name: c for c in self.candidates}
@@ -295,10 +298,22 @@ class Sensitivity:
         elif self.unmatched_hz:
             rows.append("  measured modes no model mode can reach within the bounds: "
                         + ", ".join(f"{f:.1f} Hz" for f in self.unmatched_hz))
+        if self.refused:
+            rows.append(f"  refused for their shape (1 - MAC > {REFUSE_MISMATCH:g}, measured with coherence >= "
+                        f"{REFUSE_COHERENCE:g}): " + ", ".join(
+                            f"{r['measured_hz']:.1f} Hz (model {r['model_hz']:.1f} Hz, {r['shape_mismatch']:.2f})"
+                            for r in self.refused))
         rows += [f"note: {n}" for n in self.notes]
         return "\n".join(rows)
 
-    def to_dict(self) -> dict:
+    def to_dict(self, sensor_path_hz: Sequence[float] | None = None) -> dict:
+        """JSON-ready; with ``sensor_path_hz`` (the measured modes made sensor-path panel modes) each
+        refused mode also says where it went (``sensor_path`` or ``unpaired``)."""
+        refused = [dict(r) for r in self.refused]
+        if sensor_path_hz is not None:
+            for r in refused:
+                r["goes_to"] = ("sensor_path" if np.any(np.isclose(r["measured_hz"], list(sensor_path_hz) or [np.nan]))
+                                else "unpaired")
         return {"modes_hz": self.modes_hz.tolist(), "measured_hz": self.measured_hz.tolist(),
                 "relative_sd": self.rel_sd.tolist(),
                 "parameters": [{"name": c.name, "nominal": c.nominal, "bounds": [c.lower, c.upper],
@@ -312,7 +327,9 @@ class Sensitivity:
                              "model_gain_db": None if self.gain_db is None else float(self.gain_db[i]),
                              "reach_ln_f": None if self.reach is None else [float(v) for v in self.reach[i]],
                              "shape_mismatch": None if self.shape_mismatch is None else float(self.shape_mismatch[i])}
-                            for i, (fm, f) in enumerate(zip(self.measured_hz, self.modes_hz))]}
+                            for i, (fm, f) in enumerate(zip(self.measured_hz, self.modes_hz))],
+                "refused_by_shape": refused,
+                **({"sensor_path_hz": [float(f) for f in sensor_path_hz]} if sensor_path_hz is not None else {})}
 
 
 def mode_sensitivity(fmu_path, values: Mapping[str, float], measured_hz, *, speed_hz: float, load_nm: float,
@@ -377,7 +394,8 @@ def mode_sensitivity(fmu_path, values: Mapping[str, float], measured_hz, *, spee
     chosen, left_out, info, cond = select_identifiable(S, cands, rel[ok])
     return Sensitivity(base.frequency[which], measured[ok], rel[ok], tuple(cands), S, chosen, left_out, info, cond,
                        tuple(float(f) for f in measured[~ok]), tuple(notes), reach[which], mismatch,
-                       base.gain_db[which], Pairing(base, match), "shape")
+                       base.gain_db[which], Pairing(base, match), "shape",
+                       tuple(shape_refusals(base, measured, match, rel, shapes=shapes, reach=reach)))
 
 
 def _modes_task(task):

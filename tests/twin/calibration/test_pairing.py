@@ -1,5 +1,5 @@
 """Pairing measured modes with model modes: by frequency among the visible modes (default), or by
-frequency, shape at the sensors and reach (opt-in)."""
+frequency, shape at the sensors and reach (opt-in), refusing a well-measured shape unlike the model mode's."""
 from __future__ import annotations
 
 import math
@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from twin.calibration.modal_fit import mode_errors
-from twin.calibration.pairing import (MATCH_REACH, PAIRINGS, MeasuredShapes, Pairing, mac, mode_reach, pair_modes,
-                                      shape_mismatch)
-from twin.calibration.sensitivity import Candidate, ModelModes, match_measured
+from twin.calibration.pairing import (MATCH_REACH, PAIRINGS, REFUSE_COHERENCE, REFUSE_MISMATCH, MeasuredShapes,
+                                      Pairing, mac, mode_reach, pair_modes, refused, shape_mismatch, shape_refusals)
+from twin.calibration.sensitivity import Candidate, ModelModes, Sensitivity, match_measured
 from twin.scenario import CALIBRATION_SCHEMA
 from twin.signals.shapes import ChannelShape
 
@@ -48,7 +48,8 @@ def test_a_lateral_measured_shape_picks_the_lateral_mode_over_a_closer_torsional
 
 def test_weakly_visible_modes_count_down_to_the_stated_level_only():
     quiet = _model(**{**TORSION_AND_LATERAL, "gain_db": [0.0, -80.0]})
-    assert pair_modes(quiet, [1000.0], shapes=_measured([[1.0, -0.3]], [0.95]), reach=REACH).tolist() == [0]
+    # the lateral mode 80 dB down is no candidate, and the torsional one's shape is refused (1 - MAC 0.78)
+    assert pair_modes(quiet, [1000.0], shapes=_measured([[1.0, -0.3]], [0.95]), reach=REACH).tolist() == [-1]
     assert pair_modes(quiet, [1000.0], shapes=_measured([[1.0, -0.3]], [0.95]), reach=REACH,
                       min_level_db=-90.0).tolist() == [1]
 
@@ -98,9 +99,13 @@ def test_the_objective_charges_a_wrong_shape_like_a_missing_mode():
     model = _model([1000.0, 1400.0], [[1.0, 1.0], [1.0, 1.0]], [0.0, 0.0], [True, True])
     sd = np.array([0.01])
     z0, _ = mode_errors(model, np.array([1000.0]), sd, pairing="shape")
+    assert z0 == pytest.approx([0.0])
+    # a shape measured with coherence 0.7 is not trusted enough to refuse: paired, charged 0.7 of a missing mode
+    z, matched = mode_errors(model, np.array([1000.0]), sd, _measured([[1.0, -1.0]], [0.7]), pairing="shape")
+    assert matched.tolist() == [1000.0] and abs(z[0]) == pytest.approx(0.7 * MATCH_REACH / 0.01)
+    # well measured: the pairing is refused and the mode charged as missing
     z, matched = mode_errors(model, np.array([1000.0]), sd, _measured([[1.0, -1.0]], [1.0]), pairing="shape")
-    assert z0 == pytest.approx([0.0]) and matched.tolist() == [1000.0]
-    assert abs(z[0]) == pytest.approx(MATCH_REACH / 0.01)
+    assert np.isnan(matched[0]) and abs(z[0]) == pytest.approx(MATCH_REACH / 0.01)
 
 
 def test_a_pairing_is_followed_to_a_nearby_parameter_set():
@@ -142,3 +147,77 @@ def test_an_unknown_pairing_is_refused_by_name():
     assert tuple(CALIBRATION_SCHEMA["properties"]["pairing"]["enum"]) == PAIRINGS
     with pytest.raises(ValueError, match="unknown pairing 'nearest'"):
         match_measured(_model(**FOUR), [1000.0], pairing="nearest")
+
+
+#: one torsional model mode at 1340 Hz, both sensors in phase; the measured mode at 1790 Hz is out
+#: of phase at the sensors (a casing panel's shape), 29 % away but within the mode's reach
+TORSION_ONLY = dict(freqs=[1340.0], sensor=[[1.0], [1.0]], gain_db=[0.0], visible=[True])
+WIDE = np.array([[0.4, 0.4]])
+
+
+def test_a_well_measured_shape_unlike_the_model_modes_is_refused_and_reported():
+    model = _model(**TORSION_ONLY)
+    panel = _measured([[1.0, -1.0]], [0.95])
+    assert pair_modes(model, [1790.0], reach=WIDE).tolist() == [0]          # without the shape: paired
+    index = pair_modes(model, [1790.0], shapes=panel, reach=WIDE)
+    assert index.tolist() == [-1]
+    (refusal,) = shape_refusals(model, [1790.0], index, shapes=panel, reach=WIDE)
+    assert refusal["measured_hz"] == 1790.0 and refusal["model_hz"] == 1340.0
+    assert refusal["shape_mismatch"] == pytest.approx(1.0) and refusal["coherence"] == 0.95
+    # a mode out of reach is unpaired for its frequency, not refused for its shape
+    narrow = np.array([[0.1, 0.1]])
+    assert shape_refusals(model, [1790.0], pair_modes(model, [1790.0], shapes=panel, reach=narrow),
+                          shapes=panel, reach=narrow) == []
+    # refused by the least-cost pairing too, with no reach given (15 % either way)
+    assert pair_modes(model, [1300.0], shapes=panel).tolist() == [-1]
+
+
+def test_a_refused_mode_takes_a_model_mode_of_its_shape_when_one_is_within_reach():
+    model = _model(**TORSION_AND_LATERAL)                                  # lateral: gear sensor at -0.3
+    out_of_phase = _measured([[1.0, -0.5]], [0.95])
+    assert refused(model, out_of_phase, np.array([0, 1])).tolist() == [[True, False]]
+    assert pair_modes(model, [1020.0], shapes=out_of_phase, reach=REACH).tolist() == [1]
+    assert shape_refusals(model, [1020.0], np.array([1]), shapes=out_of_phase, reach=REACH) == []
+
+
+def test_a_poorly_measured_or_moderately_unlike_shape_is_not_refused():
+    model = _model(**TORSION_ONLY)
+    # coherence below REFUSE_COHERENCE: the shape may be bent by a neighbour or the noise; it only costs
+    weak = _measured([[1.0, -1.0]], [REFUSE_COHERENCE - 0.05])
+    assert pair_modes(model, [1400.0], shapes=weak, reach=WIDE).tolist() == [0]
+    assert shape_refusals(model, [1400.0], np.array([-1]), shapes=weak, reach=WIDE) == []
+    # well measured, but 1 - MAC at most REFUSE_MISMATCH: a phase of 90 deg at equal levels is exactly 0.5
+    quarter = _measured([[1.0, 1j]], [0.99])
+    assert 1 - mac(np.array([1.0, 1j]), np.array([1.0, 1.0])) == pytest.approx(REFUSE_MISMATCH)
+    assert pair_modes(model, [1400.0], shapes=quarter, reach=WIDE).tolist() == [0]
+    assert pair_modes(model, [1400.0], shapes=_measured([[1.0, np.exp(1.7j)]], [0.99]), reach=WIDE).tolist() == [-1]
+
+
+def test_pairing_by_frequency_alone_ignores_the_refusal():
+    model = _model(**TORSION_ONLY)
+    panel = _measured([[1.0, -1.0]], [1.0])
+    assert match_measured(model, [1300.0], shapes=panel).tolist() == [0]
+    assert match_measured(model, [1300.0], shapes=panel, pairing="frequency").tolist() == [0]
+    z, matched = mode_errors(model, np.array([1300.0]), np.array([0.01]), panel)
+    assert matched.tolist() == [1340.0] and z[0] == pytest.approx(math.log(1340 / 1300) / 0.01)
+    # the shape rule charges the refused mode as a missing one
+    z, matched = mode_errors(model, np.array([1300.0]), np.array([0.01]), panel, pairing="shape")
+    assert np.isnan(matched[0]) and z[0] == pytest.approx(MATCH_REACH / 0.01)
+
+
+def test_the_sensitivity_json_says_where_each_refused_mode_went():
+    refusals = ({"measured_hz": 1790.0, "model_hz": 1340.0, "model_gain_db": -44.0, "shape_mismatch": 0.99,
+                 "coherence": 0.95},
+                {"measured_hz": 13.2, "model_hz": 15.0, "model_gain_db": -10.0, "shape_mismatch": 0.8,
+                 "coherence": 0.9})
+    sens = Sensitivity(np.array([1000.0]), np.array([1010.0]), np.array([0.01]), (Candidate("k", 1.0, 0.5, 2.0, ""),),
+                       np.array([[0.5]]), ("k",), {}, {"k": 9.0}, 1.0, (1790.0, 13.2), (), pairing_rule="shape",
+                       refused=refusals)
+    assert "refused for their shape" in sens.table() and "1790.0 Hz (model 1340.0 Hz, 0.99)" in sens.table()
+    plain = sens.to_dict()
+    assert [r["measured_hz"] for r in plain["refused_by_shape"]] == [1790.0, 13.2]
+    assert "goes_to" not in plain["refused_by_shape"][0] and "sensor_path_hz" not in plain
+    out = sens.to_dict(sensor_path_hz=[1790.0])
+    assert [r["goes_to"] for r in out["refused_by_shape"]] == ["sensor_path", "unpaired"]
+    assert [r["goes_to"] for r in sens.to_dict(sensor_path_hz=[])["refused_by_shape"]] == ["unpaired"] * 2
+    assert sens.refused[0].get("goes_to") is None                             # the record itself is not changed
