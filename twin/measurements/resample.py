@@ -22,6 +22,7 @@ function returns a note saying what was done; nothing is resampled silently.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from fractions import Fraction
 
@@ -43,8 +44,17 @@ def anti_aliasing_filter(up: int, down: int) -> np.ndarray:
     Cut-off at the lower Nyquist frequency (``1 / max(up, down)`` of the upsampled one);
     unit DC gain (``resample_poly`` applies the factor ``up`` itself).
     """
+    return _filter(up, down).copy()
+
+
+@functools.lru_cache(maxsize=16)
+def _filter(up: int, down: int) -> np.ndarray:
+    """:func:`anti_aliasing_filter`, designed once per ratio and read-only: a set of records at one
+    rate shares it (50 kHz to 20.48 kHz takes 25 001 taps, whose design cost more than the filtering)."""
     m = max(up, down)
-    return firwin(2 * FILTER_HALF_LENGTH * m + 1, 1.0 / m, window=("kaiser", KAISER_BETA))
+    taps = firwin(2 * FILTER_HALF_LENGTH * m + 1, 1.0 / m, window=("kaiser", KAISER_BETA))
+    taps.flags.writeable = False
+    return taps
 
 
 def rational_ratio(from_rate: float, to_rate: float) -> tuple[int, int]:
@@ -89,7 +99,7 @@ def resample_record(record: Record, sample_rate: float) -> tuple[Record, str | N
     n = record.n_samples
     n_new = -(-n * up // down)                         # ceil, the length resample_poly returns
     achieved = fs * up / down
-    taps = anti_aliasing_filter(up, down)
+    taps = _filter(up, down)
     channels = {}
     for name, x in record.channels.items():
         if name == record.tachometer and record.tachometer_kind == "pulse":

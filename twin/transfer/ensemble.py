@@ -377,10 +377,21 @@ class Ensemble:
         first = self.members[0]
         prepared = first._prepared(data, None, what, "target")
         raw, rec, lab = windows_of(prepared, self.preprocessing, what)       # represented once for all members
-        out = []
-        for m in self.members:
-            out.append(m._forward(m.target_normaliser_(raw))[1])
-        return np.stack(out), rec, lab, prepared
+        return self._network_probabilities(raw), rec, lab, prepared
+
+    def _network_probabilities(self, raw: np.ndarray) -> np.ndarray:
+        """The members' network probabilities (members, n, K) of represented windows ``raw`` (n, window):
+        all members over all windows together (:mod:`twin.transfer.inference`); each member's own
+        ``Assessor._forward`` gives the same numbers to float32 round-off."""
+        from twin.transfer.inference import StackedNetworks
+        key = tuple(id(m.network_) for m in self.members)
+        if getattr(self, "_stacked_key", None) != key:          # folded once per set of members
+            self._stacked, self._stacked_key = StackedNetworks([m.network_ for m in self.members]), key
+        norms = [m.target_normaliser_ for m in self.members]
+        first = norms[0]
+        if all(np.array_equal(n.centre, first.centre) and n.scale == first.scale for n in norms[1:]):
+            return self._stacked.probabilities(first(raw))
+        return self._stacked.probabilities(np.stack([n(raw) for n in norms]))
 
     def _match(self, p: np.ndarray) -> np.ndarray:
         from twin.transfer.prior import apply_log_weights, ordinal_probabilities

@@ -99,3 +99,18 @@ def test_loading_refuses_what_is_not_an_ensemble(tmp_path):
     (tmp_path / "ensemble.json").write_text(json.dumps({"format": "other"}))
     with pytest.raises(AssessorError, match="format"):
         Ensemble.load(tmp_path)
+
+
+def test_the_batched_inference_gives_each_members_own_forward_pass(trained):
+    _, _, _, ens, _ = trained
+    from twin.transfer.preprocess import windows_of
+    recs = rig_records(seed=7)
+    prepared = ens.members[0]._prepared(recs, None, "assess", "target")
+    raw, _, _ = windows_of(prepared, ens.preprocessing, "assess")
+    reference = np.stack([m._forward(m.target_normaliser_(raw))[1] for m in ens.members])
+    fast = ens._network_probabilities(raw)
+    np.testing.assert_allclose(fast, reference, rtol=0, atol=2e-6)
+    res = ens.assess(recs, time_ordered=False)
+    p = ens._match(reference.mean(0))
+    assert np.array_equal(res.window_stages, p.argmax(1))
+    assert np.array_equal(ens._member_stages(fast), ens._member_stages(reference))

@@ -1,0 +1,172 @@
+"""Fast inference: the networks of an ensemble run over many windows at once.
+
+::
+
+    from twin.transfer.inference import StackedNetworks
+    fast = StackedNetworks([m.network_ for m in ensemble.members])
+    p = fast.probabilities(x)            # (members, n, K) stage probabilities of windows x (n, window)
+
+It computes what ``Assessor._forward`` computes for each member (the reference path, kept for
+training), to float32 round-off (``tests/twin/transfer/test_inference.py``), with less work:
+
+* **batch norm folded**: in eval mode a ``BatchNorm1d`` is the affine map ``gamma (y - mean) /
+  sqrt(var + eps) + beta`` of its running statistics, so it is folded into the weights and bias of
+  the convolution or linear layer before it, once per ensemble instead of once per window;
+* **ReLU after the max-pool**: ``max`` is monotone, so ``relu(max(a, b)) = max(relu(a), relu(b))``
+  exactly, and the ReLU touches half the samples;
+* **windows in chunks** of ``chunk`` (bounded memory: the first layer's output of a 128-window
+  chunk is 4 MB), every member on the same chunk, under :func:`torch.inference_mode` (no autograd
+  bookkeeping);
+* **chunks in parallel** on ``threads`` worker threads, each running torch with one intra-op
+  thread.  On a 2-core machine that other work shares, torch's own two OpenMP threads wait for
+  each other at every layer and lose to a descheduled partner (measured 1.5-3 x slower under load,
+  BENCHMARKS.md); independent chunks do not wait.  torch's thread count is restored afterwards.
+
+The result does not depend on ``threads``: every chunk goes through the same single-threaded
+kernels whichever worker takes it.
+"""
+from __future__ import annotations
+
+import os
+import threading
+from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+
+from twin.transfer.errors import AssessorError
+
+__all__ = ["DEFAULT_CHUNK", "StackedNetworks", "default_threads"]
+
+DEFAULT_CHUNK = 128
+# torch.set_num_threads is process-wide: concurrent calls must not restore each other's setting
+_THREADS_LOCK = threading.Lock()
+
+
+def default_threads() -> int:
+    """Worker threads for inference: the cores this process may use, at most 2 (the machines'
+    count; more workers than cores only queue)."""
+    return max(1, min(2, len(os.sched_getaffinity(0))))
+
+
+def _fold(weight, bias, bn):
+    """(weight, bias) of a conv or linear layer followed by an eval-mode batch norm, as one layer.
+
+    ``weight`` (out, ...), ``bias`` (out,); returns detached float32 tensors."""
+    import torch
+    with torch.no_grad():
+        s = bn.weight / torch.sqrt(bn.running_var + bn.eps)
+        w = weight * s.reshape(-1, *([1] * (weight.dim() - 1)))
+        b = (bias - bn.running_mean) * s + bn.bias
+    return w.detach().contiguous(), b.detach().contiguous()
+
+
+class StackedNetworks:
+    """Several trained :class:`~twin.transfer.model.Network` of one shape, evaluated together.
+
+    Parameters
+    ----------
+    networks : sequence of Network
+        Trained networks (their batch norms' running statistics are used, as in eval mode); the
+        weights are copied, later changes to the networks are not seen.
+    chunk : int
+        Windows per forward pass.
+    threads : int, optional
+        Worker threads (default :func:`default_threads`).
+
+    Raises
+    ------
+    AssessorError
+        No networks, networks of different shapes, a bad chunk or thread count.
+    """
+
+    def __init__(self, networks: Sequence, *, chunk: int = DEFAULT_CHUNK, threads: int | None = None):
+        import torch
+        from torch import nn
+
+        from twin.transfer.model import MaxPool2
+
+        nets = list(networks)
+        if not nets:
+            raise AssessorError("StackedNetworks: no networks")
+        threads = default_threads() if threads is None else threads
+        for name, v in (("chunk", chunk), ("threads", threads)):
+            if isinstance(v, bool) or not isinstance(v, int) or v < 1:
+                raise AssessorError(f"StackedNetworks: {name} must be an integer >= 1, got {v!r}")
+        self.chunk, self.threads = chunk, threads
+        self._members = []
+        for net in nets:
+            layers = list(net.G.conv)
+            convs = []
+            for i in range(0, len(layers), 4):
+                conv, bn, relu, pool = layers[i:i + 4]
+                if not (isinstance(conv, nn.Conv1d) and isinstance(bn, nn.BatchNorm1d) and isinstance(relu, nn.ReLU)
+                        and isinstance(pool, MaxPool2)):
+                    raise AssessorError("StackedNetworks: a convolution module is not Conv1d, BatchNorm1d, ReLU, "
+                                        "MaxPool2")
+                w, b = _fold(conv.weight, conv.bias, bn)
+                convs.append((w, b, conv.padding[0]))
+            _, lin, bn, _ = list(net.G.fc)
+            lw, lb = _fold(lin.weight, lin.bias, bn)
+            self._members.append((convs, lw, lb, net.C.weight.detach().clone(), net.C.bias.detach().clone()))
+        shapes = {tuple(tuple(t.shape) for c in m[0] for t in c[:2]) + (tuple(m[1].shape), tuple(m[3].shape))
+                  for m in self._members}
+        if len(shapes) > 1:
+            raise AssessorError("StackedNetworks: the networks differ in shape (window or stage count)")
+        convs, lw = self._members[0][:2]
+        # the flattened features are (last channels) x (window halved by every pool)
+        self.window = lw.shape[1] // convs[-1][0].shape[0] * 2 ** len(convs)
+        self.n_classes = int(self._members[0][3].shape[0])
+        self._torch = torch
+
+    def __len__(self) -> int:
+        return len(self._members)
+
+    def _chunk(self, x):
+        """Probabilities (members, n, K) of one chunk x (n, 1, window) or (members, n, 1, window)."""
+        import torch.nn.functional as F
+        out = []
+        for k, (convs, lw, lb, cw, cb) in enumerate(self._members):
+            h = x if x.dim() == 3 else x[k]
+            for w, b, pad in convs:
+                h = F.conv1d(h, w, b, padding=pad)
+                n, c, length = h.shape
+                h = h[..., : length - length % 2].reshape(n, c, length // 2, 2).amax(-1).relu_()
+            g = F.linear(h.flatten(1), lw, lb).relu_()
+            out.append(self._torch.softmax(F.linear(g, cw, cb), 1))
+        return self._torch.stack(out).numpy()
+
+    def probabilities(self, x: np.ndarray) -> np.ndarray:
+        """Stage probabilities of every member, (members, n, K) float32.
+
+        ``x``: the windows as every member sees them, (n, window), or each member's own, (members,
+        n, window) (members whose domain normalisers differ).
+        """
+        torch = self._torch
+        m = len(self._members)
+        x = np.ascontiguousarray(x, dtype=np.float32)
+        if x.shape[-1:] != (self.window,) or x.ndim not in (2, 3) or (x.ndim == 3 and x.shape[0] != m):
+            raise AssessorError(f"StackedNetworks: windows must have shape (n, {self.window}) or ({m}, n, "
+                                f"{self.window}), got {x.shape}")
+        n = x.shape[-2]
+        out = np.empty((m, n, self.n_classes), dtype=np.float32)
+        starts = range(0, n, self.chunk)
+
+        def run(i: int) -> None:
+            with torch.inference_mode():
+                xi = torch.from_numpy(x[..., i:i + self.chunk, :])
+                out[:, i:i + self.chunk] = self._chunk(xi.unsqueeze(-2))
+
+        with _THREADS_LOCK:
+            before = torch.get_num_threads()
+            torch.set_num_threads(1)
+            try:
+                if self.threads == 1 or len(starts) == 1:
+                    for i in starts:
+                        run(i)
+                else:
+                    with ThreadPoolExecutor(max_workers=self.threads) as pool:
+                        list(pool.map(run, starts))
+            finally:
+                torch.set_num_threads(before)
+        return out
