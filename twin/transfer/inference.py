@@ -14,6 +14,10 @@ training), to float32 round-off (``tests/twin/transfer/test_inference.py``), wit
   the convolution or linear layer before it, once per ensemble instead of once per window;
 * **ReLU after the max-pool**: ``max`` is monotone, so ``relu(max(a, b)) = max(relu(a), relu(b))``
   exactly, and the ReLU touches half the samples;
+* **channels last**: the convolutions run as 2-D convolutions of height 1 on (n, channels, 1,
+  samples) tensors stored channels innermost, the layout in which oneDNN's kernels for these narrow
+  layers are fastest (2.3 x over ``conv1d`` for the five layers, 1 thread), and the pool is the
+  elementwise maximum of the even and odd samples, whole contiguous rows of channels;
 * **windows in chunks** of ``chunk`` (bounded memory: the first layer's output of a 128-window
   chunk is 4 MB), every member on the same chunk, under :func:`torch.inference_mode` (no autograd
   bookkeeping);
@@ -105,7 +109,7 @@ class StackedNetworks:
                     raise AssessorError("StackedNetworks: a convolution module is not Conv1d, BatchNorm1d, ReLU, "
                                         "MaxPool2")
                 w, b = _fold(conv.weight, conv.bias, bn)
-                convs.append((w, b, conv.padding[0]))
+                convs.append((w.unsqueeze(2).contiguous(memory_format=torch.channels_last), b, conv.padding[0]))
             _, lin, bn, _ = list(net.G.fc)
             lw, lb = _fold(lin.weight, lin.bias, bn)
             self._members.append((convs, lw, lb, net.C.weight.detach().clone(), net.C.bias.detach().clone()))
@@ -125,14 +129,17 @@ class StackedNetworks:
     def _chunk(self, x):
         """Probabilities (members, n, K) of one chunk x (n, 1, window) or (members, n, 1, window)."""
         import torch.nn.functional as F
+        torch = self._torch
         out = []
         for k, (convs, lw, lb, cw, cb) in enumerate(self._members):
-            h = x if x.dim() == 3 else x[k]
+            # (n, channels, 1, samples) with the channels innermost ("channels last"): oneDNN's fast
+            # layout for narrow convolutions, and the pool's pairs are whole contiguous rows
+            h = (x if x.dim() == 3 else x[k]).unsqueeze(2).contiguous(memory_format=torch.channels_last)
             for w, b, pad in convs:
-                h = F.conv1d(h, w, b, padding=pad)
-                n, c, length = h.shape
-                h = h[..., : length - length % 2].reshape(n, c, length // 2, 2).amax(-1).relu_()
-            g = F.linear(h.flatten(1), lw, lb).relu_()
+                h = F.conv2d(h, w, b, padding=(0, pad))
+                length = h.shape[-1] - h.shape[-1] % 2
+                h = torch.maximum(h[..., 0:length:2], h[..., 1:length:2]).relu_()
+            g = F.linear(h.contiguous().flatten(1), lw, lb).relu_()
             out.append(self._torch.softmax(F.linear(g, cw, cb), 1))
         return self._torch.stack(out).numpy()
 
