@@ -372,17 +372,36 @@ class Ensemble:
     # -- probabilities ----------------------------------------------------------------------------
     def _raw(self, data, what: str = "assess"):
         """Members' raw network probabilities on the windows of ``data``: (members, n, K), record
-        index (n,), labels (n,), prepared records."""
-        from twin.transfer.preprocess import windows_of
-        first = self.members[0]
-        prepared = first._prepared(data, None, what, "target")
-        raw, rec, lab = windows_of(prepared, self.preprocessing, what)       # represented once for all members
-        return self._network_probabilities(raw), rec, lab, prepared
+        index (n,), labels (n,), prepared records.
 
-    def _network_probabilities(self, raw: np.ndarray) -> np.ndarray:
-        """The members' network probabilities (members, n, K) of represented windows ``raw`` (n, window):
-        all members over all windows together (:mod:`twin.transfer.inference`); each member's own
-        ``Assessor._forward`` gives the same numbers to float32 round-off."""
+        Records are resampled and represented one at a time (once for all members) while the
+        members' networks run on the windows already represented (:mod:`twin.transfer.inference`).
+        """
+        from twin.measurements import MeasurementSet, load_measurements
+        from twin.transfer.preprocess import Prepared, windows_of
+        first = self.members[0]
+        if isinstance(data, (str, Path)):          # read once; resampled record by record below
+            data = load_measurements(data, channels=[self.preprocessing.channel_of("target")])
+        if isinstance(data, MeasurementSet):
+            data = list(data.records)
+        if isinstance(data, (list, tuple)) and data and not isinstance(data[0], np.ndarray):
+            pieces = [list(data[i:i + 1]) for i in range(len(data))]
+        else:                                      # window arrays, archives: prepared (and judged) whole
+            pieces = [first._prepared(data, None, what, "target")]
+        stacked, normalise = self._networks()
+        prepared, recs, labs = [], [], []
+        with stacked.stream() as stream:
+            for piece in pieces:
+                p = piece if isinstance(piece[0], Prepared) else first._prepared(piece, None, what, "target")
+                raw, rec, lab = windows_of(p, self.preprocessing, what)
+                stream.add(normalise(raw))
+                recs.append(rec + len(prepared))
+                labs.append(lab)
+                prepared += p
+        return stream.result(), np.concatenate(recs), np.concatenate(labs), prepared
+
+    def _networks(self):
+        """(the members' folded networks, the windows' domain normalisation for them)."""
         from twin.transfer.inference import StackedNetworks
         key = tuple(id(m.network_) for m in self.members)
         if getattr(self, "_stacked_key", None) != key:          # folded once per set of members
@@ -390,8 +409,15 @@ class Ensemble:
         norms = [m.target_normaliser_ for m in self.members]
         first = norms[0]
         if all(np.array_equal(n.centre, first.centre) and n.scale == first.scale for n in norms[1:]):
-            return self._stacked.probabilities(first(raw))
-        return self._stacked.probabilities(np.stack([n(raw) for n in norms]))
+            return self._stacked, first
+        return self._stacked, lambda raw: np.stack([n(raw) for n in norms])
+
+    def _network_probabilities(self, raw: np.ndarray) -> np.ndarray:
+        """The members' network probabilities (members, n, K) of represented windows ``raw`` (n, window):
+        all members over all windows together; each member's own ``Assessor._forward`` gives the
+        same numbers to float32 round-off."""
+        stacked, normalise = self._networks()
+        return stacked.probabilities(normalise(raw))
 
     def _match(self, p: np.ndarray) -> np.ndarray:
         from twin.transfer.prior import apply_log_weights, ordinal_probabilities

@@ -40,7 +40,7 @@ import numpy as np
 
 from twin.transfer.errors import AssessorError
 
-__all__ = ["DEFAULT_CHUNK", "StackedNetworks", "default_threads"]
+__all__ = ["DEFAULT_CHUNK", "StackedNetworks", "Stream", "default_threads"]
 
 DEFAULT_CHUNK = 128
 # torch.set_num_threads is process-wide: concurrent calls must not restore each other's setting
@@ -143,37 +143,99 @@ class StackedNetworks:
             out.append(self._torch.softmax(F.linear(g, cw, cb), 1))
         return self._torch.stack(out).numpy()
 
+    def _run(self, x: np.ndarray) -> np.ndarray:
+        with self._torch.inference_mode():
+            return self._chunk(self._torch.from_numpy(x).unsqueeze(-2))
+
+    def _checked(self, x) -> np.ndarray:
+        m = len(self._members)
+        x = np.ascontiguousarray(x, dtype=np.float32)
+        if x.shape[-1:] != (self.window,) or x.ndim not in (2, 3) or (x.ndim == 3 and x.shape[0] != m):
+            raise AssessorError(f"StackedNetworks: windows must have shape (n, {self.window}) or ({m}, n, "
+                                f"{self.window}), got {x.shape}")
+        return x
+
+    def stream(self) -> "Stream":
+        """A context in which windows are given piece by piece (:meth:`Stream.add`) and evaluated
+        on the worker threads while the caller prepares the next piece; :meth:`Stream.result`
+        after the context gives what :meth:`probabilities` gives for all the pieces at once."""
+        return Stream(self)
+
     def probabilities(self, x: np.ndarray) -> np.ndarray:
         """Stage probabilities of every member, (members, n, K) float32.
 
         ``x``: the windows as every member sees them, (n, window), or each member's own, (members,
         n, window) (members whose domain normalisers differ).
         """
-        torch = self._torch
-        m = len(self._members)
-        x = np.ascontiguousarray(x, dtype=np.float32)
-        if x.shape[-1:] != (self.window,) or x.ndim not in (2, 3) or (x.ndim == 3 and x.shape[0] != m):
-            raise AssessorError(f"StackedNetworks: windows must have shape (n, {self.window}) or ({m}, n, "
-                                f"{self.window}), got {x.shape}")
-        n = x.shape[-2]
-        out = np.empty((m, n, self.n_classes), dtype=np.float32)
-        starts = range(0, n, self.chunk)
+        with self.stream() as s:
+            s.add(x)
+        return s.result()
 
-        def run(i: int) -> None:
-            with torch.inference_mode():
-                xi = torch.from_numpy(x[..., i:i + self.chunk, :])
-                out[:, i:i + self.chunk] = self._chunk(xi.unsqueeze(-2))
 
-        with _THREADS_LOCK:
-            before = torch.get_num_threads()
-            torch.set_num_threads(1)
-            try:
-                if self.threads == 1 or len(starts) == 1:
-                    for i in starts:
-                        run(i)
-                else:
-                    with ThreadPoolExecutor(max_workers=self.threads) as pool:
-                        list(pool.map(run, starts))
-            finally:
-                torch.set_num_threads(before)
-        return out
+class Stream:
+    """Windows in pieces, evaluated in chunks of ``chunk`` as they fill (:meth:`StackedNetworks.stream`).
+
+    The chunks are cut from the windows in the order given, whatever the pieces, so the numbers
+    do not depend on how the windows were split.  torch runs with one thread inside the context.
+    """
+
+    def __init__(self, nets: StackedNetworks):
+        self._nets = nets
+        self._pending, self._n_pending, self._parts = [], 0, []
+        self._pool, self._result = None, None
+
+    def __enter__(self) -> "Stream":
+        torch = self._nets._torch
+        _THREADS_LOCK.acquire()
+        self._before = torch.get_num_threads()
+        torch.set_num_threads(1)
+        if self._nets.threads > 1:
+            self._pool = ThreadPoolExecutor(max_workers=self._nets.threads)
+        return self
+
+    def add(self, x: np.ndarray) -> None:
+        """Windows (n, window) or (members, n, window), after those already given."""
+        x = self._nets._checked(x)
+        if x.shape[-2] == 0:
+            return
+        self._pending.append(x)
+        self._n_pending += x.shape[-2]
+        chunk = self._nets.chunk
+        while self._n_pending >= chunk:
+            self._submit(chunk)
+
+    def _submit(self, n: int) -> None:
+        """Cut the first ``n`` pending windows into one chunk and start it."""
+        taken, need = [], n
+        while need:
+            x = self._pending[0]
+            if x.shape[-2] <= need:
+                taken.append(self._pending.pop(0))
+                need -= x.shape[-2]
+            else:
+                taken.append(x[..., :need, :])
+                self._pending[0] = x[..., need:, :]
+                need = 0
+        self._n_pending -= n
+        x = taken[0] if len(taken) == 1 else np.concatenate(taken, axis=-2)
+        self._parts.append(self._pool.submit(self._nets._run, x) if self._pool else self._nets._run(x))
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        try:
+            if exc_type is None and self._n_pending:
+                self._submit(self._n_pending)
+            parts = [p.result() if self._pool else p for p in self._parts] if exc_type is None else []
+        finally:
+            if self._pool is not None:
+                self._pool.shutdown(wait=True, cancel_futures=exc_type is not None)
+            self._nets._torch.set_num_threads(self._before)
+            _THREADS_LOCK.release()
+        if exc_type is None:
+            m, k = len(self._nets), self._nets.n_classes
+            self._result = np.concatenate(parts, axis=1) if parts else np.zeros((m, 0, k), np.float32)
+
+    def result(self) -> np.ndarray:
+        """(members, n, K) probabilities of every window given, in order (after the context)."""
+        if self._result is None:
+            raise AssessorError("Stream.result: the stream has not finished (use it as a context)")
+        return self._result

@@ -1,0 +1,143 @@
+"""Benchmark: inference cost per window of an assessor ensemble, the per-member path against the batched one.
+
+    python bench/assess_speed.py [--ensemble DIR] [--records FILE] [--members 1,2,5] [--repeats 5]
+
+Defaults: the pedestal pitting ensemble trained by ``bench/pipeline_rigs.py`` (calibrated twin,
+``OUT/pedestal_pitting_calibrated/assessor``) and that rig's 48 test records (1 s at 50 kHz, 912
+windows at 20.48 kHz).  Member counts above the trained ones reuse the trained networks in turn: the
+cost of a forward pass does not depend on the weights.
+
+For each member count, side by side in one run, repeated ``repeats`` times in turn (the fastest of
+each is reported, the machine being shared):
+
+* **before** -- the computation as it ran until 2026-11-26: the file read, every record resampled with
+  its anti-aliasing filter designed again, windowed and represented, then each member's own
+  ``Assessor._forward`` (batches of 256 under ``torch.no_grad``, torch's default threads);
+* **after** -- ``Ensemble._raw`` now: the same read, the filter designed once per rate, the records
+  resampled and represented one by one while the members' networks, folded once per ensemble, run
+  together on the windows already represented (:mod:`twin.transfer.inference`);
+* **assess** -- the whole ``Ensemble.assess`` of the file (2 members and more) with each path:
+  reading, preprocessing, networks, class-prior rule, agreement, order check.
+
+Both paths' stages are compared window by window (they must be identical) and the largest
+difference of a probability printed.  Prints the machine, its load and a Markdown table.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO))
+OUT = REPO / "bench_out" / "pipeline_rigs"
+
+
+def machine() -> str:
+    cpu = next((ln.split(":", 1)[1].strip() for ln in open("/proc/cpuinfo") if ln.startswith("model name")), "?")
+    return f"{cpu}, {len(os.sched_getaffinity(0))} cores, Python {platform.python_version()}"
+
+
+def _reference_raw(self, data, what: str = "assess"):
+    """``Ensemble._raw`` as it was: all records prepared, then each member's own forward pass."""
+    from twin.measurements.resample import _filter
+    from twin.transfer.preprocess import windows_of
+    _filter.cache_clear()                       # the filter was designed for every record
+    first = self.members[0]
+    prepared = first._prepared(data, None, what, "target")
+    raw, rec, lab = windows_of(prepared, self.preprocessing, what)
+    return np.stack([m._forward(m.target_normaliser_(raw))[1] for m in self.members]), rec, lab, prepared
+
+
+def ensembles(loaded, members):
+    """(before, after) ensembles of these members with the loaded ensemble's rule and trends; for
+    one member, objects that only compute the members' probabilities (``_raw``, which needs only
+    the members)."""
+    from twin.transfer.ensemble import Ensemble
+
+    class Reference(Ensemble):
+        _raw = _reference_raw
+
+    out = []
+    for cls in (Reference, Ensemble):
+        if len(members) == 1:
+            e = object.__new__(cls)
+            e.members = members
+        else:
+            e = cls(members, loaded.facts)
+            e.anchors_, e.log_weights_, e.twin_trends_ = loaded.anchors_, loaded.log_weights_, loaded.twin_trends_
+            e.train_time_, e.notes_ = 0.0, ()
+        out.append(e)
+    return out
+
+
+def timed(f, *args):
+    t, c = time.perf_counter(), time.process_time()
+    out = f(*args)
+    return out, time.perf_counter() - t, time.process_time() - c
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--ensemble", default=str(OUT / "pedestal_pitting_calibrated" / "assessor"))
+    ap.add_argument("--records", default=str(OUT / "data" / "pedestal_pitting_test.h5"))
+    ap.add_argument("--members", default="1,2,5")
+    ap.add_argument("--repeats", type=int, default=5)
+    args = ap.parse_args()
+    import torch
+
+    from twin.transfer.ensemble import Ensemble
+
+    ens_dir, path = Path(args.ensemble), Path(args.records)
+    if not (ens_dir / "ensemble.json").is_file() or not path.is_file():
+        raise SystemExit(f"no trained ensemble in {ens_dir} or no records {path}: run bench/pipeline_rigs.py first")
+    loaded = Ensemble.load(ens_dir)
+    counts = [int(v) for v in args.members.split(",")]
+    print(f"Machine: {machine()}; torch {torch.__version__}, {torch.get_num_threads()} threads by default; "
+          f"load average at the start {os.getloadavg()[0]:.1f}", flush=True)
+    rows = []
+    for m in counts:
+        members = [loaded.members[i % len(loaded.members)] for i in range(m)]
+        ref, fast = ensembles(loaded, members)
+        pb = ref._raw(str(path))[0]                         # warm-up (and the numbers compared)
+        pa = fast._raw(str(path))[0]
+        n = pa.shape[1]
+        same = bool(np.array_equal(pb.argmax(2), pa.argmax(2)))
+        diff = float(np.abs(pb - pa).max())
+        if m >= 2:
+            rb, ra = (e.assess(path, time_ordered=False) for e in (ref, fast))
+            same = same and np.array_equal(rb.window_stages, ra.window_stages) and \
+                [r.stage for r in rb.records] == [r.stage for r in ra.records]
+        runs = [("before", ref._raw, (str(path),)), ("after", fast._raw, (str(path),))]
+        if m >= 2:
+            runs += [("assess_before", ref.assess, (path,)), ("assess_after", fast.assess, (path,))]
+        t = {k: [] for k, _, _ in runs}
+        cpu = {k: [] for k in t}
+        for _ in range(args.repeats):
+            for k, f, a in runs:
+                _, w, c = timed(f, *a)
+                t[k].append(w)
+                cpu[k].append(c)
+        best = {k: 1e3 * min(v) / n for k, v in t.items() if v}
+        best_cpu = {k: 1e3 * min(v) / n for k, v in cpu.items() if v}
+        rows.append((m, n, best, best_cpu, same, diff))
+        print(f"members {m}: {n} windows; before {best['before']:.2f}, after {best['after']:.2f} ms/window"
+              + (f"; assess before {best['assess_before']:.2f}, after {best['assess_after']:.2f}" if m >= 2 else "")
+              + f"; identical stages {same}, largest probability difference {diff:.1e}", flush=True)
+    print(f"\nload average at the end {os.getloadavg()[0]:.1f}\n")
+    print("| members | before [ms/window] | batched [ms/window] | ratio | CPU before -> batched [ms/window] | "
+          "whole assess before -> batched [ms/window] | identical stages |")
+    print("|---|---|---|---|---|---|---|")
+    for m, n, b, c, same, diff in rows:
+        whole = f"{b['assess_before']:.2f} -> {b['assess_after']:.2f}" if "assess_before" in b else ""
+        print(f"| {m} | {b['before']:.2f} | {b['after']:.2f} | {b['before'] / b['after']:.1f}x | "
+              f"{c['before']:.2f} -> {c['after']:.2f} | {whole} | {'yes' if same else 'NO'} ({diff:.0e}) |")
+
+
+if __name__ == "__main__":
+    main()
