@@ -377,6 +377,8 @@ class Ensemble:
         Records are resampled and represented one at a time (once for all members) while the
         members' networks run on the windows already represented (:mod:`twin.transfer.inference`).
         """
+        from concurrent.futures import ThreadPoolExecutor
+
         from twin.measurements import MeasurementSet, load_measurements
         from twin.transfer.preprocess import Prepared, windows_of
         first = self.members[0]
@@ -389,12 +391,18 @@ class Ensemble:
         else:                                      # window arrays, archives: prepared (and judged) whole
             pieces = [first._prepared(data, None, what, "target")]
         stacked, normalise = self._networks()
+
+        def represent(piece):
+            p = piece if isinstance(piece[0], Prepared) else first._prepared(piece, None, what, "target")
+            raw, rec, lab = windows_of(p, self.preprocessing, what)
+            return p, normalise(raw), rec, lab
+
         prepared, recs, labs = [], [], []
-        with stacked.stream() as stream:
-            for piece in pieces:
-                p = piece if isinstance(piece[0], Prepared) else first._prepared(piece, None, what, "target")
-                raw, rec, lab = windows_of(p, self.preprocessing, what)
-                stream.add(normalise(raw))
+        # numpy's FFTs and scipy's filters release the GIL: records are prepared on worker threads
+        # too, and handed to the networks in their order
+        with stacked.stream() as stream, ThreadPoolExecutor(max_workers=stacked.threads) as pool:
+            for p, x, rec, lab in pool.map(represent, pieces):
+                stream.add(x)
                 recs.append(rec + len(prepared))
                 labs.append(lab)
                 prepared += p
