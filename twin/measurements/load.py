@@ -71,7 +71,7 @@ class _Problems:
 def load_measurements(path: str | os.PathLike[str], *, min_duration: float | None = None,
                       channels: Iterable[str] | None = None, resample_to: float | None = None,
                       sidecar: str | os.PathLike[str] | None = None,
-                      check_clipping: bool = True) -> MeasurementSet:
+                      check_clipping: bool = True, tachometer: bool = True) -> MeasurementSet:
     """Load and validate every record of a measurement file.
 
     Parameters
@@ -83,7 +83,8 @@ def load_measurements(path: str | os.PathLike[str], *, min_duration: float | Non
         Shortest acceptable record [s]; shorter records are problems.
     channels : iterable of str, optional
         Channels to load; each must exist in every record. Others are not read (nor checked).
-        A record's tachometer channel is always kept, so order analysis stays possible.
+        A record's tachometer channel is kept too (unless ``tachometer=False``), so order
+        analysis stays possible.
     resample_to : float, optional
         Target sampling rate [Hz]. Records at another rate are resampled (see
         :mod:`twin.measurements.resample`); each carries its original rate in
@@ -95,6 +96,10 @@ def load_measurements(path: str | os.PathLike[str], *, min_duration: float | Non
         Report clipped channels (default). The test (runs of equal extreme samples) cannot tell
         saturation from a coarsely quantised or noise-free periodic signal; switch it off only
         for such data.
+    tachometer : bool
+        With ``channels``: False reads (and checks) only those channels, and the records carry
+        no tachometer, for work that does not use it (the wear assessors: a compressed
+        tachometer channel costs as much to read as the vibration channel).
 
     Returns
     -------
@@ -111,6 +116,8 @@ def load_measurements(path: str | os.PathLike[str], *, min_duration: float | Non
         For invalid arguments (e.g. a negative ``resample_to``).
     """
     wanted = _check_arguments(min_duration, channels, resample_to)
+    if not isinstance(tachometer, bool):
+        raise ParameterError(f"tachometer must be True or False, got {tachometer!r}")
     p = Path(path)
     file = str(p)
     if not p.exists():
@@ -122,7 +129,7 @@ def load_measurements(path: str | os.PathLike[str], *, min_duration: float | Non
     if h5py.is_hdf5(p):
         if sidecar is not None:
             raise ParameterError(f"a sidecar only applies to CSV files, not to the HDF5 file {file}")
-        raws, file_metadata = _read_hdf5(p, problems, wanted)
+        raws, file_metadata = _read_hdf5(p, problems, wanted, tachometer)
     elif p.suffix.lower() in CSV_SUFFIXES:
         raws, file_metadata = _read_csv(p, problems, sidecar), {}
     else:
@@ -130,7 +137,7 @@ def load_measurements(path: str | os.PathLike[str], *, min_duration: float | Non
                                            f"(suffix {', '.join(CSV_SUFFIXES)})")
     records = []
     for raw in raws:
-        rec = _validate(raw, problems, file, wanted, min_duration, check_clipping)
+        rec = _validate(raw, problems, file, wanted, min_duration, check_clipping, tachometer)
         if rec is not None:
             records.append(rec)
     problems.raise_if_any()
@@ -173,7 +180,8 @@ def _kept(channel: str, wanted: tuple[str, ...] | None, tachometer: Any) -> bool
 
 # --------------------------------------------------------------------------- HDF5
 
-def _read_hdf5(p: Path, problems: _Problems, wanted) -> tuple[list[_RawRecord], dict]:
+def _read_hdf5(p: Path, problems: _Problems, wanted, keep_tachometer: bool = True
+               ) -> tuple[list[_RawRecord], dict]:
     import h5py
     try:
         f = h5py.File(p, "r")
@@ -218,7 +226,7 @@ def _read_hdf5(p: Path, problems: _Problems, wanted) -> tuple[list[_RawRecord], 
                     problems.add(name, f"member '{cname}' is not a dataset (channels are 1-D datasets)")
                     continue
                 all_channels.append(cname)
-                if not _kept(cname, wanted, tach):
+                if not _kept(cname, wanted, tach if keep_tachometer else None):
                     continue
                 if ds.ndim != 1:
                     problems.add(name, f"channel '{cname}' must be a 1-D dataset, got shape {ds.shape}")
@@ -428,7 +436,7 @@ def _read_columns(p: Path, columns: list[str], problems: _Problems
 # --------------------------------------------------------------------------- validation
 
 def _validate(raw: _RawRecord, problems: _Problems, file: str, wanted, min_duration,
-              check_clipping: bool) -> Record | None:
+              check_clipping: bool, keep_tachometer: bool = True) -> Record | None:
     """Check one raw record; add its problems; return the Record if it has none."""
     name = raw.name
     if raw.attrs is not None:
@@ -441,6 +449,9 @@ def _validate(raw: _RawRecord, problems: _Problems, file: str, wanted, min_durat
     fs = attrs.get("sample_rate")
     t0 = attrs.get("time_start") or 0.0
     tach, kind = attrs.get("tachometer"), attrs.get("tachometer_kind")
+    pulses = attrs.get("pulses_per_rev")
+    if not keep_tachometer and wanted is not None and tach not in wanted:
+        tach, kind, pulses = None, None, None          # not read: the record has no tachometer
 
     if wanted is not None:
         missing = [c for c in wanted if c not in raw.all_channels]
@@ -499,7 +510,7 @@ def _validate(raw: _RawRecord, problems: _Problems, file: str, wanted, min_durat
     try:
         return Record(name=name, channels=converted, units=units, sample_rate=fs,
                       nominal_speed=attrs["nominal_speed"], load=attrs["load"], tachometer=tach,
-                      tachometer_kind=kind, pulses_per_rev=attrs["pulses_per_rev"], label=attrs["label"],
+                      tachometer_kind=kind, pulses_per_rev=pulses, label=attrs["label"],
                       damage=attrs["damage"], source=file, time_start=attrs["time_start"],
                       resampled_from=attrs["resampled_from"], metadata=meta)
     except MeasurementError as exc:

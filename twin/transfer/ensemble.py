@@ -383,7 +383,7 @@ class Ensemble:
         from twin.transfer.preprocess import Prepared, windows_of
         first = self.members[0]
         if isinstance(data, (str, Path)):          # read once; resampled record by record below
-            data = load_measurements(data, channels=[self.preprocessing.channel_of("target")])
+            data = load_measurements(data, channels=[self.preprocessing.channel_of("target")], tachometer=False)
         if isinstance(data, MeasurementSet):
             data = list(data.records)
         if isinstance(data, (list, tuple)) and data and not isinstance(data[0], np.ndarray):
@@ -494,7 +494,7 @@ class Ensemble:
         self._check()
         pre = self.preprocessing
         if isinstance(data, (str, Path)):
-            data = load_measurements(data, channels=[pre.channel_of("target")])
+            data = load_measurements(data, channels=[pre.channel_of("target")], tachometer=False)
         recs = list(data.records if isinstance(data, MeasurementSet) else data)
         if not recs:
             raise AssessorError("assess: no records")

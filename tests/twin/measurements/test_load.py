@@ -78,6 +78,16 @@ def test_channel_selection_keeps_tachometer(good_h5):
     assert mset[0].channel_names == ("accel", "tacho")
 
 
+def test_channel_selection_without_the_tachometer(good_h5):
+    mset = load_measurements(good_h5, channels=["accel"], tachometer=False)
+    assert mset[0].channel_names == ("accel",)
+    assert (mset[0].tachometer, mset[0].tachometer_kind, mset[0].pulses_per_rev) == (None, None, None)
+    assert np.array_equal(mset[0]["accel"], load_measurements(good_h5, channels=["accel"])[0]["accel"])
+    assert load_measurements(good_h5, channels=["accel", "tacho"], tachometer=False)[0].tachometer == "tacho"
+    with pytest.raises(ParameterError, match="tachometer must be True or False"):
+        load_measurements(good_h5, tachometer="no")
+
+
 def test_csv_with_yaml_sidecar_derives_rate(write_csv, tmp_path):
     x = _noisy(7)
     p = write_csv(tmp_path / "run.csv", {"accel": x, "force": 100 + x},
