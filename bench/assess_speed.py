@@ -10,12 +10,14 @@ cost of a forward pass does not depend on the weights.
 For each member count, side by side in one run, repeated ``repeats`` times in turn (the fastest of
 each is reported, the machine being shared):
 
-* **before** -- the computation as it ran until 2026-11-26: the file read, every record resampled with
-  its anti-aliasing filter designed again, windowed and represented, then each member's own
-  ``Assessor._forward`` (batches of 256 under ``torch.no_grad``, torch's default threads);
-* **after** -- ``Ensemble._raw`` now: the same read, the filter designed once per rate, the records
-  resampled and represented one by one while the members' networks, folded once per ensemble, run
-  together on the windows already represented (:mod:`twin.transfer.inference`);
+* **before** -- the computation as it ran until 2026-11-26: the file read (with each record's
+  tachometer), every record resampled with its anti-aliasing filter designed again, windowed and
+  represented, then each member's own ``Assessor._forward`` (batches of 256 under
+  ``torch.no_grad``, torch's default threads);
+* **after** -- ``Ensemble._raw`` now: the file read without the tachometer, the filter designed
+  once per rate, the records resampled and represented one by one on worker threads while the
+  members' networks, folded once per ensemble, run together on the windows already represented
+  (:mod:`twin.transfer.inference`);
 * **assess** -- the whole ``Ensemble.assess`` of the file (2 members and more) with each path:
   reading, preprocessing, networks, class-prior rule, agreement, order check.
 
@@ -62,6 +64,12 @@ def ensembles(loaded, members):
 
     class Reference(Ensemble):
         _raw = _reference_raw
+
+        def assess(self, data, **kw):
+            from twin.measurements import load_measurements
+            if isinstance(data, (str, Path)):        # read as before: the tachometer too
+                data = load_measurements(data, channels=[self.preprocessing.channel_of("target")])
+            return super().assess(data, **kw)
 
     out = []
     for cls in (Reference, Ensemble):

@@ -16,15 +16,17 @@ training), to float32 round-off (``tests/twin/transfer/test_inference.py``), wit
   exactly, and the ReLU touches half the samples;
 * **channels last**: the convolutions run as 2-D convolutions of height 1 on (n, channels, 1,
   samples) tensors stored channels innermost, the layout in which oneDNN's kernels for these narrow
-  layers are fastest (2.3 x over ``conv1d`` for the five layers, 1 thread), and the pool is the
-  elementwise maximum of the even and odd samples, whole contiguous rows of channels;
+  layers are fastest (2.3 x over ``conv1d`` for the five layers, 1 thread, trial of 2026-11-26),
+  and the pool is the elementwise maximum of the even and odd samples, whole contiguous rows of
+  channels;
 * **windows in chunks** of ``chunk`` (bounded memory: the first layer's output of a 128-window
   chunk is 4 MB), every member on the same chunk, under :func:`torch.inference_mode` (no autograd
   bookkeeping);
 * **chunks in parallel** on ``threads`` worker threads, each running torch with one intra-op
   thread.  On a 2-core machine that other work shares, torch's own two OpenMP threads wait for
-  each other at every layer and lose to a descheduled partner (measured 1.5-3 x slower under load,
-  BENCHMARKS.md); independent chunks do not wait.  torch's thread count is restored afterwards.
+  each other at every layer and lose to a descheduled partner (with two other jobs running, the
+  per-member path took 2.1 x as long with torch's 2 threads as with 1, trial of 2026-11-26);
+  independent chunks do not wait.  torch's thread count is restored afterwards.
 
 The result does not depend on ``threads``: every chunk goes through the same single-threaded
 kernels whichever worker takes it.
@@ -48,9 +50,9 @@ _THREADS_LOCK = threading.Lock()
 
 
 def default_threads() -> int:
-    """Worker threads for inference: the cores this process may use, at most 2 (the machines'
-    count; more workers than cores only queue)."""
-    return max(1, min(2, len(os.sched_getaffinity(0))))
+    """Worker threads for inference: the cores this process may use (more workers than cores
+    only queue)."""
+    return max(1, len(os.sched_getaffinity(0)))
 
 
 def _fold(weight, bias, bn):
