@@ -659,8 +659,14 @@ class Assessor:
         net.train(was_training)
         return np.concatenate(feats), np.concatenate(probs)
 
-    def _proba_windows(self, x: np.ndarray, domain: str = "target") -> np.ndarray:
-        p = self._forward(x)[1]
+    def _proba_windows(self, x: np.ndarray, domain: str = "target", batched: bool = False) -> np.ndarray:
+        """Stage probabilities of windows under the class-prior rule of ``domain``; ``batched``: by the
+        folded network of :mod:`twin.transfer.inference` (CPU; the same numbers to float32 round-off)."""
+        if batched and next(self.network_.parameters()).device.type == "cpu":
+            from twin.transfer.inference import StackedNetworks
+            p = StackedNetworks([self.network_]).probabilities(x)[0]
+        else:
+            p = self._forward(x)[1]
         anchors = getattr(self, "ordinal_anchors_", None)
         if domain == "target" and anchors is not None:
             from twin.transfer.prior import ordinal_probabilities
@@ -699,7 +705,7 @@ class Assessor:
         (mean over the record's windows) for records.  Data are taken as rig data (``domain``)."""
         self._check_fitted()
         x, rec, _, prepared, is_array = self._windows(data, "predict", domain)
-        p = self._proba_windows(x, domain)
+        p = self._proba_windows(x, domain, batched=True)
         if is_array:
             return p
         return np.stack([p[rec == i].mean(0) for i in range(len(prepared))])
@@ -718,7 +724,7 @@ class Assessor:
         """
         self._check_fitted()
         x, rec, lab, prepared, _ = self._windows(data, "assess", domain)
-        p = self._proba_windows(x, domain)
+        p = self._proba_windows(x, domain, batched=True)
         self._check_labels([q.label for q in prepared if q.label is not None], "assess")
         out = []
         for i, q in enumerate(prepared):

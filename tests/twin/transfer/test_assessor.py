@@ -518,3 +518,15 @@ def test_rematch_after_save_and_load_and_its_typed_errors(tiny_pre, tiny_data, f
     assert old.rematch(adapt, None).class_prior is None      # dropping the match needs no proportions
     with pytest.raises(AssessorError, match="retrain it with class_prior='ordinal'"):
         old.rematch(adapt, "ordinal")
+
+
+def test_assess_and_predict_take_the_batched_network_with_the_forward_pass_numbers(fitted, tiny_data):
+    _, _, test = tiny_data
+    x, rec, _, prepared, _ = fitted._windows(test, "assess")
+    reference = fitted._proba_windows(x)                     # the training code's forward pass
+    batched = fitted._proba_windows(x, batched=True)
+    np.testing.assert_allclose(batched, reference, rtol=0, atol=2e-6)
+    per_record = np.stack([batched[rec == i].mean(0) for i in range(len(prepared))])
+    assert np.array_equal(fitted.predict_proba(test), per_record)
+    res = fitted.assess(test)
+    assert [r.stage for r in res.records] == [int(reference[rec == i].mean(0).argmax()) for i in range(len(prepared))]
