@@ -8,9 +8,10 @@ Per rig: the gearbox ``Rig().scattered(seed, 0.12)`` that ``bench/calibration_ri
 the current tools make it). For each case, the rig writes a 2 s steady record at 20 Hz / 20 N.m
 of that gearbox with one effect hidden (the rig's own implementation and default size; ``none``:
 nothing hidden) and a 6 s run-up from 2 to 20 Hz, in the measurement format, the truth apart.
-Then, as a user would, ``twin.effects.diagnose`` on the steady record's pinion casing channel
-with the calibrated scenario's model and parameters (the run-up is written for the record, the
-current diagnosis reads one record).
+Then, as a user would, ``twin.effects.diagnose`` on both records' pinion casing channel with the
+calibrated scenario's model and parameters (``twin diagnose --record steady --record runup``):
+candidates are fitted on the steady record, must hold on the end of the run-up they were not
+fitted on, and must show their signature in the run-up.
 
 Scored: the verdict against the hidden effect (the catalogue effect the rig's effect corresponds
 to; ``none`` -> "nothing missing"; an effect outside the catalogue -> "unexplained"), and the
@@ -58,6 +59,7 @@ def one_case(rig_name: str, seed: int, effect: str, calibrated, out: Path, ex) -
 
     from twin.effects.catalogue import CATALOGUE
     from twin.effects.diagnose import diagnose
+    from twin.effects.records import read_records
     from twin.measurements import load_measurements
     from twin.operating import simulate_at
 
@@ -77,14 +79,16 @@ def one_case(rig_name: str, seed: int, effect: str, calibrated, out: Path, ex) -
     x = np.asarray(rec[CHANNEL], float)
     fmu, params = calibrated.fmu_path(), dict(calibrated.parameters)
     t0 = time.perf_counter()
-    d = diagnose(fmu, x, fs, float(rec.nominal_speed), float(rec.load), parameters=params, executor=ex,
-                 duration=2.0, record="steady")
+    d = diagnose(fmu, read_records(h5, CHANNEL, ["steady", "runup"]), parameters=params, executor=ex,
+                 duration=2.0)
     wall = time.perf_counter() - t0
     n = int(round(2.0 * fs))
     xm = x[-n:]
     base = simulate_at(fmu, params, d.operating, n, [CHANNEL])[:, 0]
     dist0 = spectral_distance_report(base, xm, fs)["distance_db"]
-    top = d.candidates[0]
+    # the effect named (or the first of a tie), else the best-fitting candidate
+    top = next((c for c in d.candidates if c.effect == (d.missing or (d.tied[0] if d.tied else None))),
+               d.candidates[0])
     dist1 = None
     if top.fitted and top.error is None:
         from fmu_build import build_fmu
@@ -103,8 +107,9 @@ def one_case(rig_name: str, seed: int, effect: str, calibrated, out: Path, ex) -
             dist1 = f"{type(exc).__name__}: {exc}"
     truth = json.loads(Path(str(h5) + ".truth.json").read_text())
     row = {"rig": rig_name, "seed": seed, "hidden": effect, "expected": EXPECTED[effect], "verdict": d.verdict,
-           "missing": d.missing, "correct": correct(EXPECTED[effect], d), "top": top.effect,
-           "top_score": top.score, "top_fitted": top.fitted, "unexplained": list(d.unexplained),
+           "missing": d.missing, "tied": list(d.tied), "correct": correct(EXPECTED[effect], d), "top": top.effect,
+           "top_score": top.score, "top_held_out": top.held_out, "top_signature": [top.signature_present, top.signature],
+           "message": d.message, "top_fitted": top.fitted, "unexplained": list(d.unexplained),
            "twin_lsd_before": d.lsd_db, "twin_lsd_after_top": top.lsd_after_db,
            "distance_before_db": dist0, "distance_after_top_db": dist1, "diagnose_s": wall, "rig_s": rig_s,
            "truth_effect": next((r.get("effect") for r in truth.get("records", [truth]) if isinstance(r, dict)
@@ -113,13 +118,18 @@ def one_case(rig_name: str, seed: int, effect: str, calibrated, out: Path, ex) -
 
 
 def table(rows: list[dict]) -> str:
-    lines = ["| rig | hidden in the rig | verdict | top candidate (score) | correct | independent distance: "
-             "calibrated twin -> with the top candidate [dB] | diagnose [s] |", "|---|---|---|---|---|---|---|"]
+    lines = ["| rig | hidden in the rig | verdict | top candidate (score; held-out run-up cut [dB]; signature) | correct "
+             "| independent distance: calibrated twin -> with the top candidate [dB] | diagnose [s] |",
+             "|---|---|---|---|---|---|---|"]
     for r in rows:
-        verdict = r["verdict"] + (f": {r['missing']}" if r["missing"] else "")
+        verdict = r["verdict"] + (f": {r['missing']}" if r["missing"] else "") + \
+            (f": {' = '.join(r['tied'])}" if r.get("tied") else "")
+        held = r.get("top_held_out") or []
+        cut = f"{min(b - a for _, b, a in held):+.2f}" if held else "not run"
+        sig = {True: "present", False: "absent", None: "no test"}[(r.get("top_signature") or [None])[0]]
         after = r["distance_after_top_db"]
         after = f"{after:.1f}" if isinstance(after, float) else "not simulated"
-        lines.append(f"| {r['rig']} | {r['hidden']} | {verdict} | {r['top']} ({r['top_score']:.2f}) | "
+        lines.append(f"| {r['rig']} | {r['hidden']} | {verdict} | {r['top']} ({r['top_score']:.2f}; {cut}; {sig}) | "
                      f"{'yes' if r['correct'] else 'no'} | {r['distance_before_db']:.1f} -> {after} | "
                      f"{r['diagnose_s']:.0f} |")
     return "\n".join(lines)

@@ -431,7 +431,7 @@ def _effect_ids(text: str | None) -> list[str] | None:
 def _cmd_diagnose(args: argparse.Namespace) -> int:
     scenario = _lib("twin.scenario").load_scenario(Path(args.scenario))
     diag = _lib("twin.effects.loop").diagnose_scenario(scenario, Path(args.measurements), record=args.record,
-                                                       json_path=args.json, executor=_executor(args.workers),
+                                                       all_records=args.all_records, json_path=args.json, executor=_executor(args.workers),
                                                        duration=args.duration, effects=_effect_ids(args.effects))
     print(diag.table())
     for c in diag.candidates[:1]:
@@ -462,7 +462,7 @@ def _cmd_improve(args: argparse.Namespace) -> int:
     scenario = _lib("twin.scenario").load_scenario(Path(args.scenario))
     loop = _lib("twin.effects.loop")
     history = loop.improve(scenario, Path(args.measurements), Path(args.out), record=args.record,
-                           max_steps=args.max_steps, executor=_executor(args.workers),
+                           all_records=args.all_records, diagnosis=args.from_diagnosis, max_steps=args.max_steps, executor=_executor(args.workers),
                            modelica_dir=args.modelica_dir, duration=args.duration,
                            effects=_effect_ids(args.effects))
     print(loop.history_table(history))
@@ -560,10 +560,16 @@ def _add_ssp_commands(sub) -> None:
     p.set_defaults(handler=_cmd_export_ssp)
 
 
-def _loop_arguments(p: argparse.ArgumentParser, *, out: bool) -> None:
+def _loop_arguments(p: argparse.ArgumentParser, *, out: bool, several: bool = False) -> None:
     p.add_argument("scenario", help="scenario file (its model and calibrated parameters)")
     p.add_argument("--measurements", required=True, help="measurement file (HDF5 or CSV + sidecar)")
-    p.add_argument("--record", help="record name (default: the first)")
+    if several:
+        p.add_argument("--record", action="append",
+                       help="record name, repeatable: --record steady --record runup (default: the first); the "
+                            "effects are fitted on the first steady record and must hold on the others")
+        p.add_argument("--all-records", action="store_true", help="every record of the file")
+    else:
+        p.add_argument("--record", help="record name (default: the first)")
     p.add_argument("--duration", type=float, default=2.0, help="seconds of the record compared (default: 2)")
     if out:
         p.add_argument("--out", required=True, help="output directory")
@@ -700,7 +706,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(handler=_cmd_compare)
 
     p = sub.add_parser("diagnose", help="rank the catalogue effects the model may be missing, by trying each")
-    _loop_arguments(p, out=False)
+    _loop_arguments(p, out=False, several=True)
     p.add_argument("--json", type=Path, help="write the diagnosis here")
     p.add_argument("--workers", type=_positive_int, help="local worker processes (default: one per core)")
     _effects_argument(p)
@@ -712,7 +718,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(handler=_cmd_add_effect)
 
     p = sub.add_parser("improve", help="diagnose -> add-effect -> recalibrate until nothing improves the fit")
-    _loop_arguments(p, out=True)
+    _loop_arguments(p, out=True, several=True)
+    p.add_argument("--from-diagnosis", type=Path, metavar="JSON",
+                   help="start from this twin diagnose --json of the same scenario and records instead of "
+                        "diagnosing again")
     p.add_argument("--max-steps", type=int, default=4)
     p.add_argument("--workers", type=_positive_int, help="local worker processes (default: one per core)")
     _effects_argument(p)

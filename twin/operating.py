@@ -112,6 +112,15 @@ def simulate_at(fmu_path, parameters: Mapping[str, float], op: Operating, n: int
     a bin. So the shaft speed of the result is read off its gear-mesh line and, if it is off by
     more than 1 mHz, the run is repeated with the drive corrected by that amount.
     """
+    return simulate_settled(fmu_path, parameters, op, n, channels)[1]
+
+
+def simulate_settled(fmu_path, parameters: Mapping[str, float], op: Operating, n: int,
+                     channels: str | Sequence[str]) -> tuple[Operating, np.ndarray]:
+    """:func:`simulate_at`, also returning the operating point with the drive command that gave
+    the measured shaft speed: runs of the same model started from it need no second run."""
+    from dataclasses import replace
+
     from twin.calibration.objectives import estimate_shaft_hz
     single = isinstance(channels, str)
     names = [channels] if single else list(channels)
@@ -128,4 +137,4 @@ def simulate_at(fmu_path, parameters: Mapping[str, float], op: Operating, n: int
         if abs(error) <= 1e-3:
             break
         drive += error
-    return block[:, 0] if single else block
+    return replace(op, drive_hz=drive), (block[:, 0] if single else block)

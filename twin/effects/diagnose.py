@@ -34,19 +34,22 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Mapping, Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
 from twin.compare import Comparison, Finding, compare_signals, spectral_levels
 from twin.effects.catalogue import CATALOGUE, Effect, FitParameter, effect as get_effect
-from twin.operating import Operating, simulate_at
+from twin.operating import Operating, simulate_at, simulate_settled
 
 MIN_CUT = 0.25      # relative LSD cut for a candidate to count as the missing effect
 MIN_DB = 0.15       # and absolute cut [dB] (the LSD floor of a complete model is about 0.3-0.4 dB)
 MIN_SHARE = 0.05    # findings below this share of the error are not reported as unexplained
 BASE_BANDS = 2      # separate bands of broadband level off by 6 dB or more ...
 BASE_SHARE = 0.5    # ... holding this share of the error: the base model, not an effect, is wrong
+HELD_OUT_DB = 0.05  # LSD cut [dB] a candidate must keep on every record it was not fitted on
+TIE_RATIO = 0.8     # two candidates explaining the same findings within this score ratio are a tie
+HELD_OUT_RUNUP_S = 2.0   # s of the end of a run-up simulated as a held-out record
 
 
 @dataclass(frozen=True)
@@ -69,6 +72,14 @@ class Candidate:
     findings_after: tuple[Finding, ...]
     n_evaluations: int
     error: str | None = None             # set when the trial failed
+    # records it was not fitted on: (record, LSD of the base model [dB], LSD with it [dB])
+    held_out: tuple[tuple[str, float, float], ...] = ()
+    signature_present: bool | None = None   # its physical signature in the data (None: not tested)
+    signature: str = ""                     # what was looked for and found
+
+    def held_out_cut(self) -> float | None:
+        """Smallest LSD cut [dB] over the held-out records (None without one)."""
+        return min((b - a for _, b, a in self.held_out), default=None)
 
 
 @dataclass(frozen=True)
@@ -83,9 +94,13 @@ class Diagnosis:
     message: str
     operating: Operating
     wall_time_s: float
+    held_out_records: tuple[str, ...] = ()   # records scored but not fitted on
+    runup: str | None = None                 # the run-up the signatures were read from
+    tied: tuple[str, ...] = ()               # verdict "tie": the effects that explain the same thing
 
     def to_dict(self) -> dict:
-        return {"record": self.record, "verdict": self.verdict, "missing": self.missing,
+        return {"record": self.record, "held_out_records": list(self.held_out_records), "runup": self.runup,
+                "verdict": self.verdict, "missing": self.missing, "tied": list(self.tied),
                 "message": self.message, "headline": {"log_spectral_distance_db": self.lsd_db},
                 "operating": asdict(self.operating),
                 "findings": [asdict(f) for f in self.findings],
@@ -93,41 +108,97 @@ class Diagnosis:
                                 "expected_log_spectral_distance_db": c.lsd_after_db,
                                 "fitted_parameters": c.fitted, "n_evaluations": c.n_evaluations,
                                 "error": c.error,
+                                "held_out": [{"record": r, "log_spectral_distance_db": {"before": b, "after": a}}
+                                             for r, b, a in c.held_out],
+                                "signature_present": c.signature_present, "signature": c.signature,
                                 "evidence": [asdict(e) for e in c.evidence]} for c in self.candidates],
                 "unexplained": list(self.unexplained), "wall_time_s": self.wall_time_s}
 
     def table(self) -> str:
         """Plain-text ranking for the terminal."""
-        rows = [f"baseline log-spectral distance {self.lsd_db:.2f} dB, {len(self.findings)} findings",
-                f"{'rank':>4}  {'effect':<24} {'score':>6}  {'LSD after':>9}  explains"]
+        rows = [f"baseline log-spectral distance {self.lsd_db:.2f} dB on {self.record}, {len(self.findings)} findings"
+                + (f"; held out: {', '.join(self.held_out_records)}" if self.held_out_records else ""),
+                f"{'rank':>4}  {'effect':<24} {'score':>6}  {'LSD after':>9}  {'held-out cut':>12}  signature  explains"]
         for i, c in enumerate(self.candidates):
             ex = "; ".join(e.kind for e in c.evidence) or ("failed: " + c.error if c.error else "-")
-            rows.append(f"{i + 1:>4}  {c.effect:<24} {c.score:>6.2f}  {c.lsd_after_db:>7.2f} dB  {ex}")
+            cut = c.held_out_cut()
+            held = f"{cut:+9.2f} dB" if cut is not None else f"{'-':>12}"
+            sig = {True: "present", False: "absent", None: "-"}[c.signature_present]
+            rows.append(f"{i + 1:>4}  {c.effect:<24} {c.score:>6.2f}  {c.lsd_after_db:>7.2f} dB  {held:>12}  "
+                        f"{sig:<9}  {ex}")
         rows.append(self.message)
         return "\n".join(rows)
 
 
-def judge(before: Comparison, candidates: Sequence[Candidate], *, min_cut: float = MIN_CUT,
-          min_db: float = MIN_DB) -> tuple[str, str | None, tuple[str, ...], str]:
-    """The verdict on a baseline comparison and its ranked candidates (best first):
-    ``(verdict, missing effect id or None, unexplained findings, message)``.
+def fits(before: Comparison, c: Candidate, min_cut: float = MIN_CUT, min_db: float = MIN_DB) -> bool:
+    """The candidate cuts the LSD of the record it was fitted on by ``min_cut`` and ``min_db``."""
+    return c.error is None and c.score >= min_cut and before.lsd_db - c.lsd_after_db >= min_db
 
-    ``missing_effect``: the top candidate cuts the LSD by ``min_cut`` and ``min_db``.  Otherwise,
-    ``base_not_calibrated`` when the discrepancy is mostly broadband level off in two or more
-    separate bands (resonance findings of +-``resonance_db``, by default 6 dB: modes or a transfer
-    path in the wrong place, which one added effect cannot mend and which would mask any effect);
-    ``unexplained`` for other large findings; else ``nothing_missing``.
+
+def judge(before: Comparison, candidates: Sequence[Candidate], *, min_cut: float = MIN_CUT,
+          min_db: float = MIN_DB, held_out_db: float = HELD_OUT_DB,
+          tie_ratio: float = TIE_RATIO) -> tuple[str, str | None, tuple[str, ...], str, tuple[str, ...]]:
+    """The verdict on a baseline comparison and its ranked candidates (best first):
+    ``(verdict, missing effect id or None, unexplained findings, message, tied effect ids)``.
+
+    A candidate **earns its place** when (a) it cuts the LSD of the record it was fitted on by
+    ``min_cut`` and ``min_db``; (b) on every record it was not fitted on (``Candidate.held_out``:
+    another steady record, the run-up) it still cuts the LSD by ``held_out_db``: the held-out
+    test is the penalty for its added freedom, since a free mode that absorbs what the base
+    model gets wrong on one record does not carry to another; and (c) its physical signature
+    is not absent from the data (``Candidate.signature_present``, :mod:`twin.effects.signatures`).
+    With one record (b) and (c) are not tested.
+
+    ``missing_effect``: the best candidate that earns its place. ``tie``: another that earned
+    its place explains the same findings (one's explained findings contain the other's) and
+    scores at least ``tie_ratio`` of it; both are named, neither is added (only among
+    candidates tested on held-out records: with one record the fit score is all there is).
+    Otherwise ``base_not_calibrated`` when the discrepancy is mostly broadband level off in two
+    or more separate bands (resonance findings of +-``resonance_db``, by default 6 dB: modes or
+    a transfer path in the wrong place, which one added effect cannot mend and which would mask
+    any effect); ``unexplained`` for other large findings; else ``nothing_missing``. Candidates
+    that fitted but did not earn their place are named in the message, with the reason.
     """
-    best = candidates[0] if candidates else None
     big = [fd for fd in before.findings if fd.share >= MIN_SHARE]
-    if best is not None and best.score >= min_cut and before.lsd_db - best.lsd_after_db >= min_db:
+    fitted = [c for c in candidates if fits(before, c, min_cut, min_db)]
+
+    def held_ok(c: Candidate) -> bool:
+        cut = c.held_out_cut()
+        return cut is None or cut >= held_out_db
+
+    earned = [c for c in fitted if held_ok(c) and c.signature_present is not False]
+    if earned:
+        best = earned[0]
         explained = {e.finding for e in best.evidence}
+        same = [c for c in earned[1:] if best.held_out and c.held_out and c.score >= tie_ratio * best.score
+                and ({e.finding for e in c.evidence} <= explained or explained <= {e.finding for e in c.evidence})]
         unexplained = tuple(fd.description for fd in big if fd.description not in explained)
+        if same:
+            tied = (best.effect, *(c.effect for c in same))
+            msg = (f"tie: {' and '.join(tied)} explain the same findings (scores "
+                   f"{', '.join(f'{c.score:.2f}' for c in (best, *same))}) and each holds on the held-out records; "
+                   "the records cannot tell them apart: add a record that separates them (another speed or load)")
+            return "tie", None, unexplained, msg, tied
         msg = (f"missing: {best.effect} ({best.title}); adding it is expected to cut the log-spectral distance "
                f"from {before.lsd_db:.2f} to {best.lsd_after_db:.2f} dB ({100 * best.score:.0f} %)")
+        if best.held_out:
+            msg += "; held out: " + ", ".join(f"{r} {b:.2f} -> {a:.2f} dB" for r, b, a in best.held_out)
+        if best.signature_present:
+            msg += f"; signature: {best.signature}"
         if unexplained:
             msg += "; unexplained: " + "; ".join(unexplained)
-        return "missing_effect", best.effect, unexplained, msg
+        return "missing_effect", best.effect, unexplained, msg, ()
+    refused = ""
+    if fitted:
+        why = []
+        for c in fitted:
+            r = []
+            if not held_ok(c):
+                r.append("held out " + ", ".join(f"{n} {b:.2f} -> {a:.2f} dB" for n, b, a in c.held_out))
+            if c.signature_present is False:
+                r.append(c.signature)
+            why.append(f"{c.effect} (cut {100 * c.score:.0f} % where fitted; {'; '.join(r)})")
+        refused = "; fitted but did not earn its place: " + "; ".join(why)
     bands = [fd for fd in big if fd.kind == "resonance"]
     share = sum(fd.share for fd in bands)
     if len(bands) >= BASE_BANDS and share >= BASE_SHARE:
@@ -136,13 +207,14 @@ def judge(before: Comparison, candidates: Sequence[Candidate], *, min_cut: float
         msg = (f"base model not calibrated well enough to diagnose: its level is off in {len(bands)} bands "
                f"({where}), {100 * share:.0f} % of the discrepancy, which no single effect mends; calibrate the "
                "modes near these frequencies first (twin modes RUNUP, then twin calibrate --modes-from RUNUP)")
-        return "base_not_calibrated", None, tuple(fd.description for fd in big), msg
+        return "base_not_calibrated", None, tuple(fd.description for fd in big), msg + refused, ()
     if big:
         unexplained = tuple(fd.description for fd in big)
         return "unexplained", None, unexplained, ("no catalogue effect explains the discrepancy; unexplained: "
-                                                  + "; ".join(unexplained))
+                                                  + "; ".join(unexplained) + refused), ()
     return "nothing_missing", None, (), (f"nothing missing: no localised finding, and no catalogue effect cuts the "
-                                         f"log-spectral distance ({before.lsd_db:.2f} dB) by {100 * min_cut:.0f} %")
+                                         f"log-spectral distance ({before.lsd_db:.2f} dB) by {100 * min_cut:.0f} %"
+                                         + refused), ()
 
 
 # ---------------------------------------------------------------------------------------------
@@ -467,22 +539,28 @@ def record_conditions(fmu_path, measured: np.ndarray, sample_rate: float, nomina
     return Conditions(measured, current, z1, z2, op)
 
 
-def diagnose(fmu_path, measured: np.ndarray, sample_rate: float, nominal_speed: float, load: float, *,
+def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed: float | None = None,
+             load: float | None = None, *,
              parameters: Mapping[str, float] | None = None, channel: str = "accel_pinion_casing",
              effects: Sequence[str] | None = None, executor=None, record: str = "record",
              candidates_fmu=None, duration: float = 2.0, max_evals: int = 30,
              min_cut: float = MIN_CUT, min_db: float = MIN_DB, solver_step: float | None = 1e-5,
              related_leaders: int = 2, anchors: Mapping[str, float] | None = None,
-             progress: bool = False) -> Diagnosis:
-    """Diagnose one record (see the module docstring).
+             held_out_runup: float = HELD_OUT_RUNUP_S, progress: bool = False) -> Diagnosis:
+    """Diagnose one record, or several records of the same gearbox (see the module docstring).
 
     Parameters
     ----------
     fmu_path : the current model's FMU (the base gearbox or a variant of it).
-    measured : (n,) measured acceleration [m/s2] at ``sample_rate`` [Hz]; the last ``duration`` s are used
-        (2 s give 2 Hz bins, which separate sidebands at the gear speed, 7 Hz at 20 Hz input, from
-        their mesh harmonic).
-    nominal_speed, load : drive setting [Hz] and brake torque [N.m] of the record.
+    measured : (n,) measured acceleration [m/s2] at ``sample_rate`` [Hz] (with ``nominal_speed``
+        [Hz] and ``load`` [N.m], the drive setting and brake torque), or a sequence of
+        :class:`twin.effects.records.Record` (:func:`~twin.effects.records.read_records`). The
+        candidates are fitted on the first steady record; every other steady record and the
+        last ``held_out_runup`` s of each run-up are held out (each candidate that fits is
+        simulated there, in parallel), and the first run-up is read for the effects'
+        signatures (:mod:`twin.effects.signatures`). The last ``duration`` s of a steady
+        record are used (2 s give 2 Hz bins, which separate sidebands at the gear speed, 7 Hz
+        at 20 Hz input, from their mesh harmonic).
     parameters : the current model's (calibrated) parameters.
     effects : candidate ids (default: every catalogue effect the current model lacks).
     candidates_fmu : the built candidate model of the current model's base (``Gearbox21Candidates``,
@@ -491,20 +569,37 @@ def diagnose(fmu_path, measured: np.ndarray, sample_rate: float, nominal_speed: 
         their related base parameters (:attr:`Effect.related`); 0 switches that off.
     anchors : calibrated values of base parameters (a scenario's ``diagnosis.calibrated``): the
         related parameters stay within +-``RELATED_SPAN`` of these (default: their current values).
+
+    Raises :class:`~twin.errors.ParameterError` for records that hold no steady record (a
+    run-up alone cannot be fitted) or a run-up without a shaft speed.
     """
+    from twin.effects.records import HeldOutSpec, as_records, guarded_held_out
+    from twin.effects.signatures import survey_records
+    from twin.errors import ParameterError
     from twin.executor import LocalExecutor
 
     t0 = time.perf_counter()
     parameters = dict(parameters or {})
-    cond = record_conditions(fmu_path, measured, sample_rate, nominal_speed, load, parameters, record=record,
-                             duration=duration, solver_step=solver_step)
+    recs = as_records(measured, sample_rate, nominal_speed, load, record)
+    steady = [r for r in recs if not r.runup]
+    runups = [r for r in recs if r.runup]
+    if not steady:
+        raise ParameterError(f"records {', '.join(r.name for r in recs)} are all run-ups; the candidates are "
+                             "fitted on a steady record: give one too")
+    fit_rec = steady[0]
+    conds = {r.name: record_conditions(fmu_path, r.signal, r.sample_rate, r.nominal_speed, r.load, parameters,
+                                       record=r.name, duration=duration, solver_step=solver_step) for r in steady}
+    cond = conds[fit_rec.name]
     measured, current, z1, z2, op = cond.measured, cond.current, cond.z1, cond.z2, cond.operating
+    sample_rate = fit_rec.sample_rate
     shaft = op.shaft_hz
     active = active_effects(current)
     ids = [e for e in (effects or CATALOGUE) if e not in active]
     for e in ids:
         get_effect(e)
-    base_model = simulate(fmu_path, parameters, op, measured.size, channel)
+    # the trials start from the drive command that gave the base model the measured speed: without
+    # it a model whose slip differs from the estimate runs every trial twice (simulate_at)
+    op, base_model = simulate_settled(fmu_path, parameters, op, measured.size, channel)
     before = compare_signals(base_model, measured, sample_rate, shaft, z1=z1, z2=z2)
 
     if candidates_fmu is None:
@@ -555,6 +650,48 @@ def diagnose(fmu_path, measured: np.ndarray, sample_rate: float, nominal_speed: 
             cands[cands.index(c)] = joint
     cands.sort(key=lambda c: -c.score)
 
-    verdict, missing, unexplained, msg = judge(before, cands, min_cut=min_cut, min_db=min_db)
-    return Diagnosis(record, before.lsd_db, before.findings, tuple(cands), verdict, missing, unexplained, msg, op,
-                     time.perf_counter() - t0)
+    held_names: tuple[str, ...] = ()
+    runup_name = None
+    if len(recs) > 1:
+        # held-out records: the other steady ones at their own operating points, the end of each
+        # run-up along its measured speed; the base model and every candidate that fits are run
+        # there, all in parallel (candidates x records)
+        slip = op.drive_hz - op.shaft_hz
+        held: list[tuple[str, dict]] = []
+        for r in steady[1:]:
+            c2 = conds[r.name]
+            held.append((r.name, dict(measured=c2.measured, sample_rate=r.sample_rate, load=r.load,
+                                      operating=c2.operating)))
+        for r in runups:
+            if r.shaft_hz is None:
+                raise ParameterError(f"run-up {r.name} has no tachometer, encoder or speed channel: its speed "
+                                     "profile is needed to simulate it")
+            m = int(round(min(held_out_runup, r.signal.size / r.sample_rate) * r.sample_rate))
+            held.append((r.name, dict(measured=r.signal[-m:], sample_rate=r.sample_rate, load=r.load,
+                                      shaft_hz=r.shaft_hz[-m:], slip_hz=slip * r.load / op.load if op.load else slip)))
+        fitting = [c for c in cands if fits(before, c, min_cut, min_db)]
+        tasks = [HeldOutSpec(name, str(candidates_fmu), dict(probe), channel, solver_step=solver_step, **kw)
+                 for name, kw in held]
+        tasks += [HeldOutSpec(name, str(candidates_fmu), {**probe, **c.fitted}, channel, solver_step=solver_step, **kw)
+                  for c in fitting for name, kw in held]
+        out = ex.map(guarded_held_out, tasks, progress=progress, desc="held-out records") if tasks else []
+        base_lsd = {name: out[i] for i, (name, _) in enumerate(held)}
+        bad = [f"{n}: {v}" for n, v in base_lsd.items() if isinstance(v, Exception)]
+        if bad:
+            raise ParameterError("the current model does not run on the held-out record " + bad[0])
+        for j, c in enumerate(fitting):
+            vals = out[len(held) * (j + 1): len(held) * (j + 2)]
+            ho = tuple((name, float(base_lsd[name]), float(v) if not isinstance(v, Exception) else math.inf)
+                       for (name, _), v in zip(held, vals))
+            cands[cands.index(c)] = replace(c, held_out=ho)
+        held_names = tuple(name for name, _ in held)
+        shafts = {r.name: conds[r.name].operating.shaft_hz for r in steady}
+        survey = survey_records(steady, runups[0] if runups else None, channel, z1, z2, shafts)
+        runup_name = survey.runup
+        from twin.effects.signatures import signature
+        cands = [replace(c, **dict(zip(("signature_present", "signature"), signature(c.effect, c.fitted, survey))))
+                 if c.error is None else c for c in cands]
+
+    verdict, missing, unexplained, msg, tied = judge(before, cands, min_cut=min_cut, min_db=min_db)
+    return Diagnosis(fit_rec.name, before.lsd_db, before.findings, tuple(cands), verdict, missing, unexplained, msg,
+                     op, time.perf_counter() - t0, held_names, runup_name, tied)

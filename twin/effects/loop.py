@@ -45,26 +45,63 @@ def _out_dir(out) -> Path:
     return out
 
 
-def diagnose_scenario(scenario, measurements, *, record: str | None = None, json_path=None, executor=None,
-                      duration: float = 2.0, progress: bool = True, candidates_fmu=None,
-                      effects: Sequence[str] | None = None) -> Diagnosis:
-    """``twin diagnose``: the scenario's model against one record; writes ``json_path`` if given.
+def _record_names(record) -> list[str] | None:
+    if record is None:
+        return None
+    return [record] if isinstance(record, str) else list(record)
 
+
+def diagnose_scenario(scenario, measurements, *, record: str | Sequence[str] | None = None, all_records: bool = False,
+                      json_path=None, executor=None, duration: float = 2.0, progress: bool = True,
+                      candidates_fmu=None, effects: Sequence[str] | None = None) -> Diagnosis:
+    """``twin diagnose``: the scenario's model against one or several records; writes ``json_path`` if given.
+
+    ``record``: a record name or several (``--record steady --record runup``); ``all_records``:
+    every record of the file; default: the first. With several, the candidates are fitted on the
+    first steady record and must hold on the others (:func:`twin.effects.diagnose.diagnose`).
     ``effects``: the candidate ids tried (default: every catalogue effect the model lacks).
     """
+    from twin.effects.records import read_records
     from twin.errors import OutputPathError
     if json_path is not None and not Path(json_path).parent.exists():
         raise OutputPathError(f"parent directory of {json_path} does not exist")
     channel = (scenario.outputs or ("accel_pinion_casing",))[0]
-    rec = read_record(measurements, channel, record)
-    diag = diagnose(scenario.fmu_path(), rec.signal, rec.sample_rate, rec.nominal_speed, rec.load,
-                    parameters=dict(scenario.parameters), channel=channel, executor=executor, record=rec.name,
-                    duration=duration, progress=progress, candidates_fmu=candidates_fmu, effects=effects,
-                    anchors=(scenario.raw or {}).get("diagnosis", {}).get("calibrated", {}))
+    recs = read_records(measurements, channel, _record_names(record), every=all_records)
+    diag = diagnose(scenario.fmu_path(), recs, parameters=dict(scenario.parameters), channel=channel,
+                    executor=executor, duration=duration, progress=progress, candidates_fmu=candidates_fmu,
+                    effects=effects, anchors=(scenario.raw or {}).get("diagnosis", {}).get("calibrated", {}))
     if json_path is not None:
-        _write_json(Path(json_path), {"scenario": scenario.name, "measurements": str(measurements),
-                                      **diag.to_dict()})
+        _write_json(Path(json_path), {"scenario": scenario.name, "fmu": str(scenario.fmu),
+                                      "measurements": str(Path(measurements).resolve()),
+                                      "records": [r.name for r in recs], "duration": duration,
+                                      "effects": list(effects) if effects else None, **diag.to_dict()})
     return diag
+
+
+def load_diagnosis(path, scenario, measurements, *, duration: float = 2.0) -> dict:
+    """A ``diagnosis.json`` written by :func:`diagnose_scenario`, checked to be of this scenario,
+    measurement file and record length: ``twin improve --from-diagnosis`` starts from it
+    instead of diagnosing again.
+
+    Raises :class:`~twin.errors.ParameterError` naming what differs (or a file that is not a
+    diagnosis).
+    """
+    from twin.errors import ParameterError
+    path = Path(path)
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, ValueError) as exc:
+        raise ParameterError(f"cannot read diagnosis {path}: {exc}") from None
+    need = ("scenario", "fmu", "measurements", "verdict", "missing", "candidates", "record", "headline")
+    if not isinstance(data, dict) or any(k not in data for k in need):
+        raise ParameterError(f"{path} is not a diagnosis written by twin diagnose (it lacks "
+                             f"{next((k for k in need if not isinstance(data, dict) or k not in data), '')!r})")
+    mine = {"scenario": scenario.name, "fmu": str(scenario.fmu), "measurements": str(Path(measurements).resolve()),
+            "duration": duration}
+    for k, v in mine.items():
+        if data.get(k, v) != v:
+            raise ParameterError(f"diagnosis {path} is of {k} {data.get(k)!r}, not {v!r}: diagnose again")
+    return data
 
 
 @dataclass(frozen=True)
@@ -225,29 +262,53 @@ class Step:
     verdict: str
 
 
-def improve(scenario, measurements, out_dir, *, record: str | None = None, max_steps: int = 4, executor=None,
-            modelica_dir=None, build_dir=None, duration: float = 2.0, progress: bool = True,
-            effects: Sequence[str] | None = None) -> tuple[Step, ...]:
+def improve(scenario, measurements, out_dir, *, record: str | Sequence[str] | None = None, all_records: bool = False,
+            max_steps: int = 4, executor=None, modelica_dir=None, build_dir=None, duration: float = 2.0,
+            progress: bool = True, effects: Sequence[str] | None = None, diagnosis=None) -> tuple[Step, ...]:
     """``twin improve``: diagnose -> add -> recalibrate until no candidate improves the fit.
 
     ``effects``: the candidate ids tried at each step (default: the whole catalogue).
+    ``diagnosis``: a diagnosis of this scenario already made (a ``diagnosis.json`` path, see
+    :func:`load_diagnosis`, or a :class:`Diagnosis`): the first step takes its verdict and
+    fitted values instead of diagnosing again.
     """
     from twin.scenario import load_scenario
     for e in effects or ():
         get_effect(e)                   # an unknown id is refused before anything is written
+    first = None
+    if isinstance(diagnosis, Diagnosis):
+        first = {"verdict": diagnosis.verdict, "missing": diagnosis.missing, "record": diagnosis.record,
+                 "lsd": diagnosis.lsd_db, "fitted": diagnosis.candidates[0].fitted if diagnosis.candidates else {}}
+    elif diagnosis is not None:
+        data = load_diagnosis(diagnosis, scenario, measurements, duration=duration)
+        names = _record_names(record)
+        if names is not None and names != data.get("records", names):
+            from twin.errors import ParameterError
+            raise ParameterError(f"diagnosis {diagnosis} is of records {data.get('records')}, not {names}: "
+                                 "diagnose again")
+        top = next((c for c in data["candidates"] if c["effect"] == data["missing"]), None)
+        first = {"verdict": data["verdict"], "missing": data["missing"], "record": data["record"],
+                 "lsd": data["headline"]["log_spectral_distance_db"],
+                 "fitted": top["fitted_parameters"] if top else {}}
     out = _out_dir(out_dir)
     history: list[Step] = []
     for k in range(1, max_steps + 1):
-        diag = diagnose_scenario(scenario, measurements, record=record, executor=executor, duration=duration,
-                                 progress=progress, json_path=out / f"diagnosis_{k}.json", effects=effects)
-        if diag.verdict != "missing_effect":
-            history.append(Step(k, None, diag.lsd_db, diag.lsd_db, scenario.fmu, diag.verdict))
+        if k == 1 and first is not None:
+            verdict, missing, fit_record, lsd, fitted = (first["verdict"], first["missing"], first["record"],
+                                                         first["lsd"], first["fitted"])
+        else:
+            diag = diagnose_scenario(scenario, measurements, record=record, all_records=all_records,
+                                     executor=executor, duration=duration, progress=progress,
+                                     json_path=out / f"diagnosis_{k}.json", effects=effects)
+            verdict, missing, fit_record, lsd = diag.verdict, diag.missing, diag.record, diag.lsd_db
+            fitted = diag.candidates[0].fitted if diag.candidates else {}
+        if verdict != "missing_effect":
+            history.append(Step(k, None, lsd, lsd, scenario.fmu, verdict))
             break
         # the diagnosis fitted the effect already: add it with those values, without a refit
-        add = add_effect(scenario, measurements, diag.missing, out, record=record,
-                         start=diag.candidates[0].fitted, refit=False, modelica_dir=modelica_dir,
-                         build_dir=build_dir, duration=duration)
-        history.append(Step(k, add.effect, add.lsd_before_db, add.lsd_after_db, add.model, diag.verdict))
+        add = add_effect(scenario, measurements, missing, out, record=fit_record, start=fitted, refit=False,
+                         modelica_dir=modelica_dir, build_dir=build_dir, duration=duration)
+        history.append(Step(k, add.effect, add.lsd_before_db, add.lsd_after_db, add.model, verdict))
         if add.lsd_after_db >= add.lsd_before_db:
             break
         scenario = load_scenario(add.scenario_file)

@@ -41,7 +41,7 @@ def test_judge_tells_a_missing_effect_a_base_model_off_and_the_rest_apart():
     strong = Candidate("housing_mode", "housing mode", 0.6, 4.0, {}, (), (), 30)
     modes_off = _comparison(("resonance", 636, 12.0, 0.3), ("resonance", 1728, -9.0, 0.25),
                             ("mesh_harmonic", 385, 7.0, 0.1))
-    verdict, missing, unexplained, msg = judge(modes_off, [weak])
+    verdict, missing, unexplained, msg, _ = judge(modes_off, [weak])
     assert (verdict, missing, len(unexplained)) == ("base_not_calibrated", None, 3)
     assert "636 Hz (+12 dB), 1728 Hz (-9 dB)" in msg and "--modes-from" in msg
     assert judge(modes_off, [strong])[:2] == ("missing_effect", "housing_mode")

@@ -1,0 +1,130 @@
+"""Several records of one gearbox: reading them, the run-up's signatures, the held-out run, the verdict."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from twin.effects.diagnose import Candidate, Evidence, judge
+from twin.errors import MeasurementError, ParameterError
+
+FS = 10_000.0
+Z1, Z2 = 19, 71
+
+
+def _speed_record(name, speed, x, **kw):
+    from twin.measurements import Record
+    return Record(name, {"accel_pinion_casing": x, "tacho": speed}, {"accel_pinion_casing": "m/s2", "tacho": "Hz"},
+                  FS, nominal_speed=20.0, load=20.0, **kw)
+
+
+def _gearbox_signal(speed, *, line_hz=None, runout=0.0, seed=0):
+    """Mesh harmonics (orders 19, 38, 57) with first pinion sidebands of relative size ``runout``,
+    an optional line fixed at ``line_hz``, and white noise; ``speed`` (n,) [Hz]."""
+    rng = np.random.default_rng(seed)
+    angle = 2 * np.pi * np.cumsum(speed) / FS
+    x = 0.2 * rng.standard_normal(speed.size)
+    for k in (1, 2, 3):
+        x += np.sin(k * Z1 * angle)
+        for s in (-1, 1):
+            x += runout * np.sin((k * Z1 + s) * angle)
+    if line_hz:
+        x += 0.5 * np.sin(2 * np.pi * line_hz * np.arange(speed.size) / FS)
+    return x
+
+
+def _write(path, *, runout=0.0, line_hz=None):
+    from twin.measurements import write_measurements
+    steady_speed = np.full(int(2 * FS), 20.0)
+    ramp = np.linspace(8.0, 20.0, int(6 * FS))
+    write_measurements([_speed_record("steady", steady_speed, _gearbox_signal(steady_speed, runout=runout,
+                                                                              line_hz=line_hz)),
+                        _speed_record("runup", ramp, _gearbox_signal(ramp, runout=runout, line_hz=line_hz, seed=1))],
+                       path)
+    return path
+
+
+def test_records_are_read_by_name_and_a_runup_told_from_a_steady_record(tmp_path):
+    from twin.effects.records import read_records
+    path = _write(tmp_path / "m.h5")
+    steady, runup = read_records(path, every=True)
+    assert (steady.name, steady.runup, runup.name, runup.runup) == ("steady", False, "runup", True)
+    assert np.median(runup.shaft_hz[:1000]) == pytest.approx(8.0, abs=0.1)
+    assert [r.name for r in read_records(path, names=["runup", "steady"])] == ["runup", "steady"]
+    assert [r.name for r in read_records(path)] == ["steady"]
+    with pytest.raises(MeasurementError, match="run9.*steady, runup"):
+        read_records(path, names=["steady", "run9"])
+    with pytest.raises(MeasurementError, match="given twice"):
+        read_records(path, names=["steady", "steady"])
+
+
+def test_a_runup_alone_is_refused_before_anything_runs(tmp_path, gearbox_fmu):
+    from twin.effects.diagnose import diagnose
+    from twin.effects.records import read_records
+    runup = read_records(_write(tmp_path / "m.h5"), names=["runup"])
+    with pytest.raises(ParameterError, match="all run-ups"):
+        diagnose(gearbox_fmu, runup)
+
+
+def test_signatures_tell_shaft_sidebands_and_a_fixed_line_apart(tmp_path):
+    """A run-out puts first pinion sidebands on every mesh harmonic, locked to the shaft through the
+    run-up; a drive line stays at its frequency. Each test finds its own signature and not the other."""
+    from twin.effects.records import read_records
+    from twin.effects.signatures import signature, survey_records
+    fitted = {"motor_torque_ripple.frequency": 113.0, "housing_mode.frequency": 2000.0}
+    for runout, line in ((0.3, None), (0.0, 113.0)):
+        steady, runup = read_records(_write(tmp_path / f"m{runout}.h5", runout=runout, line_hz=line), every=True)
+        survey = survey_records([steady], runup, "accel_pinion_casing", Z1, Z2, {"steady": 20.0})
+        assert signature("pinion_eccentricity", fitted, survey)[0] is (runout > 0)
+        assert signature("gear_eccentricity", fitted, survey)[0] is False
+        assert signature("motor_torque_ripple", fitted, survey)[0] is (line is not None)
+        assert signature("housing_mode", fitted, survey)[0] is False
+        assert signature("backlash", fitted, survey)[0] is None               # no test: held-out record only
+    assert signature("pinion_eccentricity", fitted, None)[0] is None          # one record: not tested
+
+
+def _cand(effect, score, held=(), sig=None, explains=("a",)):
+    ev = tuple(Evidence(f, "resonance", "", 1.0, 0.1) for f in explains)
+    return Candidate(effect, effect, score, 10.0 * (1 - score), {}, ev, (), 10, None, tuple(held), sig, "why")
+
+
+def test_an_effect_must_hold_on_the_held_out_record_show_its_signature_and_not_tie():
+    from twin.compare import Comparison, Finding
+    before = Comparison(10.0, 0.5, 0.5, 1.0, 1.0, 20.0, (Finding("resonance", "a", 900, (850, 950), 9.0, 0.9),),
+                        np.zeros(1), np.zeros(1), np.zeros(1))
+    good = _cand("housing_mode", 0.5, [("runup", 8.0, 7.0)], True)
+    assert judge(before, [good])[:2] == ("missing_effect", "housing_mode")
+    # it cut the fit but not the run-up it was not fitted on: a flexible candidate absorbing base error
+    overfit = _cand("housing_mode", 0.5, [("runup", 8.0, 8.02)], True)
+    verdict, missing, _, msg, _ = judge(before, [overfit])
+    assert (verdict, missing) == ("unexplained", None) and "did not earn its place" in msg and "runup" in msg
+    # the held-out record agrees but the run-up shows no such band
+    assert judge(before, [_cand("housing_mode", 0.5, [("runup", 8.0, 7.0)], False)])[0] == "unexplained"
+    # the runner-up earned its place too: the next best that did is named, not the first
+    assert judge(before, [overfit, _cand("backlash", 0.4, [("runup", 8.0, 7.5)], None)])[1] == "backlash"
+    # two that explain the same findings with close scores are a tie, neither added
+    verdict, missing, _, msg, tied = judge(before, [good, _cand("pinion_eccentricity", 0.45, [("runup", 8.0, 7.2)],
+                                                                True)])
+    assert (verdict, missing, tied) == ("tie", None, ("housing_mode", "pinion_eccentricity"))
+    # a clearly weaker one, or one explaining something else, is no tie
+    assert judge(before, [good, _cand("backlash", 0.3, [("runup", 8.0, 7.5)])])[0] == "missing_effect"
+    assert judge(before, [good, _cand("backlash", 0.45, [("runup", 8.0, 7.5)], explains=("b",))])[0] == \
+        "missing_effect"
+
+
+def test_the_model_follows_a_measured_speed_profile(gearbox_fmu):
+    """The held-out run-up: the drive follows the record's speed, so the mesh line sweeps with it."""
+    from twin.effects.records import simulate_runup
+    fs = 20_000.0
+    speed = np.linspace(17.0, 20.0, int(0.4 * fs))
+    y = simulate_runup(gearbox_fmu, {}, speed, 20.0, fs, "accel_pinion_casing")
+    assert y.shape == speed.shape and np.all(np.isfinite(y))
+    n = y.size // 4
+    peaks = []
+    for part, sp in ((y[:n], speed[:n]), (y[-n:], speed[-n:])):
+        f = np.fft.rfftfreq(8 * n, 1 / fs)
+        a = np.abs(np.fft.rfft(part * np.hanning(n), 8 * n))
+        band = (f > 250) & (f < 450)
+        peaks.append((f[band][np.argmax(a[band])], Z1 * sp.mean()))
+    for got, expected in peaks:
+        assert got == pytest.approx(expected, rel=0.03)
+    assert peaks[1][0] > peaks[0][0] + 30

@@ -1,0 +1,141 @@
+"""Is an effect's physical signature in the data? Read from the records alone, never from a model.
+
+Each catalogue effect leaves a signature that a run-up separates from others:
+
+* a **run-out** (``pinion_eccentricity``, ``gear_eccentricity``) modulates the mesh once per
+  revolution of its shaft: first sidebands at that shaft's speed beside the mesh harmonics, in
+  every steady record, and in the run-up as orders ``k z1 +- 1`` (pinion) or ``k z1 +- z1/z2``
+  (gear, in pinion orders) that follow the speed. A ``local_tooth_damage`` of the pinion gives
+  the same first pinion sidebands (and more), so it shares the pinion test;
+* a **resonance** (``housing_mode``) is a band fixed in frequency across the run-up, excited by
+  broadband content: a mode of the run-up analysis near the fitted frequency;
+* a **drive ripple** (``motor_torque_ripple``) is a narrow line fixed in frequency across the
+  run-up, not a hump: a fixed line of the run-up analysis at the fitted frequency.
+
+The other effects (``load_torque_fluctuation``, ``backlash``, ``tooth_friction``,
+``distributed_wear``) have no test here: they earn their place on the held-out record alone.
+The run-up is read by :func:`twin.modes.survey_record` (orders, fixed lines and modes told apart
+by :func:`twin.signals.runup.analyse_runup`); nothing is re-implemented here.
+"""
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+#: A steady line is present when it stands this much above the median of the fine spectrum
+#: around it [dB]: a Rayleigh-distributed noise bin exceeds its median by 10 dB with
+#: probability exp(-10 ln 2) ~ 1e-3.
+LINE_DB = 10.0
+#: Mesh harmonics at which a first sideband must be present (steady) or locked (run-up): one
+#: could be a coincidence, a run-out modulates them all.
+MIN_HARMONICS = 2
+#: Order tolerance [cycles/rev] of a run-up order to its expected value.
+ORDER_TOL = 0.05
+#: Relative tolerance of a fitted frequency to a fixed line or mode of the run-up (at least
+#: two bins of the analysis).
+FREQ_TOL = 0.02
+
+
+@dataclass(frozen=True)
+class Survey:
+    """What the records show about shafts, lines and resonances (model-free).
+
+    ``runup``: name of the run-up analysed (None without one); ``lines`` fixed lines [Hz],
+    ``modes`` (frequency [Hz], damping ratio) with confidence >= ``twin.modes.MIN_CONFIDENCE``,
+    ``orders`` [pinion orders] locked to the shaft; ``resolution`` [Hz] of the run-up analysis;
+    ``steady_sidebands``: per steady record, ``{"pinion": n, "gear": n}`` mesh harmonics with a
+    first sideband at that shaft's speed.
+    """
+
+    runup: str | None
+    lines: tuple[float, ...] = ()
+    modes: tuple[tuple[float, float], ...] = ()
+    orders: tuple[float, ...] = ()
+    resolution: float = 0.0
+    steady_sidebands: Mapping[str, Mapping[str, int]] = field(default_factory=dict)
+    z1: int = 19
+    z2: int = 71
+
+
+def steady_sidebands(x: np.ndarray, fs: float, shaft_hz: float, z1: int, z2: int, n_harmonics: int = 10
+                     ) -> dict[str, int]:
+    """Mesh harmonics (of the first ``n_harmonics`` below 0.4 fs) with a first sideband at the
+    pinion / gear speed standing ``LINE_DB`` above the median spectrum within +-3 shaft speeds."""
+    from twin.effects.diagnose import _fine_spectrum
+    f, amp = _fine_spectrum(np.asarray(x, float), fs)
+    df = f[1] - f[0]
+    gmf = z1 * shaft_hz
+    out = {}
+    for shaft, spacing in (("pinion", shaft_hz), ("gear", shaft_hz * z1 / z2)):
+        count = 0
+        tol = max(2 * df, 0.3 * fs / x.size)
+        for k in range(1, n_harmonics + 1):
+            fk = k * gmf
+            if fk + 3 * shaft_hz > 0.4 * fs:
+                break
+            around = (f >= fk - 3 * shaft_hz) & (f <= fk + 3 * shaft_hz)
+            floor = float(np.median(amp[around]))
+            side = [float(np.max(amp[(f >= fs_ - tol) & (f <= fs_ + tol)])) for fs_ in (fk - spacing, fk + spacing)]
+            if floor > 0 and max(side) >= floor * 10 ** (LINE_DB / 20):
+                count += 1
+        out[shaft] = count
+    return out
+
+
+def survey_records(fit: Sequence, runup, channel: str, z1: int, z2: int, shaft_hz: Mapping[str, float]) -> Survey:
+    """The :class:`Survey` of the steady records ``fit`` (their measured pinion speeds in
+    ``shaft_hz`` by name) and of a run-up record (or None)."""
+    from twin.modes import MIN_CONFIDENCE, survey_record
+    steady = {r.name: steady_sidebands(r.signal, r.sample_rate, shaft_hz[r.name], z1, z2) for r in fit}
+    if runup is None or runup.raw is None:
+        return Survey(None, steady_sidebands=steady, z1=z1, z2=z2)
+    s = survey_record(runup.raw, channels=[channel])
+    modes = tuple((m.frequency, m.damping) for m in s.modes if m.confidence >= MIN_CONFIDENCE)
+    return Survey(runup.name, tuple(ln.frequency for ln in s.lines), modes, tuple(o.order for o in s.orders),
+                  float(s.resolution), steady, z1, z2)
+
+
+def _locked_sidebands(orders: Sequence[float], z1: int, spacing: float, max_order: float) -> int:
+    """Mesh harmonics k z1 with an order at k z1 +- spacing (within ORDER_TOL)."""
+    o = np.asarray(orders, float)
+    count = 0
+    for k in range(1, int(max_order // z1) + 2):
+        if o.size and any(np.min(np.abs(o - (k * z1 + s * spacing))) <= ORDER_TOL for s in (-1, 1)):
+            count += 1
+    return count
+
+
+def signature(effect_id: str, fitted: Mapping[str, float], survey: Survey | None) -> tuple[bool | None, str]:
+    """(present?, what was looked for and found). None: this effect has no signature test, or
+    the records cannot show it (a run-up is needed and there is none)."""
+    if survey is None:
+        return None, "no signature test with one record"
+    z1, z2 = survey.z1, survey.z2
+    if effect_id in ("pinion_eccentricity", "gear_eccentricity", "local_tooth_damage"):
+        shaft = "gear" if effect_id == "gear_eccentricity" else "pinion"
+        spacing = z1 / z2 if shaft == "gear" else 1.0
+        steady = {k: v.get(shaft, 0) for k, v in survey.steady_sidebands.items()}
+        ok_steady = bool(steady) and all(v >= MIN_HARMONICS for v in steady.values())
+        text = "first " + shaft + " sidebands at " + ", ".join(f"{v} mesh harmonics of {k}" for k, v in steady.items())
+        if survey.runup is None:
+            return ok_steady, text
+        locked = _locked_sidebands(survey.orders, z1, spacing, max(survey.orders, default=0.0))
+        text += f"; {locked} locked to the {shaft} in run-up {survey.runup}"
+        return ok_steady and locked >= MIN_HARMONICS, text
+    if survey.runup is None:
+        return None, "no run-up to tell fixed from shaft-locked content"
+    if effect_id == "motor_torque_ripple":
+        fr = float(fitted.get("motor_torque_ripple.frequency", np.nan))
+        tol = max(FREQ_TOL * fr, 2 * survey.resolution)
+        near = [ln for ln in survey.lines if abs(ln - fr) <= tol]
+        return bool(near), (f"fixed line at {near[0]:.1f} Hz in run-up {survey.runup}" if near else
+                            f"no fixed line within {tol:.1f} Hz of {fr:.1f} Hz in run-up {survey.runup}")
+    if effect_id == "housing_mode":
+        fr = float(fitted.get("housing_mode.frequency", np.nan))
+        tol = max(FREQ_TOL * fr, 2 * survey.resolution)
+        near = [m for m in survey.modes if abs(m[0] - fr) <= tol]
+        return bool(near), (f"broadband-excited band fixed at {near[0][0]:.0f} Hz in run-up {survey.runup}" if near
+                            else f"no resonance within {tol:.0f} Hz of {fr:.0f} Hz in run-up {survey.runup}")
+    return None, "no signature test for this effect"
