@@ -26,8 +26,17 @@ For one measured record:
    more bands (modes in the wrong place), the verdict is that the base model is not calibrated
    well enough to diagnose, naming the bands to calibrate (:func:`judge`).
 
+5. **Several records** (:mod:`twin.effects.records`). The candidates are fitted on the first
+   steady record. Each one that passes 4. is run on every other record, which it was not fitted
+   on (another steady record at its own operating point; the end of a run-up along its measured
+   speed), and must still cut the LSD there (``HELD_OUT_DB``): this held-out test is the
+   penalty for a candidate's added freedom. Its physical signature must not be absent from the
+   data (:mod:`twin.effects.signatures`: shaft-order sidebands for a run-out, a band fixed in
+   frequency across the run-up for a resonance, a fixed narrow line for a drive ripple). Two
+   that earn their place and explain the same findings are a tie.
+
 Candidates are fitted in parallel on an :class:`twin.executor.Executor` (local processes or
-Dask). All evaluations use one FMU, so there is one build (seconds, cached) per catalogue.
+Dask), and the held-out runs too (candidates x records). All evaluations use one FMU, so there is one build (seconds, cached) per catalogue.
 """
 from __future__ import annotations
 
@@ -38,9 +47,12 @@ from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
-from twin.compare import Comparison, Finding, compare_signals, spectral_levels
-from twin.effects.catalogue import CATALOGUE, Effect, FitParameter, effect as get_effect
-from twin.operating import Operating, simulate_at, simulate_settled
+from twin.compare import Comparison, Finding, compare_signals
+from twin.effects.catalogue import CATALOGUE, Effect, effect as get_effect
+# the fit runs in the workers; its names stay importable from here
+from twin.effects.fit import (TrialSpec, _fine_spectrum, _guarded_fit, _Objective, fit_effect,  # noqa: F401
+                              simulate, starting_values)
+from twin.operating import Operating, simulate_settled
 
 MIN_CUT = 0.25      # relative LSD cut for a candidate to count as the missing effect
 MIN_DB = 0.15       # and absolute cut [dB] (the LSD floor of a complete model is about 0.3-0.4 dB)
@@ -215,230 +227,6 @@ def judge(before: Comparison, candidates: Sequence[Candidate], *, min_cut: float
     return "nothing_missing", None, (), (f"nothing missing: no localised finding, and no catalogue effect cuts the "
                                          f"log-spectral distance ({before.lsd_db:.2f} dB) by {100 * min_cut:.0f} %"
                                          + refused), ()
-
-
-# ---------------------------------------------------------------------------------------------
-# Evaluation of one parameter set (runs in a worker)
-
-@dataclass(frozen=True)
-class TrialSpec:
-    """Everything a worker needs to fit one candidate (picklable)."""
-
-    effect: str
-    fmu_path: str
-    channel: str
-    measured: np.ndarray = field(repr=False)   # (n,) measured signal
-    operating: Operating
-    parameters: dict                            # base + active effects + neutral candidates
-    guesses: dict                               # fit parameter name -> starting value
-    max_evals: int = 30
-    # related base parameters (FMU name -> calibrated value) refitted jointly with the effect, and
-    # the evaluations that joint step may take; ``polish_only`` starts it from ``guesses`` directly
-    related: dict = field(default_factory=dict)
-    related_evals: int = 12
-    polish_only: bool = False
-    # calibrated values the related parameters stay within +-RELATED_SPAN of (default: ``related``)
-    related_anchor: dict = field(default_factory=dict)
-
-
-class _Objective:
-    """LSD [dB] between a simulated and the measured signal, the measured PSD computed once."""
-
-    def __init__(self, measured: np.ndarray, fs: float, fmin: float = 10.0, fmax: float = 5000.0,
-                 resolution: float = 2.0):
-        from twin.signals import welch_psd
-        self.fs, self.n = fs, measured.size
-        self.resolution = max(resolution, 4.0 * fs / self.n)
-        f, pp = welch_psd(measured, fs, resolution=self.resolution)
-        self.band = (f >= fmin) & (f <= min(fmax, fs / 2))
-        self.pp = pp[self.band]
-
-    def __call__(self, simulated: np.ndarray) -> float:
-        from twin.signals import welch_psd
-        if not np.all(np.isfinite(simulated)):
-            return 1e3
-        _, pm = welch_psd(simulated[: self.n], self.fs, resolution=self.resolution)
-        lp, lm, _ = spectral_levels(pm[self.band], self.pp)
-        return float(np.sqrt(np.mean((lp - lm) ** 2)))
-
-
-def simulate(fmu_path, parameters: Mapping[str, float], op: Operating, n: int, channel: str) -> np.ndarray:
-    """Model signal (n,) at the measured operating point (:func:`twin.operating.simulate_at`)."""
-    return simulate_at(fmu_path, parameters, op, n, channel)
-
-
-def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int, np.ndarray]:
-    """Fit one effect's parameters, then (with ``spec.related``) them and the related base ones.
-
-    1. amplitude-like parameters on a coarse grid, then Brent;
-    2. all effect parameters together (Nelder-Mead);
-    3. the effect parameters and the related base parameters together (Nelder-Mead, the base
-       ones within +-``RELATED_SPAN`` of their calibrated values), kept only if it lowers the LSD.
-
-    Returns (FMU parameters: the effect's and any moved base ones, LSD [dB], evaluations, the
-    simulated signal (n,) at the fit), so the caller compares the fitted model without
-    simulating it again.
-    """
-    from scipy.optimize import minimize, minimize_scalar
-
-    from twin.effects.catalogue import RELATED_SPAN
-
-    eff = CATALOGUE[spec.effect]
-    objective = _Objective(spec.measured, spec.operating.sample_rate)
-    n = spec.measured.size
-    fixed = dict(spec.parameters)
-    params = list(eff.fit)
-    free = [p for p in params if p.guess is None]
-    count = 0
-    cache: dict[tuple, tuple[float, np.ndarray | None]] = {}   # values -> (LSD, simulated signal)
-
-    def start(p: FitParameter) -> float:
-        default = math.sqrt(p.lower * p.upper) if p.log else 0.5 * (p.lower + p.upper)
-        return float(np.clip(spec.guesses.get(p.name, default), p.lower, p.upper))
-
-    def to_x(p: FitParameter, v: float) -> float:
-        return (math.log(v / p.lower) / math.log(p.upper / p.lower)) if p.log else (v - p.lower) / (p.upper - p.lower)
-
-    def from_x(p: FitParameter, z: float) -> float:
-        z = min(max(z, 0.0), 1.0)
-        return p.lower * (p.upper / p.lower) ** z if p.log else p.lower + z * (p.upper - p.lower)
-
-    def key_of(values: Mapping[str, float], base: Mapping[str, float]) -> tuple:
-        return tuple(sorted((k, round(v, 12)) for k, v in values.items())) + \
-            tuple(sorted((k, round(v, 12)) for k, v in base.items()))
-
-    def lsd(values: Mapping[str, float], base: Mapping[str, float] | None = None) -> float:
-        nonlocal count
-        base = base or {}
-        key = key_of(values, base)
-        if key not in cache:
-            count += 1
-            try:
-                sim = simulate(spec.fmu_path, {**fixed, **base, **{eff.parameter(k): v for k, v in values.items()}},
-                               spec.operating, n, spec.channel)
-                cache[key] = (objective(sim), sim)
-            except Exception:  # a diverging trial scores badly; it does not end the diagnosis
-                cache[key] = (1e3, None)
-        return cache[key][0]
-
-    values = {p.name: start(p) for p in params} if spec.polish_only else \
-        {p.name: start(p) for p in params if p.guess is not None}
-    if not spec.polish_only:
-        # 1) amplitude-like parameters on a coarse grid with the guessed ones held, then Brent
-        for p in free:
-            grid = np.linspace(0.0, 1.0, p.grid)
-            scores = [lsd({**values, p.name: from_x(p, z)}) for z in grid]
-            j = int(np.argmin(scores))
-            lo, hi = grid[max(j - 1, 0)], grid[min(j + 1, grid.size - 1)]
-            res = minimize_scalar(lambda z: lsd({**values, p.name: from_x(p, z)}), bounds=(lo, hi),
-                                  method="bounded", options={"xatol": 0.01, "maxiter": 8})
-            best_z = res.x if res.fun < scores[j] else grid[j]
-            values[p.name] = from_x(p, best_z)
-        # 2) all parameters together (frequency-like ones move within +-5 % of their range)
-        if len(params) > 1 and count < spec.max_evals:
-            z0 = np.array([to_x(p, values[p.name]) for p in params])
-            res = minimize(lambda z: lsd({p.name: from_x(p, zi) for p, zi in zip(params, z)}), z0,
-                           method="Nelder-Mead",
-                           options={"maxfev": max(spec.max_evals - count, 4), "xatol": 2e-3, "fatol": 0.01,
-                                    "initial_simplex": np.vstack([z0] + [z0 + 0.05 * np.eye(len(params))[i]
-                                                                         for i in range(len(params))])})
-            if res.fun < lsd(values):
-                values = {p.name: from_x(p, zi) for p, zi in zip(params, res.x)}
-    base: dict[str, float] = {}
-    # 3) the effect and its related base parameters together
-    if spec.related:
-        names = list(spec.related)
-        anchor = np.array([float(spec.related_anchor.get(k, spec.related[k])) for k in names])
-        now = np.array([float(spec.related[k]) for k in names])
-        m = len(params)
-
-        def unpack(z):
-            eff_values = {p.name: from_x(p, zi) for p, zi in zip(params, z[:m])}
-            rel = np.clip(z[m:], -1.0, 1.0)
-            return eff_values, {k: float(v * (1 + RELATED_SPAN * r)) for k, v, r in zip(names, anchor, rel)}
-
-        # start from the current values (an earlier step may have moved them), inside the band
-        r0 = np.clip((now / np.where(anchor != 0, anchor, 1.0) - 1.0) / RELATED_SPAN, -1.0, 1.0)
-        z0 = np.concatenate([[to_x(p, values[p.name]) for p in params], r0])
-        steps = np.concatenate([np.full(m, 0.05), np.full(len(names), 0.5)])   # 5 % of range, 5 % of value
-        simplex = np.vstack([z0] + [z0 + steps[i] * np.eye(z0.size)[i] for i in range(z0.size)])
-        res = minimize(lambda z: lsd(*unpack(z)), z0, method="Nelder-Mead",
-                       options={"maxfev": spec.related_evals, "xatol": 2e-3, "fatol": 0.005,
-                                "initial_simplex": simplex})
-        # the calibrated base values are the simplex's first vertex, so comparing costs no run
-        values, base = unpack(res.x) if res.fun < lsd(*unpack(z0)) else unpack(z0)
-    val = lsd(values, base)
-    fitted = {eff.parameter(k): float(v) for k, v in values.items()}
-    fitted.update(base)
-    return fitted, val, count, cache[key_of(values, base)][1]
-
-
-def _guarded_fit(spec: TrialSpec):
-    try:
-        return fit_effect(spec)
-    except Exception as exc:  # reported per candidate, never ends the diagnosis
-        return exc
-
-
-# ---------------------------------------------------------------------------------------------
-# Physics-based starting values
-
-def _fine_spectrum(x: np.ndarray, fs: float) -> tuple[np.ndarray, np.ndarray]:
-    n = x.size
-    nfft = 1 << int(np.ceil(np.log2(8 * n)))
-    amp = np.abs(np.fft.rfft((x - x.mean()) * np.hanning(n), n=nfft))
-    return np.fft.rfftfreq(nfft, 1.0 / fs), amp
-
-
-def starting_values(comp: Comparison, measured: np.ndarray, model: np.ndarray, fs: float,
-                    shaft_hz: float, z1: int, z2: int) -> dict[str, dict[str, float]]:
-    """Initial values of guessed fit parameters, per effect id, from the measured spectrum."""
-    gear_hz = shaft_hz * z1 / z2
-    gmf = z1 * shaft_hz
-    f, am = _fine_spectrum(measured, fs)
-    _, ao = _fine_spectrum(model, fs)
-    excess = 20 * np.log10((am + 1e-30) / (ao + 1e-30))
-    lock_tol = max(0.1, 0.3 * fs / measured.size)      # as in twin.compare
-
-    def locked(fr: float) -> bool:
-        return any(abs(fr / s - round(fr / s)) * s <= lock_tol for s in (shaft_hz, gear_hz))
-
-    out: dict[str, dict[str, float]] = {}
-    # strongest measured line in 20-400 Hz that is locked to no shaft, weighted by its excess
-    band = (f >= 20) & (f <= 400)
-    idx = np.flatnonzero(band)
-    # what the measurement has beyond the model (a ratio would blow up in the model's spectral nulls)
-    order = idx[np.argsort(-np.clip(am[idx] - ao[idx], 0, None))]
-    for j in order[:200]:
-        if not locked(f[j]):
-            out["motor_torque_ripple"] = {"frequency": float(f[j])}
-            break
-    # slow modulation: excess beside the first mesh harmonics at offsets of 0.5-15 Hz
-    offsets = np.arange(0.5, 15.0, 0.05)
-    score = np.zeros_like(offsets)
-    for k in (1, 2, 3):
-        for s in (-1, 1):
-            fq = k * gmf + s * offsets
-            score += np.interp(fq, f, np.clip(excess, 0, None))
-    for j in np.argsort(-score):
-        if not locked(offsets[j]):
-            out["load_torque_fluctuation"] = {"frequency": float(offsets[j])}
-            break
-    # resonance: centre of the largest lifted band
-    # a mode in the path lifts whatever lies in its band: the lifted region, or else the line
-    # findings that are most above the model
-    res = [fd for fd in comp.findings if fd.kind == "resonance" and fd.size_db > 0]
-    lifted = [fd for fd in comp.findings if fd.kind in ("mesh_harmonic", "sideband") and fd.size_db > 0]
-    if res:
-        fc = max(res, key=lambda fd: fd.share).frequency_hz
-    elif lifted:
-        fc = max(lifted, key=lambda fd: fd.size_db).frequency_hz
-    else:
-        sm = np.convolve(excess, np.ones(257) / 257, mode="same")
-        win = (f >= 300) & (f <= 4800)
-        fc = float(f[win][np.argmax(sm[win])])
-    out["housing_mode"] = {"frequency": float(fc)}
-    return out
 
 
 # ---------------------------------------------------------------------------------------------

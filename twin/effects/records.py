@@ -202,7 +202,7 @@ class HeldOutSpec:
 
 def held_out_lsd(spec: HeldOutSpec) -> float:
     """LSD [dB] of the model run against the held-out stretch (the diagnosis's fit objective)."""
-    from twin.effects.diagnose import _Objective
+    from twin.effects.fit import _Objective
     from twin.operating import simulate_at
     objective = _Objective(spec.measured, spec.sample_rate)
     if spec.shaft_hz is not None:

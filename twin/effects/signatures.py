@@ -63,7 +63,7 @@ def steady_sidebands(x: np.ndarray, fs: float, shaft_hz: float, z1: int, z2: int
                      ) -> dict[str, int]:
     """Mesh harmonics (of the first ``n_harmonics`` below 0.4 fs) with a first sideband at the
     pinion / gear speed standing ``LINE_DB`` above the median spectrum within +-3 shaft speeds."""
-    from twin.effects.diagnose import _fine_spectrum
+    from twin.effects.fit import _fine_spectrum
     f, amp = _fine_spectrum(np.asarray(x, float), fs)
     df = f[1] - f[0]
     gmf = z1 * shaft_hz
