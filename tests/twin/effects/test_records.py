@@ -128,3 +128,31 @@ def test_the_model_follows_a_measured_speed_profile(gearbox_fmu):
     for got, expected in peaks:
         assert got == pytest.approx(expected, rel=0.03)
     assert peaks[1][0] > peaks[0][0] + 30
+
+
+def test_improve_starts_from_a_diagnosis_of_the_same_scenario_and_refuses_another(tmp_path, gearbox_fmu, capsys):
+    import json
+
+    import yaml
+
+    from twin.cli import main
+    meas = _write(tmp_path / "m.h5")
+    scen = tmp_path / "s.yaml"
+    scen.write_text(yaml.safe_dump({"version": 1, "name": "s", "fmu": str(gearbox_fmu), "stop_time": 1.0}))
+    diag = {"scenario": "s", "fmu": str(gearbox_fmu), "measurements": str(meas.resolve()), "records": ["steady"],
+            "duration": 2.0, "record": "steady", "verdict": "nothing_missing", "missing": None, "candidates": [],
+            "headline": {"log_spectral_distance_db": 0.4}}
+    (tmp_path / "d.json").write_text(json.dumps(diag))
+    # the diagnosis is taken as it is: nothing is simulated, the loop stops at its verdict
+    assert main(["improve", str(scen), "--measurements", str(meas), "--out", str(tmp_path / "o"),
+                 "--from-diagnosis", str(tmp_path / "d.json")]) == 0
+    steps = json.loads((tmp_path / "o" / "history.json").read_text())["steps"]
+    assert [(s["effect"], s["verdict"], s["lsd_before_db"]) for s in steps] == [(None, "nothing_missing", 0.4)]
+    assert not (tmp_path / "o" / "diagnosis_1.json").exists()
+    (tmp_path / "d2.json").write_text(json.dumps({**diag, "scenario": "other-gearbox"}))
+    assert main(["improve", str(scen), "--measurements", str(meas), "--out", str(tmp_path / "o2"),
+                 "--from-diagnosis", str(tmp_path / "d2.json")]) == 2
+    assert "other-gearbox" in capsys.readouterr().err and not (tmp_path / "o2").exists()
+    assert main(["improve", str(scen), "--measurements", str(meas), "--out", str(tmp_path / "o3"), "--record",
+                 "runup", "--from-diagnosis", str(tmp_path / "d.json")]) == 2
+    assert "runup" in capsys.readouterr().err
