@@ -458,12 +458,13 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
             held.append((r.name, dict(measured=r.signal[-m:], sample_rate=r.sample_rate, load=r.load,
                                       shaft_hz=r.shaft_hz[-m:], slip_hz=slip * r.load / op.load if op.load else slip)))
         fitting = [c for c in cands if fits(before, c, min_cut, min_db)]
+        # nothing to test when no candidate fits: the base model is not run on the held-out records
         tasks = [HeldOutSpec(name, str(candidates_fmu), dict(probe), channel, solver_step=solver_step, **kw)
-                 for name, kw in held]
+                 for name, kw in held] if fitting else []
         tasks += [HeldOutSpec(name, str(candidates_fmu), {**probe, **c.fitted}, channel, solver_step=solver_step, **kw)
                   for c in fitting for name, kw in held]
         out = ex.map(guarded_held_out, tasks, progress=progress, desc="held-out records") if tasks else []
-        base_lsd = {name: out[i] for i, (name, _) in enumerate(held)}
+        base_lsd = {name: out[i] for i, (name, _) in enumerate(held)} if fitting else {}
         bad = [f"{n}: {v}" for n, v in base_lsd.items() if isinstance(v, Exception)]
         if bad:
             raise ParameterError("the current model does not run on the held-out record " + bad[0])

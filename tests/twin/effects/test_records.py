@@ -156,3 +156,34 @@ def test_improve_starts_from_a_diagnosis_of_the_same_scenario_and_refuses_anothe
     assert main(["improve", str(scen), "--measurements", str(meas), "--out", str(tmp_path / "o3"), "--record",
                  "runup", "--from-diagnosis", str(tmp_path / "d.json")]) == 2
     assert "runup" in capsys.readouterr().err
+
+
+def test_a_hidden_mode_is_fitted_on_the_steady_record_and_held_out_on_the_runup(gearbox_fmu, candidates_fmu,
+                                                                                  executor):
+    """Records made by the candidate model with a casing mode switched on (plumbing, not evidence):
+    the mode is fitted on the steady record, cuts the discrepancy on the run-up it was not fitted
+    on, and its band is fixed across the run-up."""
+    from twin.effects.catalogue import CATALOGUE
+    from twin.effects.diagnose import diagnose
+    from twin.effects.records import Record, simulate_runup
+    from twin.operating import Operating, simulate_at
+    fs = 20_000.0
+    truth = {e.parameter(k): v for e in CATALOGUE.values() for k, v in e.neutral.items()}
+    truth.update({"housing_mode.frequency": 1500.0, "housing_mode.participation": 0.8,
+                  "housing_mode.damping_ratio": 0.02})
+    rng = np.random.default_rng(3)
+    n = int(0.5 * fs)
+    op = Operating(20.0, 20.0, 20.0, fs)
+    steady = simulate_at(candidates_fmu, truth, op, n, "accel_pinion_casing")
+    ramp = np.linspace(14.0, 20.0, int(1.0 * fs))
+    runup = simulate_runup(candidates_fmu, truth, ramp, 20.0, fs, "accel_pinion_casing")
+    noise = 0.02 * np.std(steady)
+    recs = [Record("steady", steady + noise * rng.standard_normal(n), fs, 20.0, 20.0, np.full(n, 20.0)),
+            Record("runup", runup + noise * rng.standard_normal(ramp.size), fs, 20.0, 20.0, ramp)]
+    d = diagnose(gearbox_fmu, recs, candidates_fmu=candidates_fmu, executor=executor, duration=0.5,
+                 effects=["housing_mode"], max_evals=8, related_leaders=0, held_out_runup=0.5)
+    c, = d.candidates
+    assert d.held_out_records == ("runup",) and c.held_out and c.held_out[0][0] == "runup"
+    assert c.held_out_cut() > 0.5
+    assert (d.verdict, d.missing) == ("missing_effect", "housing_mode"), d.message
+    assert c.signature_present is None         # Records without the loaded run-up: no survey
