@@ -159,8 +159,12 @@ def refused(model, shapes: MeasuredShapes | None, cols: np.ndarray) -> np.ndarra
     raw = raw_mismatch(model, shapes, cols)
     if shapes is None:
         return np.zeros(raw.shape, bool)
-    coherent = shapes.coherence[:, None] >= REFUSE_COHERENCE
-    return coherent & (np.nan_to_num(raw) > REFUSE_MISMATCH)
+    return _refusal(raw, shapes.coherence)
+
+
+def _refusal(raw: np.ndarray, coherence: np.ndarray) -> np.ndarray:
+    """:func:`refused` from the (k, n) ``1 - MAC`` of :func:`raw_mismatch` and the (k,) coherences."""
+    return (coherence[:, None] >= REFUSE_COHERENCE) & (np.nan_to_num(raw) > REFUSE_MISMATCH)
 
 
 def mode_reach(S: np.ndarray, candidates) -> np.ndarray:
@@ -186,8 +190,9 @@ def pairing_cost(model, measured: np.ndarray, rel_sd: np.ndarray, cols: np.ndarr
     excess, within = _gap(model, measured, rel_sd, cols, reach)
     if shapes is None:
         return np.where(within, excess / MATCH_REACH, np.inf)
-    cost = excess / MATCH_REACH + SHAPE_WEIGHT * shape_mismatch(model, shapes, cols)
-    return np.where(within & ~refused(model, shapes, cols), cost, np.inf)
+    raw = raw_mismatch(model, shapes, cols)       # once: it weighs the cost and decides refusals
+    cost = excess / MATCH_REACH + SHAPE_WEIGHT * np.nan_to_num(shapes.coherence[:, None] * raw)
+    return np.where(within & ~_refusal(raw, shapes.coherence), cost, np.inf)
 
 
 def _gap(model, measured: np.ndarray, rel_sd: np.ndarray, cols: np.ndarray, reach: np.ndarray | None):
@@ -235,8 +240,8 @@ def shape_refusals(model, measured, index: np.ndarray, rel_sd=None, *, shapes: M
     if shapes is None or cols.size == 0:
         return []
     _, within = _gap(model, measured, rel_sd, cols, reach)
-    no = refused(model, shapes, cols) & within
     raw = raw_mismatch(model, shapes, cols)
+    no = _refusal(raw, shapes.coherence) & within
     out = []
     for i in np.flatnonzero((np.asarray(index) < 0) & no.any(axis=1)):
         jj = np.flatnonzero(no[i])
