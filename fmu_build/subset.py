@@ -13,7 +13,8 @@ Supported subset (documented in fmu_build/README.md):
 * continuous ``Real`` variables, ``input``/``output`` Real, ``der()`` of variables;
 * equations that can be sorted into assignments (no algebraic loops), each linear in the
   variable it is solved for;
-* ``if``-expressions only inside ``noEvent(...)``; ``abs``, ``min``, ``max``, ``atan2``
+* ``if``-expressions and ``div mod rem floor ceil integer`` of time-varying values only
+  inside ``noEvent(...)`` (so an array may be indexed by ``noEvent(integer(...))``); ``abs``, ``min``, ``max``, ``atan2``
   and the usual elementary functions; array comprehensions and ``sum``.
 
 Declaration equations of time-varying variables (``Real y = expr;``) are checked like
@@ -48,16 +49,20 @@ _FORBIDDEN_CALLS = {
     "change": "change() needs discrete events", "sample": "sample() needs discrete events",
     "reinit": "reinit() needs discrete events", "initial": "initial() needs event handling",
     "terminal": "terminal() needs event handling", "delay": "delay() needs a history buffer",
-    "mod": "mod() of a time-varying expression generates events",
-    "rem": "rem() of a time-varying expression generates events",
-    "floor": "floor() of a time-varying expression generates events",
-    "ceil": "ceil() of a time-varying expression generates events",
-    "integer": "integer() of a time-varying expression generates events",
-    "div": "div() of a time-varying expression generates events",
+    "mod": "mod() of a time-varying expression generates events; inside noEvent(...) it does not",
+    "rem": "rem() of a time-varying expression generates events; inside noEvent(...) it does not",
+    "floor": "floor() of a time-varying expression generates events; inside noEvent(...) it does not",
+    "ceil": "ceil() of a time-varying expression generates events; inside noEvent(...) it does not",
+    "integer": "integer() of a time-varying expression generates events; inside noEvent(...) it does not",
+    "div": "div() of a time-varying expression generates events; inside noEvent(...) it does not",
     "spatialDistribution": "spatialDistribution() is not supported",
     "homotopy": "homotopy() is not supported",
     "semiLinear": "semiLinear() is not supported",
 }
+
+# Allowed on time-varying arguments inside noEvent(...): evaluated as written, without events
+# (e.g. an array index tooth_pit_field[noEvent(integer(...))]).
+_NOEVENT_CALLS = {"mod", "rem", "floor", "ceil", "integer", "div"}
 
 _DISCRETE_TYPES = ("Boolean", "Integer", "String")
 # `type X = Real(...)`, `model A = B(...)`, `import X = A.B`: a `=` that is no declaration equation
@@ -253,7 +258,7 @@ def _scan(toks: list[_Tok], nested: set[str]) -> list[tuple[str, int, str, str]]
                              "for-loop equations are not supported; use an array comprehension {... for i in 1:n}"))
         elif s == "while":
             problems.append((t.file, t.line, "while", "while loops are not supported"))
-        elif s in _FORBIDDEN_CALLS and nxt == "(" and prev != ".":
+        elif s in _FORBIDDEN_CALLS and nxt == "(" and prev != "." and not (s in _NOEVENT_CALLS and depth_noevent):
             problems.append((t.file, t.line, f"{s}()", _FORBIDDEN_CALLS[s]))
         elif s == "der" and nxt == "(" and i + 3 < n and toks[i + 3].text != ")":
             # der(a.b) tokenizes as der ( a . b ) ; der(x[1]) as der ( x [ 1 ] ) -- allow both

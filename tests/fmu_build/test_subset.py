@@ -152,6 +152,26 @@ CASES = {
           der(x) = -x;
         end M;
     """),
+    "integer() index outside noEvent()": ("integer()", """
+        model M
+          parameter Real f[3] = {1, 2, 3};
+          Real x(start = 1, fixed = true);
+          output Real y;
+        equation
+          der(x) = 1;
+          y = f[integer(x) + 1]; // <-
+        end M;
+    """),
+    "mod() outside the noEvent() of an index": ("mod()", """
+        model M
+          parameter Real f[3] = {1, 2, 3};
+          Real x(start = 1, fixed = true);
+          output Real y;
+        equation
+          der(x) = 1;
+          y = f[mod(noEvent(integer(x)), 3) + 1]; // <-
+        end M;
+    """),
     "mod() in a declaration equation": ("mod()", """
         model M
           Real x(start = 1, fixed = true);
@@ -243,7 +263,7 @@ def test_supported_constructs_pass(tmp_path, write_package):
         equation
           // an if-expression inside noEvent() is fine, so is der() of an array element
           der(x) = noEvent(if x > 0 then -x else 0) + sum(c) * u;
-          y = noEvent(max(x, 0)) + abs(x) + atan2(x, 1.0);
+          y = noEvent(max(x, 0)) + abs(x) + atan2(x, 1.0) + c[noEvent(mod(integer(x), n)) + 1];
         end M;
         type Angle = Real(unit = "rad") "Short class definition: its '=' is no equation";
         model N "Declarations whose bindings are parameter expressions or inside noEvent()"

@@ -81,6 +81,55 @@ def test_equations_in_any_order_are_sorted_and_solved(tmp_path, write_package):
         assert float(ode.outputs_fn(0.0, x, u, g, [])) == pytest.approx(2 * c, rel=1e-14)
 
 
+def test_time_varying_index_looks_up_exactly(tmp_path, write_package):
+    """f[noEvent(integer(...))] reads the element the Modelica expression names (1-based,
+    mod() as in Modelica for negative values too), one lookup call per array."""
+    write_package(tmp_path, "Look", """
+        model M
+          parameter Integer n = 5;
+          parameter Real f[n] = {10.0 * j for j in 1:n};
+          parameter Real g[2 * n] = fill(0.0, 2 * n);
+          Real x(start = 0, fixed = true);
+          Real k "Integer valued";
+          output Real y;
+          output Real z;
+        equation
+          der(x) = 1;
+          k = noEvent(mod(integer(x * 3), n)) + 1;
+          y = f[noEvent(integer(k))] + g[noEvent(integer(k)) + n];
+          z = f[noEvent(min(integer(abs(x)), n - 1)) + 1] * 2;
+        end M;
+    """)
+    ode = _ode(tmp_path, "Look.M")
+    rng = np.random.default_rng(3)
+    f, g = rng.normal(size=5), rng.normal(size=10)
+    p = np.concatenate([f, g])
+    for x in [0.0, 0.34, 1.0, 2.99, 7.2, -0.2, -4.01]:
+        k = math.floor(x * 3) % 5                               # Python % is Modelica's mod
+        y, z = np.array(ode.outputs_fn(0.0, x, [], p, [])).ravel()
+        assert y == f[k] + g[k + 5]                             # exact: a lookup, not a weighted sum
+        assert z == f[min(math.floor(abs(x)), 4)] * 2
+    expression = str(ode.outputs_fn.call(ode.outputs_fn.sx_in())[0])
+    assert expression.count("lookup_5_2(") == 1 and expression.count("lookup_10_1(") == 1
+
+
+def test_index_that_needs_its_own_lookup_is_an_algebraic_loop(tmp_path, write_package):
+    write_package(tmp_path, "Look", """
+        model M
+          parameter Real f[3] = {1, 2, 3};
+          Real x(start = 0, fixed = true);
+          Real k;
+          output Real y;
+        equation
+          der(x) = 1;
+          k = x * 2;
+          y = f[noEvent(integer(f[noEvent(integer(y))]))];
+        end M;
+    """)
+    with pytest.raises(BuildError, match="algebraic loop through an array index"):
+        _ode(tmp_path, "Look.M")
+
+
 def _loop_package(write_package, root: Path, equations: str, decls: str):
     write_package(root, "Bad", f"""
         model M
