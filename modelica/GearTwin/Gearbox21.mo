@@ -168,7 +168,9 @@ model Gearbox21 "21-DOF lumped model of the UNSW spur-gear test rig (Feng et al.
   Real tooth_angle(unit = "rad") "Angle 2*pi*k/z1 of the pinion tooth that entered contact last (k = completed mesh cycles)";
   output Real roll[3] "Roll position along the path of contact (0 = start, 1 = end) of the pairs leading, current and next";
   Real window[3] "Share of each pair in contact (smooth 0-1 gate over [0, 1])";
-  Real tooth_weight[z1] "1 for the pinion tooth of the current pair, 0 for the others";
+  Real pair_tooth[3] "Pinion tooth (1..z1, integer valued) in each pair: mod(k - 1, z1) + 1, mod(k, z1) + 1, mod(k + 1, z1) + 1 with k = completed mesh cycles";
+  Real profile_position[3] "Contact point of each pair in node spacings from the start of the path of contact (0..n_profile - 1)";
+  Real pair_node[3] "Profile interval of each pair's contact point (0..n_profile - 2, integer valued): it lies between nodes pair_node + 1 and pair_node + 2";
   Real pair_tooth_factor[3] "tooth_stiffness_factor of the pinion tooth in each pair";
   Real pair_tooth_offset[3](each unit = "m") "tooth_deviation_offset of the pinion tooth in each pair";
   Real pair_pit_field[3](each unit = "m") "tooth_pit_field of the pinion tooth in each pair, interpolated at its contact point";
@@ -233,13 +235,17 @@ equation
   tooth_angle = (mesh_angle - 2 * GearTwin.pi * cycle_fraction) / z1;
   roll = {(cycle_fraction + 1) / contact_ratio, cycle_fraction / contact_ratio, (cycle_fraction - 1) / contact_ratio};
   window = {noEvent(min(1.0, max(0.0, (roll[i] + contact_smoothing) / (2 * contact_smoothing)))) ^ 2 * (3 - 2 * noEvent(min(1.0, max(0.0, (roll[i] + contact_smoothing) / (2 * contact_smoothing))))) * noEvent(min(1.0, max(0.0, (1 - roll[i] + contact_smoothing) / (2 * contact_smoothing)))) ^ 2 * (3 - 2 * noEvent(min(1.0, max(0.0, (1 - roll[i] + contact_smoothing) / (2 * contact_smoothing))))) for i in 1:3};
-  // Nearest-tooth selection on the unit circle (hat of radius half a chord around each tooth);
-  // the leading and next pairs use the same weights on the cyclically shifted tooth arrays.
-  tooth_weight = {noEvent(max(0.0, 1 - ((cos(tooth_angle) - cos(2 * GearTwin.pi * (j - 1) / z1)) ^ 2 + (sin(tooth_angle) - sin(2 * GearTwin.pi * (j - 1) / z1)) ^ 2) / sin(GearTwin.pi / z1) ^ 2)) for j in 1:z1};
-  pair_tooth_factor = {sum(tooth_stiffness_factor[tooth_prev[j]] * effect_tooth_stiffness_factor[tooth_prev[j]] * tooth_weight[j] for j in 1:z1), sum(tooth_stiffness_factor[j] * effect_tooth_stiffness_factor[j] * tooth_weight[j] for j in 1:z1), sum(tooth_stiffness_factor[tooth_next[j]] * effect_tooth_stiffness_factor[tooth_next[j]] * tooth_weight[j] for j in 1:z1)};
-  pair_tooth_offset = {sum((tooth_deviation_offset[tooth_prev[j]] + effect_tooth_offset[tooth_prev[j]]) * tooth_weight[j] for j in 1:z1), sum((tooth_deviation_offset[j] + effect_tooth_offset[j]) * tooth_weight[j] for j in 1:z1), sum((tooth_deviation_offset[tooth_next[j]] + effect_tooth_offset[tooth_next[j]]) * tooth_weight[j] for j in 1:z1)};
-  // Each pair reads the field of the tooth it holds (same tooth weights and profile hats as above).
-  pair_pit_field = {sum(sum(tooth_pit_field[(tooth_prev[j] - 1) * n_profile + n] * tooth_weight[j] for j in 1:z1) * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[1]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile), sum(sum(tooth_pit_field[(j - 1) * n_profile + n] * tooth_weight[j] for j in 1:z1) * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[2]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile), sum(sum(tooth_pit_field[(tooth_next[j] - 1) * n_profile + n] * tooth_weight[j] for j in 1:z1) * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[3]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile)};
+  // Each pair reads the entries of the tooth it holds (array indices computed without events:
+  // a lookup, whatever z1 and n_profile), the leading pair the tooth ahead, the next pair the
+  // tooth behind.
+  pair_tooth = {noEvent(mod(integer(tooth_angle * z1 / (2 * GearTwin.pi) + 0.5) + i - 2, z1)) + 1 for i in 1:3};
+  profile_position = {noEvent(min(1.0, max(0.0, roll[i]))) * (n_profile - 1) for i in 1:3};
+  pair_node = {noEvent(min(integer(profile_position[i]), n_profile - 2)) for i in 1:3};
+  pair_tooth_factor = {tooth_stiffness_factor[noEvent(integer(pair_tooth[i]))] * effect_tooth_stiffness_factor[noEvent(integer(pair_tooth[i]))] for i in 1:3};
+  pair_tooth_offset = {tooth_deviation_offset[noEvent(integer(pair_tooth[i]))] + effect_tooth_offset[noEvent(integer(pair_tooth[i]))] for i in 1:3};
+  // The pit field of that tooth at the contact point: linear between the two profile nodes
+  // around it (the same hat functions as below, restricted to the two that are not zero).
+  pair_pit_field = {tooth_pit_field[noEvent(integer((pair_tooth[i] - 1) * n_profile + pair_node[i])) + 1] * noEvent(max(0.0, 1 - abs(profile_position[i] - pair_node[i]))) + tooth_pit_field[noEvent(integer((pair_tooth[i] - 1) * n_profile + pair_node[i])) + 2] * noEvent(max(0.0, 1 - abs(profile_position[i] - (pair_node[i] + 1)))) for i in 1:3};
   // Piecewise-linear interpolation along the profile: hat functions on n_profile nodes.
   pair_stiffness = {mesh_stiffness_scale * window[i] * pair_tooth_factor[i] * sum(k_pair[n] * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[i]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile) for i in 1:3};
   pair_deviation = {pair_tooth_offset[i] + effect_pair_deviation[i] + pair_pit_field[i] + sum((profile_deviation[n] + effect_profile_deviation[n]) * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[i]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile) for i in 1:3};
