@@ -13,13 +13,13 @@ directory and implemented in :mod:`twin.measurements.format`.
 """
 from twin.measurements.format import (ACCEPTED_UNITS, ARCHIVE_FORMAT, FORMAT_VERSION, MEASUREMENT_FORMAT,
                                       RECORD_ATTRIBUTES, STANDARD_GRAVITY, UNITS)
-from twin.measurements.load import load_measurements, read_sidecar
+from twin.measurements.load import iter_measurements, load_measurements, read_sidecar
 from twin.measurements.record import MeasurementSet, Record
 from twin.measurements.resample import resample_record
 from twin.measurements.write import import_csv, write_measurements
 
 __all__ = [
     "ACCEPTED_UNITS", "ARCHIVE_FORMAT", "FORMAT_VERSION", "MEASUREMENT_FORMAT", "MeasurementSet",
-    "RECORD_ATTRIBUTES", "Record", "STANDARD_GRAVITY", "UNITS", "import_csv", "load_measurements",
+    "RECORD_ATTRIBUTES", "Record", "STANDARD_GRAVITY", "UNITS", "import_csv", "iter_measurements", "load_measurements",
     "read_sidecar", "resample_record", "write_measurements",
 ]

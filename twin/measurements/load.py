@@ -14,7 +14,7 @@ import logging
 import math
 import os
 import warnings
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -29,7 +29,7 @@ from twin.measurements.format import (CSV_SUFFIXES, FORMAT_VERSION, READABLE_FOR
 from twin.measurements.record import MeasurementSet, Record
 from twin.measurements.resample import resample_record
 
-__all__ = ["MeasurementSet", "Record", "load_measurements", "read_sidecar"]
+__all__ = ["MeasurementSet", "Record", "iter_measurements", "load_measurements", "read_sidecar"]
 
 log = logging.getLogger("twin.measurements")
 
@@ -116,30 +116,9 @@ def load_measurements(path: str | os.PathLike[str], *, min_duration: float | Non
         For invalid arguments (e.g. a negative ``resample_to``).
     """
     wanted = _check_arguments(min_duration, channels, resample_to)
-    if not isinstance(tachometer, bool):
-        raise ParameterError(f"tachometer must be True or False, got {tachometer!r}")
-    p = Path(path)
-    file = str(p)
-    if not p.exists():
-        raise MeasurementError(file, None, "file does not exist")
-    if p.is_dir():
-        raise MeasurementError(file, None, "is a directory, not a measurement file")
-    problems = _Problems(file)
-    import h5py
-    if h5py.is_hdf5(p):
-        if sidecar is not None:
-            raise ParameterError(f"a sidecar only applies to CSV files, not to the HDF5 file {file}")
-        raws, file_metadata = _read_hdf5(p, problems, wanted, tachometer)
-    elif p.suffix.lower() in CSV_SUFFIXES:
-        raws, file_metadata = _read_csv(p, problems, sidecar), {}
-    else:
-        raise MeasurementError(file, None, "neither an HDF5 file (no HDF5 signature) nor a CSV file "
-                                           f"(suffix {', '.join(CSV_SUFFIXES)})")
-    records = []
-    for raw in raws:
-        rec = _validate(raw, problems, file, wanted, min_duration, check_clipping, tachometer)
-        if rec is not None:
-            records.append(rec)
+    problems, file_metadata = _Problems(str(Path(path))), {}
+    records = list(_records(path, problems, wanted, min_duration, check_clipping, tachometer, sidecar, file_metadata))
+    file = problems.file
     problems.raise_if_any()
     notes = []
     if resample_to is not None:
@@ -154,6 +133,56 @@ def load_measurements(path: str | os.PathLike[str], *, min_duration: float | Non
                 log.info("%s: %s", file, note)
         problems.raise_if_any()
     return MeasurementSet(tuple(records), file, tuple(notes), file_metadata)
+
+
+def iter_measurements(path: str | os.PathLike[str], *, min_duration: float | None = None,
+                      channels: Iterable[str] | None = None, check_clipping: bool = True,
+                      tachometer: bool = True) -> Iterator[Record]:
+    """The records :func:`load_measurements` returns (without resampling), one at a time as they
+    are read, so work on a record can run while the next one is read (HDF5: one record's
+    datasets at a time; CSV: the whole file first).
+
+    Raises
+    ------
+    MeasurementError
+        As :func:`load_measurements`, listing every problem of the file, after the last record
+        of a file with problems (no record is yielded after the first problem: the file is
+        rejected, so whatever was computed from the records yielded must be discarded).
+    ParameterError
+        For invalid arguments, at the first ``next``.
+    """
+    wanted = _check_arguments(min_duration, channels, None)
+    problems = _Problems(str(Path(path)))
+    yield from _records(path, problems, wanted, min_duration, check_clipping, tachometer, None, {})
+    problems.raise_if_any()
+
+
+def _records(path, problems: _Problems, wanted, min_duration, check_clipping, tachometer, sidecar,
+             metadata: dict) -> Iterator[Record]:
+    """The valid records of a file as they are read; the file's problems go to ``problems``, its
+    attributes to ``metadata``."""
+    if not isinstance(tachometer, bool):
+        raise ParameterError(f"tachometer must be True or False, got {tachometer!r}")
+    p = Path(path)
+    file = str(p)
+    if not p.exists():
+        raise MeasurementError(file, None, "file does not exist")
+    if p.is_dir():
+        raise MeasurementError(file, None, "is a directory, not a measurement file")
+    import h5py
+    if h5py.is_hdf5(p):
+        if sidecar is not None:
+            raise ParameterError(f"a sidecar only applies to CSV files, not to the HDF5 file {file}")
+        raws = _read_hdf5(p, problems, wanted, tachometer, metadata)
+    elif p.suffix.lower() in CSV_SUFFIXES:
+        raws = _read_csv(p, problems, sidecar)
+    else:
+        raise MeasurementError(file, None, "neither an HDF5 file (no HDF5 signature) nor a CSV file "
+                                           f"(suffix {', '.join(CSV_SUFFIXES)})")
+    for raw in raws:
+        rec = _validate(raw, problems, file, wanted, min_duration, check_clipping, tachometer)
+        if rec is not None:
+            yield rec
 
 
 def _check_arguments(min_duration, channels, resample_to) -> tuple[str, ...] | None:
@@ -180,8 +209,10 @@ def _kept(channel: str, wanted: tuple[str, ...] | None, tachometer: Any) -> bool
 
 # --------------------------------------------------------------------------- HDF5
 
-def _read_hdf5(p: Path, problems: _Problems, wanted, keep_tachometer: bool = True
-               ) -> tuple[list[_RawRecord], dict]:
+def _read_hdf5(p: Path, problems: _Problems, wanted, keep_tachometer: bool, metadata: dict
+               ) -> Iterator[_RawRecord]:
+    """The file's records, one at a time (the file stays open until the last); its root
+    attributes go to ``metadata``."""
     import h5py
     try:
         f = h5py.File(p, "r")
@@ -206,8 +237,7 @@ def _read_hdf5(p: Path, problems: _Problems, wanted, keep_tachometer: bool = Tru
             problems.add(None, "empty file: '/records' holds no records")
         # Without a known format and a records group nothing below can be trusted.
         problems.raise_if_any()
-        metadata = {k: plain_value(v) for k, v in f.attrs.items() if k not in ("format", "format_version")}
-        raws = []
+        metadata.update((k, plain_value(v)) for k, v in f.attrs.items() if k not in ("format", "format_version"))
         for name in group:
             obj = group.get(name)
             if not isinstance(obj, h5py.Group):
@@ -236,8 +266,7 @@ def _read_hdf5(p: Path, problems: _Problems, wanted, keep_tachometer: bool = Tru
                     continue
                 chans[cname] = np.asarray(ds[()], dtype=np.float64)
                 units[cname] = plain_value(ds.attrs["unit"]) if "unit" in ds.attrs else None
-            raws.append(_RawRecord(name, chans, units, all_channels, attrs))
-    return raws, metadata
+            yield _RawRecord(name, chans, units, all_channels, attrs)
 
 
 # --------------------------------------------------------------------------- CSV

@@ -372,41 +372,71 @@ class Ensemble:
     # -- probabilities ----------------------------------------------------------------------------
     def _raw(self, data, what: str = "assess"):
         """Members' raw network probabilities on the windows of ``data``: (members, n, K), record
-        index (n,), labels (n,), prepared records.
+        index (n,), labels (n,), prepared records (:meth:`_streamed`)."""
+        return self._streamed(data, what)[:4]
 
-        Records are resampled and represented one at a time (once for all members) while the
-        members' networks run on the windows already represented (:mod:`twin.transfer.inference`).
+    def _streamed(self, data, what: str = "assess", features: bool = False):
+        """:meth:`_raw`, the records read from a path (None otherwise) and, with ``features``,
+        the records' order-check features (:func:`~twin.transfer.order.record_features`).
+
+        A file is read record by record; each record is resampled, represented (and its
+        features computed) on worker threads as soon as it is read, once for all members, while
+        the members' networks run on the windows already represented
+        (:mod:`twin.transfer.inference`): the two cores share reading, preparing and the networks.
         """
+        from collections import deque
         from concurrent.futures import ThreadPoolExecutor
 
-        from twin.measurements import MeasurementSet, load_measurements
+        from twin.measurements import MeasurementSet, iter_measurements
         from twin.transfer.preprocess import Prepared, windows_of
-        first = self.members[0]
-        if isinstance(data, (str, Path)):          # read once; resampled record by record below
-            data = load_measurements(data, channels=[self.preprocessing.channel_of("target")], tachometer=False)
-        if isinstance(data, MeasurementSet):
-            data = list(data.records)
-        if isinstance(data, (list, tuple)) and data and not isinstance(data[0], np.ndarray):
-            pieces = [list(data[i:i + 1]) for i in range(len(data))]
-        else:                                      # window arrays, archives: prepared (and judged) whole
-            pieces = [first._prepared(data, None, what, "target")]
+        first, pre = self.members[0], self.preprocessing
+        records = None
+        if isinstance(data, (str, Path)):
+            records = []
+
+            def read(path):
+                for r in iter_measurements(path, channels=[pre.channel_of("target")], tachometer=False):
+                    records.append(r)
+                    yield [r]
+            pieces = read(data)
+        else:
+            if isinstance(data, MeasurementSet):
+                data = list(data.records)
+            if isinstance(data, (list, tuple)) and data and not isinstance(data[0], np.ndarray):
+                pieces = [list(data[i:i + 1]) for i in range(len(data))]
+            else:                                  # window arrays, archives: prepared (and judged) whole
+                pieces = [first._prepared(data, None, what, "target")]
         stacked, normalise = self._networks()
 
         def represent(piece):
             p = piece if isinstance(piece[0], Prepared) else first._prepared(piece, None, what, "target")
-            raw, rec, lab = windows_of(p, self.preprocessing, what)
-            return p, normalise(raw), rec, lab
+            raw, rec, lab = windows_of(p, pre, what)
+            return p, normalise(raw), rec, lab, self._features(p) if features else None
 
-        prepared, recs, labs = [], [], []
-        # numpy's FFTs and scipy's filters release the GIL: records are prepared on worker threads
-        # too, and handed to the networks in their order
+        prepared, recs, labs, feats = [], [], [], []
+        # numpy's FFTs, scipy's filters and torch release the GIL: the main thread reads while
+        # worker threads prepare the records read, handed to the networks in their order
         with stacked.stream() as stream, ThreadPoolExecutor(max_workers=stacked.threads) as pool:
-            for p, x, rec, lab in pool.map(represent, pieces):
+            queue = deque()
+
+            def take():
+                p, x, rec, lab, f = queue.popleft().result()
                 stream.add(x)
                 recs.append(rec + len(prepared))
                 labs.append(lab)
-                prepared += p
-        return stream.result(), np.concatenate(recs), np.concatenate(labs), prepared
+                feats.append(f)
+                prepared.extend(p)
+
+            for piece in pieces:
+                queue.append(pool.submit(represent, piece))
+                while queue and queue[0].done():
+                    take()
+            while queue:
+                take()
+        if not prepared:
+            raise AssessorError(f"{what}: no records")
+        f = {k: np.concatenate([v[k] for v in feats]) for k in feats[0]} if features else None
+        return stream.result(), np.concatenate(recs), np.concatenate(labs), prepared, records, f
 
     def _networks(self):
         """(the members' folded networks, the windows' domain normalisation for them)."""
@@ -486,16 +516,19 @@ class Ensemble:
             True: the records are given in time order (a run-to-failure history in file order).
             False: ignore any time order.
         """
-        from twin.measurements import MeasurementSet, load_measurements
+        from twin.measurements import MeasurementSet
         from twin.transfer.order import check_order, monotone_stages, time_order
         from twin.transfer.reliability import pairwise_agreement
         from twin.transfer.settings import check_records, resampling_note
 
         self._check()
         pre = self.preprocessing
-        if isinstance(data, (str, Path)):
-            data = load_measurements(data, channels=[pre.channel_of("target")], tachometer=False)
-        recs = list(data.records if isinstance(data, MeasurementSet) else data)
+        streamed = None
+        if isinstance(data, (str, Path)):              # read record by record beside the work on them
+            streamed = self._streamed(data, features=True)
+            recs = streamed[4]
+        else:
+            recs = list(data.records if isinstance(data, MeasurementSet) else data)
         if not recs:
             raise AssessorError("assess: no records")
         notes = check_records(recs, self.facts, "assess")
@@ -505,7 +538,7 @@ class Ensemble:
             notes.append(f"stage boundaries placed along the expected stage of the rig's adaptation records (the "
                          f"ordinal rule), which assumes those records covered the {self.n_classes_} stages in about "
                          "the archive's equal shares")
-        raw, rec, lab, prepared = self._raw(recs)
+        raw, rec, lab, prepared, _, features = streamed or self._streamed(recs, features=True)
         p = self._match(raw.mean(0))
         members = self._member_stages(raw)
         g = pairwise_agreement(members)
@@ -514,7 +547,7 @@ class Ensemble:
         k = self.n_classes_
         record_p = np.stack([p[rec == i].mean(0) for i in range(len(prepared))])
         expected = record_p @ np.arange(k)
-        order = check_order(self._features(prepared), expected, self.twin_trends_)
+        order = check_order(features, expected, self.twin_trends_)
         if time_ordered is False:
             idx, how = None, "not used"
         elif time_ordered:

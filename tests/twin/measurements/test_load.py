@@ -10,7 +10,7 @@ import pytest
 
 from twin.errors import MeasurementError, ParameterError, TwinError
 from twin.measurements import (ACCEPTED_UNITS, ARCHIVE_FORMAT, STANDARD_GRAVITY, MeasurementSet, Record,
-                               load_measurements)
+                               iter_measurements, load_measurements)
 
 FS = 10_000.0
 N = 2_000
@@ -196,6 +196,27 @@ def test_csv_without_rows_is_empty(write_csv, tmp_path):
     (tmp_path / "e.csv.yaml").write_text("sample_rate: 100\nunits: {x: V}\n")
     with pytest.raises(MeasurementError, match="empty record: 0 samples"):
         load_measurements(p)
+
+
+def test_records_one_at_a_time_are_the_loaded_ones(good_h5, write_h5, tmp_path):
+    loaded = load_measurements(good_h5, channels=["accel"], tachometer=False)
+    it = iter_measurements(good_h5, channels=["accel"], tachometer=False)
+    first = next(it)                                   # yielded before the rest of the file is read
+    streamed = [first, *it]
+    assert [r.name for r in streamed] == [r.name for r in loaded.records]
+    for a, b in zip(streamed, loaded.records):
+        assert np.array_equal(a["accel"], b["accel"]) and (a.sample_rate, a.label) == (b.sample_rate, b.label)
+    x = _noisy()
+    x[5] = np.nan
+    bad = write_h5(tmp_path / "b.h5", {"r1": {"channels": {"accel": (_noisy(), "m/s2")}, "attrs": {"sample_rate": FS}},
+                                       "r2": {"channels": {"accel": (x, "m/s2")}, "attrs": {"sample_rate": FS}}})
+    with pytest.raises(MeasurementError) as want:
+        load_measurements(bad)
+    seen = []
+    with pytest.raises(MeasurementError) as got:
+        for r in iter_measurements(bad):
+            seen.append(r.name)
+    assert seen == ["r1"] and got.value.problems == want.value.problems
 
 
 # --------------------------------------------------------------------------- sample errors
