@@ -532,3 +532,16 @@ def test_csv_short_row_and_nan_text(tmp_path):
         load_measurements(p)
     assert _problems(e) == ["column 'y' has 1 non-numeric cells; first at sample 2: ''",
                             "channel 'x' has 1 non-finite samples (NaN); first at index 1 (t = 0.0001 s)"]
+
+
+@pytest.mark.parametrize("up, down, n", [(256, 625, 3000), (2, 1, 501), (3, 7, 1000), (7, 3, 64), (1, 5, 999),
+                                         (5, 1, 3), (625, 256, 40)])
+def test_polyphase_resampling_is_scipys_resample_poly(up, down, n):
+    from scipy.signal import resample_poly
+
+    from twin.measurements.resample import anti_aliasing_filter, polyphase
+    x = np.cumsum(np.random.default_rng(n).standard_normal(n)) + 3.0       # a trend and an offset: the padding shows
+    ref = resample_poly(x, up, down, window=anti_aliasing_filter(up, down), padtype="line")
+    y = polyphase(x, up, down)
+    assert y.shape == ref.shape
+    np.testing.assert_allclose(y, ref, rtol=0, atol=1e-12 * np.abs(ref).max())
