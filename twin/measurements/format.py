@@ -308,7 +308,7 @@ def clipping_problems(channel: str, x: np.ndarray, unit: str) -> list[str]:
     for side, level in (("maximum", x.max()), ("minimum", x.min())):
         at = x == level
         count = int(at.sum())
-        run = _longest_run(at)
+        run = count if count <= 1 else _longest_run(at)       # a noisy signal's extreme: one sample
         if run >= CLIP_MIN_RUN or count > max(1.0, CLIP_MAX_FRACTION * n):
             out.append(f"channel '{channel}' is clipped at its {side} {float(level):.9g} {unit}".rstrip()
                        + f": {count} samples ({100.0 * count / n:.3g} %) at that level, "

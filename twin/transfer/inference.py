@@ -24,10 +24,10 @@ training), to float32 round-off (``tests/twin/transfer/test_inference.py``), wit
   and the pool is the elementwise maximum of the even and odd samples, whole contiguous rows of
   channels;
 * **windows in chunks** of ``chunk`` (bounded memory: the first layer's output of a 128-window
-  chunk is 4 MB), every member on the same chunk, under :func:`torch.inference_mode` (no autograd
-  bookkeeping);
-* **chunks in parallel** on ``threads`` worker threads, each running torch with one intra-op
-  thread.  On a 2-core machine that other work shares, torch's own two OpenMP threads wait for
+  chunk is 4 MB), under :func:`torch.inference_mode` (no autograd bookkeeping);
+* **chunks and members in parallel**: each member's pass over a chunk is one task (so the last
+  chunk's members still share the cores) on ``threads`` worker threads, each running torch with
+  one intra-op thread.  On a 2-core machine that other work shares, torch's own two OpenMP threads wait for
   each other at every layer and lose to a descheduled partner (with two other jobs running, the
   per-member path took 2.1 x as long with torch's 2 threads as with 1, trial of 2026-11-26);
   independent chunks do not wait.  torch's thread count is restored afterwards.
@@ -170,34 +170,33 @@ class StackedNetworks:
     def __len__(self) -> int:
         return len(self._members)
 
-    def _chunk(self, x):
-        """Probabilities (members, n, K) of one chunk x (n, 1, window) or (members, n, 1, window)."""
+    def _member(self, x, k: int):
+        """Probabilities (n, K) of member ``k`` on one chunk x (n, 1, window)."""
         import torch.nn.functional as F
         torch = self._torch
-        out = []
-        for k, (convs, lw, lb, cw, cb) in enumerate(self._members):
-            # (n, channels, 1, samples) with the channels innermost ("channels last"): oneDNN's fast
-            # layout for narrow convolutions, and the pool's pairs are whole contiguous rows
-            h = (x if x.dim() == 3 else x[k]).unsqueeze(2).contiguous(memory_format=torch.channels_last)
-            for w, b, pad, block in convs:
-                if block > 1:                     # the same memory seen as blocks of samples (_blocked)
-                    n, c, _, length = h.shape
-                    h = h.as_strided((n, block * c, 1, length // block), (length * c, 1, length * c, block * c))
-                    h = F.conv2d(h, w, b, padding=(0, pad)).contiguous(memory_format=torch.channels_last)
-                    c = w.shape[0] // block
-                    h = h.as_strided((n, c, 1, length), (length * c, 1, length * c, c))
-                else:
-                    h = F.conv2d(h, w, b, padding=(0, pad))
-                length = h.shape[-1] - h.shape[-1] % 2
-                h = torch.maximum(h[..., 0:length:2], h[..., 1:length:2]).relu_() \
-                    .contiguous(memory_format=torch.channels_last)
-            g = F.linear(h.permute(0, 2, 3, 1).flatten(1), lw, lb).relu_()
-            out.append(self._torch.softmax(F.linear(g, cw, cb), 1))
-        return self._torch.stack(out).numpy()
+        convs, lw, lb, cw, cb = self._members[k]
+        # (n, channels, 1, samples) with the channels innermost ("channels last"): oneDNN's fast
+        # layout for narrow convolutions, and the pool's pairs are whole contiguous rows
+        h = x.unsqueeze(2).contiguous(memory_format=torch.channels_last)
+        for w, b, pad, block in convs:
+            if block > 1:                         # the same memory seen as blocks of samples (_blocked)
+                n, c, _, length = h.shape
+                h = h.as_strided((n, block * c, 1, length // block), (length * c, 1, length * c, block * c))
+                h = F.conv2d(h, w, b, padding=(0, pad)).contiguous(memory_format=torch.channels_last)
+                c = w.shape[0] // block
+                h = h.as_strided((n, c, 1, length), (length * c, 1, length * c, c))
+            else:
+                h = F.conv2d(h, w, b, padding=(0, pad))
+            length = h.shape[-1] - h.shape[-1] % 2
+            h = torch.maximum(h[..., 0:length:2], h[..., 1:length:2]).relu_() \
+                .contiguous(memory_format=torch.channels_last)
+        g = F.linear(h.permute(0, 2, 3, 1).flatten(1), lw, lb).relu_()
+        return torch.softmax(F.linear(g, cw, cb), 1)
 
-    def _run(self, x: np.ndarray) -> np.ndarray:
+    def _run(self, x: np.ndarray, k: int) -> np.ndarray:
+        """Member ``k``'s probabilities (n, K) of windows x (n, window) or (members, n, window)."""
         with self._torch.inference_mode():
-            return self._chunk(self._torch.from_numpy(x).unsqueeze(-2))
+            return self._member(self._torch.from_numpy(x if x.ndim == 2 else x[k]).unsqueeze(1), k).numpy()
 
     def _checked(self, x) -> np.ndarray:
         m = len(self._members)
@@ -270,13 +269,16 @@ class Stream:
                 need = 0
         self._n_pending -= n
         x = taken[0] if len(taken) == 1 else np.concatenate(taken, axis=-2)
-        self._parts.append(self._pool.submit(self._nets._run, x) if self._pool else self._nets._run(x))
+        # one task per member: the last chunk's members still spread over the workers
+        run = self._nets._run
+        self._parts.append([self._pool.submit(run, x, k) if self._pool else run(x, k) for k in range(len(self._nets))])
 
     def __exit__(self, exc_type, exc, tb) -> None:
         try:
             if exc_type is None and self._n_pending:
                 self._submit(self._n_pending)
-            parts = [p.result() if self._pool else p for p in self._parts] if exc_type is None else []
+            parts = [np.stack([p.result() if self._pool else p for p in ps]) for ps in self._parts] \
+                if exc_type is None else []
         finally:
             if self._pool is not None:
                 self._pool.shutdown(wait=True, cancel_futures=exc_type is not None)
