@@ -14,10 +14,11 @@ each is reported, the machine being shared):
   tachometer), every record resampled with its anti-aliasing filter designed again, windowed and
   represented, then each member's own ``Assessor._forward`` (batches of 256 under
   ``torch.no_grad``, torch's default threads);
-* **after** -- ``Ensemble._raw`` now: the file read without the tachometer, the filter designed
-  once per rate, the records resampled and represented one by one on worker threads while the
-  members' networks, folded once per ensemble, run together on the windows already represented
-  (:mod:`twin.transfer.inference`);
+* **after** -- ``Ensemble._raw`` now: the file read record by record without the tachometer,
+  each record resampled (polyphase filter as matrix products, designed once per rate) and
+  represented (float32 spectra) on worker threads as soon as it is read, while the members'
+  networks, folded once per ensemble, run on the windows already represented, one task per
+  member and chunk (:mod:`twin.transfer.inference`);
 * **assess** -- the whole ``Ensemble.assess`` of the file (2 members and more) with each path:
   reading, preprocessing, networks, class-prior rule, agreement, order check.
 
@@ -46,12 +47,20 @@ def machine() -> str:
 
 
 def _reference_raw(self, data, what: str = "assess"):
-    """``Ensemble._raw`` as it was: all records prepared, then each member's own forward pass."""
-    from twin.measurements.resample import _filter
+    """``Ensemble._raw`` as it was: all records prepared (scipy's ``resample_poly``), then each
+    member's own forward pass."""
+    from scipy.signal import resample_poly
+
+    import twin.measurements.resample as rs
     from twin.transfer.preprocess import windows_of
-    _filter.cache_clear()                       # the filter was designed for every record
-    first = self.members[0]
-    prepared = first._prepared(data, None, what, "target")
+    rs._filter.cache_clear()                     # the filter was designed for every record
+    fast, rs.polyphase = rs.polyphase, lambda x, up, down: resample_poly(x, up, down, window=rs._filter(up, down),
+                                                                         padtype="line")
+    try:
+        first = self.members[0]
+        prepared = first._prepared(data, None, what, "target")
+    finally:
+        rs.polyphase = fast
     raw, rec, lab = windows_of(prepared, self.preprocessing, what)
     return np.stack([m._forward(m.target_normaliser_(raw))[1] for m in self.members]), rec, lab, prepared
 
