@@ -410,7 +410,7 @@ class Ensemble:
 
         def represent(piece):
             p = piece if isinstance(piece[0], Prepared) else first._prepared(piece, None, what, "target")
-            raw, rec, lab = windows_of(p, pre, what, np.float32)
+            raw, rec, lab = windows_of(p, pre, what)
             return p, normalise(raw), rec, lab, self._features(p) if features else None
 
         prepared, recs, labs, feats = [], [], [], []

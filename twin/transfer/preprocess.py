@@ -218,11 +218,11 @@ class Prepared:
     label: int | None
 
 
-def window_signal(x: np.ndarray, window: int, hop: int, dtype=np.float64) -> np.ndarray:
-    """Windows of a 1-D signal, shape (n_windows, window) of ``dtype``; (0, window) if it is too short."""
-    x = np.asarray(x, dtype=dtype)
+def window_signal(x: np.ndarray, window: int, hop: int) -> np.ndarray:
+    """Windows of a 1-D signal, shape (n_windows, window); (0, window) if it is too short."""
+    x = np.asarray(x, dtype=np.float64)
     if x.size < window:
-        return np.empty((0, window), dtype=dtype)
+        return np.empty((0, window))
     n = (x.size - window) // hop + 1
     idx = np.arange(window)[None, :] + hop * np.arange(n)[:, None]
     return x[idx]
@@ -253,23 +253,12 @@ def log_spectrum(w: np.ndarray, time_bandwidth: float = 4.0) -> np.ndarray:
     ``2 NW / T`` (80 Hz for a 0.1 s window, below the 380 Hz mesh-line spacing at 20 Hz shaft
     speed).  ``time_bandwidth`` 0: one Hann taper (assessors saved before version 3).
 
-    float32 windows give a float32 spectrum, computed in float32 (``scipy.fft``, all tapers in
-    one call; 2.3 x faster than float64, within 4e-7 of it for unit-variance windows): what
-    inference feeds its float32 networks.  Anything else is computed in float64.
-
     Zero-padded to twice the window, so there are ``window`` bins from 0 Hz up to (not including)
     the Nyquist frequency, spaced ``sample_rate / (2 window)``; the value is half the log power,
     i.e. the log magnitude.  The small absolute floor only keeps an all-zero window finite.
     """
-    w = np.asarray(w)
-    w = w if w.dtype == np.float32 else w.astype(np.float64)
+    w = np.asarray(w, dtype=np.float64)
     n = w.shape[-1]
-    if w.dtype == np.float32 and time_bandwidth != 0:
-        import scipy.fft
-        tapers = _slepian_tapers(n, float(time_bandwidth)).astype(np.float32)
-        spec = scipy.fft.rfft(w[None] * tapers.reshape(len(tapers), *[1] * (w.ndim - 1), n), n=2 * n, axis=-1)[..., :n]
-        power = (spec.real ** 2 + spec.imag ** 2).sum(0)
-        return 0.5 * np.log(power / np.float32(len(tapers)) + np.float32(1e-24))
     if time_bandwidth == 0:
         mag = np.abs(np.fft.rfft(w * np.hanning(n), n=2 * n, axis=-1))[..., :n]
         return np.log(mag + 1e-12)
@@ -431,12 +420,9 @@ def prepare(data, pre: Preprocessing, what: str = "data", domain: str = "source"
     return out
 
 
-def windows_of(prepared: Sequence[Prepared], pre: Preprocessing, what: str = "data", dtype=np.float64
+def windows_of(prepared: Sequence[Prepared], pre: Preprocessing, what: str = "data"
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Steps 3-4: (windows (n, window) float32, record index (n,), label (n,) with -1 = unknown).
-
-    ``dtype``: the precision of the representation before it is rounded to float32 (float32: the
-    faster spectra of :func:`log_spectrum`, for inference).
 
     Raises
     ------
@@ -445,7 +431,7 @@ def windows_of(prepared: Sequence[Prepared], pre: Preprocessing, what: str = "da
     """
     ws, rec, lab = [], [], []
     for i, p in enumerate(prepared):
-        w = window_signal(p.signal, pre.window, pre.hop, dtype)
+        w = window_signal(p.signal, pre.window, pre.hop)
         if w.shape[0] == 0:
             raise AssessorError(f"{what}: record '{p.name}' has {p.signal.size} samples at "
                                 f"{pre.sample_rate:g} Hz, shorter than one window of {pre.window}")
