@@ -16,7 +16,7 @@ each is reported, the machine being shared):
   ``torch.no_grad``, torch's default threads);
 * **after** -- ``Ensemble._raw`` now: the file read record by record without the tachometer,
   each record resampled (polyphase filter as matrix products, designed once per rate) and
-  represented (float32 spectra) on worker threads as soon as it is read, while the members'
+  represented on worker threads as soon as it is read, while the members'
   networks, folded once per ensemble, run on the windows already represented, one task per
   member and chunk (:mod:`twin.transfer.inference`);
 * **assess** -- the whole ``Ensemble.assess`` of the file (2 members and more) with each path:
