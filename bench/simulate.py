@@ -11,6 +11,10 @@
 A second table gives the bare ``doStep`` of the variant with the gear's own tooth errors
 (``GearTwin.Variants.Gearbox21WheelErrors``) and of the model with broadband excitation and
 sensor paths (``GearTwin.Gearbox21Measured``) against the base model's, in the same run.
+``--against DIR [DIR ...]`` adds the base model and that variant built from other Modelica trees
+(an older revision: ``git archive REV modelica | tar -x -C DIR``). On a shared machine wall times
+of separate runs drift with the load, so these are compared by CPU time: all FMUs are loaded
+at once and advanced in turn by 0.2 s chunks (25 rounds); the median chunk, scaled to the span.
 
 Accuracy is measured over the first 0.1 s against a converged run of the same FMU with a
 step of 6.25e-7 s (RK4 error at 1.25e-6 s is already < 1e-6, see the model readme).
@@ -37,11 +41,32 @@ def _rel(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.sqrt(np.mean((a - b) ** 2)) / np.sqrt(np.mean(b ** 2)))
 
 
+def _interleaved(fmu_class, paths, step: float, span: float, chunk: float = 0.2, rounds: int = 25) -> list[float]:
+    """CPU time [s] of a bare run over ``span`` for each FMU: all loaded at once and advanced in
+    turn by ``chunk`` seconds, ``rounds`` times; the median chunk, scaled to ``span``."""
+    fmus = [fmu_class(p).__enter__() for p in paths]
+    try:
+        times = [[] for _ in fmus]
+        for fmu in fmus:
+            fmu.setup(parameters={"solver.step_size": step})
+        for _ in range(rounds):
+            for fmu, t in zip(fmus, times):
+                t0 = time.process_time()
+                fmu.step(chunk)
+                t.append(time.process_time() - t0)
+        return [float(np.median(t)) * span / chunk for t in times]
+    finally:
+        for fmu in fmus:
+            fmu.__exit__(None, None, None)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--stop-time", type=float, default=10.0)
     ap.add_argument("--ivp-span", type=float, default=0.05)
     ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--against", type=Path, nargs="+", default=[],
+                    help="also time the models built from DIR/modelica (other revisions), interleaved")
     args = ap.parse_args()
 
     from fmu_build import build_fmu
@@ -83,6 +108,13 @@ def main() -> None:
     # interleaved, so that a change of machine load hits both models alike
     variant_rows = [(step, bare_step(fmu_path, step), bare_step(variant_path, step), bare_step(measured_path, step))
                     for step in (5e-6, 1e-5)]
+    against_rows = []
+    models = ("GearTwin.Gearbox21", "GearTwin.Variants.Gearbox21WheelErrors")
+    for m, here in zip(models, (fmu_path, variant_path)):
+        if args.against:
+            others = [build_fmu(m, d / "modelica", REPO / "build" / "against" / str(k))
+                      for k, d in enumerate(args.against)]
+            against_rows.append((m, _interleaved(FMU, [here, *others], 5e-6, T)))
 
     # solve_ivp on the numpy equations (short span, scaled)
     params = ref.GearboxParams()
@@ -132,7 +164,13 @@ def main() -> None:
               f"{PAPER_SIMULINK_S / variant:.0f}x |")
         print(f"| GearTwin.Gearbox21Measured (broadband on, sensor paths) | {step:g} s | {measured:.2f} | "
               f"{measured / base:.2f}x | {PAPER_SIMULINK_S / measured:.0f}x |")
-
+    if against_rows:
+        trees = " | ".join(f"built from {d} [s]" for d in args.against)
+        print(f"\n| model, bare doStep, 5e-06 s, CPU time | built from this tree [s] | {trees} |")
+        print("|---|---|" + "---|" * len(args.against))
+        for m, (here, *others) in against_rows:
+            cells = " | ".join(f"{o:.2f} ({o / here:.2f}x)" for o in others)
+            print(f"| {m} | {here:.2f} | {cells} |")
 
 if __name__ == "__main__":
     main()
