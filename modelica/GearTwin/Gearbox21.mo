@@ -228,8 +228,8 @@ model Gearbox21 "21-DOF lumped model of the UNSW spur-gear test rig (Feng et al.
   Real support_output_vx(unit = "m/s") = 0 "Time derivative of support_output_x";
   Real support_output_vy(unit = "m/s") = 0 "Time derivative of support_output_y";
 equation
-  // Tooth-pair bookkeeping without events: the mesh phase is wrapped with atan2, the tooth
-  // identity is read from the angle of the last entered tooth on the unit circle.
+  // Tooth-pair bookkeeping without events: the mesh phase is wrapped with atan2; the angle of
+  // the last entered tooth counts the completed mesh cycles k, which name the teeth in contact.
   mesh_angle = z1 * theta5 + mesh_phase0;
   cycle_fraction = atan2(sin(mesh_angle - GearTwin.pi), cos(mesh_angle - GearTwin.pi)) / (2 * GearTwin.pi) + 0.5;
   tooth_angle = (mesh_angle - 2 * GearTwin.pi * cycle_fraction) / z1;
