@@ -21,6 +21,7 @@ import numpy as np
 
 from twin.errors import BuildError
 
+from . import lookup
 from .flat import Decl, FlatModel
 
 _UNARY = {
@@ -73,16 +74,6 @@ def _is_sym(v) -> bool:
     return isinstance(v, (ca.SX, ca.MX))
 
 
-@dataclass
-class _Lookup:
-    """``array[index]`` with a time-varying Integer index, standing in as ``placeholder``."""
-
-    name: str
-    array: list           # the array's scalars (SX or numbers)
-    index: object         # 1-based index (SX, integer valued)
-    placeholder: ca.SX
-
-
 class _Env:
     """Evaluation environment: name -> value (float, int, SX, or list thereof)."""
 
@@ -91,8 +82,8 @@ class _Env:
         self.symbolic = symbolic
         self.locals: list[dict] = []
         # While equations are evaluated: the array lookups with a time-varying index, resolved
-        # into calls of a lookup function once the equations are solved (see _Lookup).
-        self.lookups: list[_Lookup] | None = None
+        # into calls of a lookup function once the equations are solved (fmu_build.lookup).
+        self.lookups: list[lookup.Lookup] | None = None
 
     def lookup(self, name: str):
         for scope in reversed(self.locals):
@@ -151,7 +142,7 @@ def evaluate(node, env: _Env):
         for k, s in enumerate(subs):
             idx = evaluate(s, env)
             if _is_sym(idx) and env.lookups is not None and k == len(subs) - 1 and isinstance(val, list):
-                return _lookup(name, val, idx, env)
+                return lookup.placeholder(name, val, idx, env.lookups)
             if _is_sym(idx) or not float(idx).is_integer():
                 raise BuildError(f"index of {name!r} must be a structural integer, got {idx}")
             if not isinstance(val, list):
@@ -281,7 +272,7 @@ def _call(node, env: _Env):
         if any(_is_sym(v) for v in _flatten(vals)):
             # rumoca drops noEvent(); the subset check has made sure that each of these calls
             # on a time-varying argument sits inside one, so no event is wanted.
-            return _elementwise(lambda a, b: _integer_function(fname, a, b), vals[0],
+            return _elementwise(lambda a, b: lookup.integer_function(fname, a, b), vals[0],
                                 vals[1] if len(vals) > 1 else 0)
         a = vals[0]
         if fname == "div":
@@ -308,53 +299,6 @@ def _call(node, env: _Env):
             out = [out for _ in range(int(d))]
         return out
     raise BuildError(f"function {fname}() is not supported")
-
-
-def _integer_function(fname: str, a, b):
-    """div, mod, rem, floor, ceil, integer of a time-varying value, as in Modelica (no events)."""
-    a = ca.SX(a)
-    if fname in ("floor", "integer"):
-        return ca.floor(a)
-    if fname == "ceil":
-        return ca.ceil(a)
-    quotient = ca.floor(a / b) if fname == "mod" else ca.sign(a / b) * ca.floor(ca.fabs(a / b))
-    if fname == "div":
-        return quotient
-    return a - quotient * b
-
-
-_INTEGER_OPS = {ca.OP_ADD, ca.OP_SUB, ca.OP_MUL, ca.OP_NEG, ca.OP_FMIN, ca.OP_FMAX, ca.OP_FABS}
-
-
-def _integer_valued(e: ca.SX) -> bool:
-    """Whether an index expression takes only integer values: integer constants, structural
-    integers and floor/ceil combined by + - * min max abs (what integer(), mod() and Integer
-    arithmetic evaluate to)."""
-    if e.is_constant():
-        return float(e).is_integer()
-    if e.is_symbolic():
-        return False
-    op = e.op()
-    if op in (ca.OP_FLOOR, ca.OP_CEIL):
-        return True
-    if op == ca.OP_IF_ELSE_ZERO:
-        return _integer_valued(e.dep(1))
-    if op in _INTEGER_OPS:
-        return all(_integer_valued(e.dep(i)) for i in range(e.n_dep()))
-    return False
-
-
-def _lookup(name: str, array: list, index, env: _Env):
-    """``array[index]`` for a time-varying Integer index: a placeholder symbol now, a lookup
-    call (constant cost, whatever the length of the array) once the equations are solved."""
-    if any(isinstance(v, list) for v in array):
-        raise BuildError(f"{name!r}: a time-varying index is supported on 1-D arrays only")
-    if not _integer_valued(ca.SX(index)):
-        raise BuildError(f"index of {name!r} must be an Integer expression (structural, or "
-                         f"noEvent(integer(...)) of a time-varying one), got {index}")
-    placeholder = ca.SX.sym(f"{name}[_lookup{len(env.lookups)}]")
-    env.lookups.append(_Lookup(name, list(array), index, placeholder))
-    return placeholder
 
 
 # ----------------------------------------------------------------------------------------------
@@ -665,17 +609,13 @@ def build_ode(flat: FlatModel) -> OdeModel:
     # Parameter-only subexpressions (sin(alpha), products of parameters, ...) are moved into the
     # derived function, which runs once per parameter change instead of 4x per RK4 step.
     # Array lookups with a time-varying index: their indices (and arrays) in the same terms.
-    lk_exprs = []
-    for lk in lookups:
-        lk_exprs += [ca.SX(lk.index) - 1, *(ca.SX(v) for v in lk.array)]
-    if lookups:
-        lk_exprs = ca.substitute(lk_exprs, subs_syms, resolved)
+    lk_exprs = ca.substitute(lookup.operands(lookups), subs_syms, resolved) if lookups else []
     dynamic = {s.__hash__() for s in [t, *x_syms, *u_syms, *(lk.placeholder for lk in lookups)]}
     rebuilt, h_syms, h_exprs = hoist_static([*xdot, *y_exprs, *lk_exprs], dynamic)
     n_x, n_y = len(xdot), len(y_exprs)
     xdot, y_exprs = rebuilt[:n_x], rebuilt[n_x:n_x + n_y]
     if lookups:
-        xdot, y_exprs = _resolve_lookups(lookups, rebuilt[n_x + n_y:], xdot, y_exprs)
+        xdot, y_exprs = lookup.resolve(lookups, rebuilt[n_x + n_y:], xdot, y_exprs)
     if h_exprs:
         h_in_p = ca.substitute(h_exprs, q_syms, q_final) if q_syms else h_exprs
         q_final = [*q_final, *h_in_p]
@@ -796,50 +736,6 @@ def hoist_static(exprs: list, dynamic: set[int]) -> tuple[list, list, list]:
         r, dyn = memo[ca.SX(root).__hash__()]
         out.append(r if dyn else replacement(r, False))
     return out, h_syms, h_exprs
-
-
-def _lookup_function(n: int, m: int) -> ca.Function:
-    """``(array[n], index[m]) -> array[index]`` with 0-based indices, in constant time per index
-    (CasADi's parametric indexing of MX; an index out of range gives NaN, which fails the step)."""
-    array, index = ca.MX.sym("array", n), ca.MX.sym("index", m)
-    return ca.Function(f"lookup_{n}_{m}", [array, index], [array[index]], ["array", "index"], ["value"],
-                       {"never_inline": True})
-
-
-def _resolve_lookups(lookups: list[_Lookup], exprs: list, xdot: list, y_exprs: list):
-    """Replace the lookup placeholders by calls of :func:`_lookup_function`: one call per array
-    for all the lookups into it whose indices are known, so each array is passed once per
-    evaluation.  An index that needs its own lookup's value is an algebraic loop."""
-    parts, k = [], 0
-    for lk in lookups:
-        parts.append((exprs[k], exprs[k + 1:k + 1 + len(lk.array)]))
-        k += 1 + len(lk.array)
-    pending = list(range(len(lookups)))
-    while pending:
-        waiting = ca.vertcat(*(lookups[i].placeholder for i in pending))
-        ready = [i for i in pending if not ca.depends_on(ca.vertcat(*parts[i][1], parts[i][0]), waiting)]
-        if not ready:
-            raise BuildError("algebraic loop through an array index: the index of "
-                             + ", ".join(sorted({lookups[i].name for i in pending}))
-                             + " depends on the looked-up value")
-        groups: dict[tuple, list[int]] = {}
-        for i in ready:
-            key = tuple(float(e) if e.is_constant() else e.__hash__() for e in parts[i][1])
-            groups.setdefault(key, []).append(i)
-        syms, vals = [], []
-        for members in groups.values():
-            array = ca.vertcat(*parts[members[0]][1])
-            index = ca.vertcat(*(parts[i][0] for i in members))
-            value = _lookup_function(array.numel(), index.numel())(array, index)
-            syms += [lookups[i].placeholder for i in members]
-            vals += [value[j] for j in range(len(members))]
-        pending = [i for i in pending if i not in ready]
-        xdot = ca.substitute(xdot, syms, vals)
-        y_exprs = ca.substitute(y_exprs, syms, vals)
-        for i in pending:
-            index, *array = ca.substitute([parts[i][0], *parts[i][1]], syms, vals)
-            parts[i] = (index, array)
-    return xdot, y_exprs
 
 
 def _eval_with_der(node, env, der_eval):
