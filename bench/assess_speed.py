@@ -74,6 +74,10 @@ def ensembles(loaded, members):
     class Reference(Ensemble):
         _raw = _reference_raw
 
+        def _streamed(self, data, what="assess", features=False):
+            raw, rec, lab, prepared = self._raw(data, what)
+            return raw, rec, lab, prepared, None, self._features(prepared) if features else None
+
         def assess(self, data, **kw):
             from twin.measurements import load_measurements
             if isinstance(data, (str, Path)):        # read as before: the tachometer too
