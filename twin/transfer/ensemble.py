@@ -377,66 +377,9 @@ class Ensemble:
 
     def _streamed(self, data, what: str = "assess", features: bool = False):
         """:meth:`_raw`, the records read from a path (None otherwise) and, with ``features``,
-        the records' order-check features (:func:`~twin.transfer.order.record_features`).
-
-        A file is read record by record; each record is resampled, represented (and its
-        features computed) on worker threads as soon as it is read, once for all members, while
-        the members' networks run on the windows already represented
-        (:mod:`twin.transfer.inference`): the two cores share reading, preparing and the networks.
-        """
-        from collections import deque
-        from concurrent.futures import ThreadPoolExecutor
-
-        from twin.measurements import MeasurementSet, iter_measurements
-        from twin.transfer.preprocess import Prepared, windows_of
-        first, pre = self.members[0], self.preprocessing
-        records = None
-        if isinstance(data, (str, Path)):
-            records = []
-
-            def read(path):
-                for r in iter_measurements(path, channels=[pre.channel_of("target")], tachometer=False):
-                    records.append(r)
-                    yield [r]
-            pieces = read(data)
-        else:
-            if isinstance(data, MeasurementSet):
-                data = list(data.records)
-            if isinstance(data, (list, tuple)) and data and not isinstance(data[0], np.ndarray):
-                pieces = [list(data[i:i + 1]) for i in range(len(data))]
-            else:                                  # window arrays, archives: prepared (and judged) whole
-                pieces = [first._prepared(data, None, what, "target")]
-        stacked, normalise = self._networks()
-
-        def represent(piece):
-            p = piece if isinstance(piece[0], Prepared) else first._prepared(piece, None, what, "target")
-            raw, rec, lab = windows_of(p, pre, what)
-            return p, normalise(raw), rec, lab, self._features(p) if features else None
-
-        prepared, recs, labs, feats = [], [], [], []
-        # numpy's FFTs, scipy's filters and torch release the GIL: the main thread reads while
-        # worker threads prepare the records read, handed to the networks in their order
-        with stacked.stream() as stream, ThreadPoolExecutor(max_workers=stacked.threads) as pool:
-            queue = deque()
-
-            def take():
-                p, x, rec, lab, f = queue.popleft().result()
-                stream.add(x)
-                recs.append(rec + len(prepared))
-                labs.append(lab)
-                feats.append(f)
-                prepared.extend(p)
-
-            for piece in pieces:
-                queue.append(pool.submit(represent, piece))
-                while queue and queue[0].done():
-                    take()
-            while queue:
-                take()
-        if not prepared:
-            raise AssessorError(f"{what}: no records")
-        f = {k: np.concatenate([v[k] for v in feats]) for k in feats[0]} if features else None
-        return stream.result(), np.concatenate(recs), np.concatenate(labs), prepared, records, f
+        the records' order-check features: :func:`twin.transfer.inference.assess_stream`."""
+        from twin.transfer.inference import assess_stream
+        return assess_stream(self, data, what, features)
 
     def _networks(self):
         """(the members' folded networks, the windows' domain normalisation for them)."""

@@ -5,6 +5,7 @@
     from twin.transfer.inference import StackedNetworks
     fast = StackedNetworks([m.network_ for m in ensemble.members])
     p = fast.probabilities(x)            # (members, n, K) stage probabilities of windows x (n, window)
+    p, rec, lab, prepared, records, features = assess_stream(ensemble, "rig.h5", features=True)
 
 It computes what ``Assessor._forward`` computes for each member (the reference path, kept for
 training), to float32 round-off (``tests/twin/transfer/test_inference.py``), with less work:
@@ -39,14 +40,16 @@ from __future__ import annotations
 
 import os
 import threading
+from collections import deque
 from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
 
 import numpy as np
 
 from twin.transfer.errors import AssessorError
 
-__all__ = ["DEFAULT_CHUNK", "StackedNetworks", "Stream", "default_threads"]
+__all__ = ["DEFAULT_CHUNK", "StackedNetworks", "Stream", "assess_stream", "default_threads"]
 
 DEFAULT_CHUNK = 128
 # samples per block of each convolution layer (_blocked), 1 = the plain convolution: the first
@@ -293,3 +296,67 @@ class Stream:
         if self._result is None:
             raise AssessorError("Stream.result: the stream has not finished (use it as a context)")
         return self._result
+
+
+def assess_stream(ensemble, data, what: str = "assess", features: bool = False):
+    """An ensemble's raw network probabilities on the windows of ``data`` (members, n, K), record
+    index (n,), labels (n,), prepared records, the records read from a path (None otherwise)
+    and, with ``features``, the records' order-check features
+    (:func:`~twin.transfer.order.record_features`).
+
+    A file is read record by record; each record is resampled, represented (and its
+    features computed) on worker threads as soon as it is read, once for all members, while
+    the members' networks run on the windows already represented
+    (:class:`StackedNetworks`): the two cores share reading, preparing and the networks.
+    """
+    from twin.measurements import MeasurementSet, iter_measurements
+    from twin.transfer.preprocess import Prepared, windows_of
+    first, pre = ensemble.members[0], ensemble.preprocessing
+    records = None
+    if isinstance(data, (str, Path)):
+        records = []
+
+        def read(path):
+            for r in iter_measurements(path, channels=[pre.channel_of("target")], tachometer=False):
+                records.append(r)
+                yield [r]
+        pieces = read(data)
+    else:
+        if isinstance(data, MeasurementSet):
+            data = list(data.records)
+        if isinstance(data, (list, tuple)) and data and not isinstance(data[0], np.ndarray):
+            pieces = [list(data[i:i + 1]) for i in range(len(data))]
+        else:                                  # window arrays, archives: prepared (and judged) whole
+            pieces = [first._prepared(data, None, what, "target")]
+    stacked, normalise = ensemble._networks()
+
+    def represent(piece):
+        p = piece if isinstance(piece[0], Prepared) else first._prepared(piece, None, what, "target")
+        raw, rec, lab = windows_of(p, pre, what)
+        return p, normalise(raw), rec, lab, ensemble._features(p) if features else None
+
+    prepared, recs, labs, feats = [], [], [], []
+    # numpy's FFTs, scipy's filters and torch release the GIL: the main thread reads while
+    # worker threads prepare the records read, handed to the networks in their order
+    with stacked.stream() as stream, ThreadPoolExecutor(max_workers=stacked.threads) as pool:
+        queue = deque()
+
+        def take():
+            p, x, rec, lab, f = queue.popleft().result()
+            stream.add(x)
+            recs.append(rec + len(prepared))
+            labs.append(lab)
+            feats.append(f)
+            prepared.extend(p)
+
+        for piece in pieces:
+            queue.append(pool.submit(represent, piece))
+            while queue and queue[0].done():
+                take()
+        while queue:
+            take()
+    if not prepared:
+        raise AssessorError(f"{what}: no records")
+    f = {k: np.concatenate([v[k] for v in feats]) for k in feats[0]} if features else None
+    return stream.result(), np.concatenate(recs), np.concatenate(labs), prepared, records, f
+
