@@ -102,7 +102,7 @@ def measured_operating(measured: np.ndarray, sample_rate: float, nominal_speed: 
 
 
 def simulate_at(fmu_path, parameters: Mapping[str, float], op: Operating, n: int,
-                channels: str | Sequence[str]) -> np.ndarray:
+                channels: str | Sequence[str], *, retune: bool = True) -> np.ndarray:
     """Model signal at the operating point, after ``op.settle`` s, with the pinion at ``op.shaft_hz``.
 
     Returns (n,) for one channel name, (n, len(channels)) for a list; the first channel must be a
@@ -110,13 +110,15 @@ def simulate_at(fmu_path, parameters: Mapping[str, float], op: Operating, n: int
     slip of the loaded motor; an effect that adds losses (tooth friction) or torque slows the shaft
     a little more, and at the 13th mesh harmonic a few mHz of shaft speed already move a line by
     a bin. So the shaft speed of the result is read off its gear-mesh line and, if it is off by
-    more than 1 mHz, the run is repeated with the drive corrected by that amount.
+    more than 1 mHz, the run is repeated with the drive corrected by that amount. ``retune=False``
+    runs once at ``op.drive_hz`` (a short search run: 1 s of signal cannot resolve 1 mHz, the
+    zero-padded gear-mesh bin is 2.5 mHz of shaft speed at 50 kHz).
     """
-    return simulate_settled(fmu_path, parameters, op, n, channels)[1]
+    return simulate_settled(fmu_path, parameters, op, n, channels, retune=retune)[1]
 
 
 def simulate_settled(fmu_path, parameters: Mapping[str, float], op: Operating, n: int,
-                     channels: str | Sequence[str]) -> tuple[Operating, np.ndarray]:
+                     channels: str | Sequence[str], *, retune: bool = True) -> tuple[Operating, np.ndarray]:
     """:func:`simulate_at`, also returning the operating point with the drive command that gave
     the measured shaft speed: runs of the same model started from it need no second run."""
     from dataclasses import replace
@@ -131,7 +133,7 @@ def simulate_settled(fmu_path, parameters: Mapping[str, float], op: Operating, n
         block = simulate_operating_point(fmu_path, drive, op.load, parameters=parameters, settle=op.settle,
                                          duration=n / op.sample_rate, channels=names,
                                          output_interval=1.0 / op.sample_rate)[:n]
-        if attempt or not np.all(np.isfinite(block)):
+        if attempt or not retune or not np.all(np.isfinite(block)):
             break
         error = op.shaft_hz - estimate_shaft_hz(block[:, 0], op.sample_rate, op.shaft_hz, op.teeth)
         if abs(error) <= 1e-3:

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -37,6 +37,11 @@ class TrialSpec:
     polish_only: bool = False
     # calibrated values the related parameters stay within +-RELATED_SPAN of (default: ``related``)
     related_anchor: dict = field(default_factory=dict)
+    # the search runs on the last ``search_samples`` samples of ``measured`` at the RK4 step
+    # ``search_step`` [s], without the drive's retuning run; the values it finds are then scored
+    # once on the whole stretch at the operating point's step (None, None: search on that directly)
+    search_samples: int | None = None
+    search_step: float | None = None
 
 
 class _Objective:
@@ -60,9 +65,10 @@ class _Objective:
         return float(np.sqrt(np.mean((lp - lm) ** 2)))
 
 
-def simulate(fmu_path, parameters: Mapping[str, float], op: Operating, n: int, channel: str) -> np.ndarray:
+def simulate(fmu_path, parameters: Mapping[str, float], op: Operating, n: int, channel: str, *,
+             retune: bool = True) -> np.ndarray:
     """Model signal (n,) at the measured operating point (:func:`twin.operating.simulate_at`)."""
-    return simulate_at(fmu_path, parameters, op, n, channel)
+    return simulate_at(fmu_path, parameters, op, n, channel, retune=retune)
 
 
 def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int, np.ndarray]:
@@ -82,8 +88,13 @@ def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int, np.ndarra
     from twin.effects.catalogue import RELATED_SPAN
 
     eff = CATALOGUE[spec.effect]
-    objective = _Objective(spec.measured, spec.operating.sample_rate)
     n = spec.measured.size
+    m = min(n, spec.search_samples or n)
+    op = spec.operating
+    if spec.search_step is not None and op.solver_step is not None:
+        op = replace(op, solver_step=spec.search_step)
+    short = m < n or op != spec.operating        # search on a shorter or coarser run, score on the whole
+    objective = _Objective(spec.measured[-m:], spec.operating.sample_rate)
     fixed = dict(spec.parameters)
     params = list(eff.fit)
     free = [p for p in params if p.guess is None]
@@ -113,7 +124,7 @@ def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int, np.ndarra
             count += 1
             try:
                 sim = simulate(spec.fmu_path, {**fixed, **base, **{eff.parameter(k): v for k, v in values.items()}},
-                               spec.operating, n, spec.channel)
+                               op, m, spec.channel, retune=not short)
                 cache[key] = (objective(sim), sim)
             except Exception:  # a diverging trial scores badly; it does not end the diagnosis
                 cache[key] = (1e3, None)
@@ -168,7 +179,16 @@ def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int, np.ndarra
     val = lsd(values, base)
     fitted = {eff.parameter(k): float(v) for k, v in values.items()}
     fitted.update(base)
-    return fitted, val, count, cache[key_of(values, base)][1]
+    sim = cache[key_of(values, base)][1]
+    if short and sim is not None:
+        # the values found are scored on the whole stretch at the operating point's step
+        count += 1
+        try:
+            sim = simulate(spec.fmu_path, {**fixed, **fitted}, spec.operating, n, spec.channel)
+            val = _Objective(spec.measured, spec.operating.sample_rate)(sim)
+        except Exception:  # a fit that diverges on the whole stretch scores badly, as in the search
+            sim, val = None, 1e3
+    return fitted, val, count, sim
 
 
 def _guarded_fit(spec: TrialSpec):

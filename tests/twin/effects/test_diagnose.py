@@ -96,3 +96,23 @@ def test_joint_refit_moves_the_related_base_parameter_toward_the_truth(candidate
     assert lsd_joint < lsd_alone
     assert 1.02 < fitted["mesh_stiffness_scale"] <= 1.1 + 1e-12      # within RELATED_SPAN of 1.0
     assert n <= 11 and sim.shape == x.shape
+
+
+def test_a_search_on_a_shorter_coarser_run_is_scored_on_the_whole_record(candidates_fmu):
+    """The candidates' search runs on the last part of the record at a coarser step; the values it
+    finds are simulated once more on the whole record at the operating point's step, and that
+    run is what is returned and scored."""
+    from twin.effects.diagnose import TrialSpec, fit_effect, record_conditions
+    from twin.effects.fit import _Objective
+    from twin.effects.synthetic import _neutral
+    from twin.operating import simulate_operating_point
+    truth = {**_neutral(), "pinion_eccentricity.eccentricity": 2e-5}
+    x = simulate_operating_point(candidates_fmu, 20.0, 20.0, parameters=truth, settle=0.15, duration=0.5,
+                                 channels=["accel_pinion_casing"], output_interval=5e-5)[:, 0]
+    x = x + np.random.default_rng(0).normal(0, 0.05 * x.std(), x.size)
+    op = record_conditions(candidates_fmu, x, 20000.0, 20.0, 20.0, {}, duration=0.5).operating
+    fitted, lsd, n, sim = fit_effect(TrialSpec("pinion_eccentricity", str(candidates_fmu), "accel_pinion_casing", x,
+                                               op, _neutral(), {}, search_samples=5000, search_step=2e-5))
+    assert sim.shape == x.shape and lsd == pytest.approx(_Objective(x, 20000.0)(sim))
+    assert fitted["pinion_eccentricity.eccentricity"] == pytest.approx(2e-5, rel=0.3)
+    assert n <= 16                      # 7 grid points, at most 8 polishing runs, one scoring run
