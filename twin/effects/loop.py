@@ -278,7 +278,7 @@ def improve(scenario, measurements, out_dir, *, record: str | Sequence[str] | No
     first = None
     if isinstance(diagnosis, Diagnosis):
         first = {"verdict": diagnosis.verdict, "missing": diagnosis.missing, "record": diagnosis.record,
-                 "lsd": diagnosis.lsd_db, "fitted": diagnosis.candidates[0].fitted if diagnosis.candidates else {}}
+                 "lsd": diagnosis.lsd_db, "fitted": _fitted_of(diagnosis)}
     elif diagnosis is not None:
         data = load_diagnosis(diagnosis, scenario, measurements, duration=duration)
         names = _record_names(record)
@@ -301,7 +301,7 @@ def improve(scenario, measurements, out_dir, *, record: str | Sequence[str] | No
                                      executor=executor, duration=duration, progress=progress,
                                      json_path=out / f"diagnosis_{k}.json", effects=effects)
             verdict, missing, fit_record, lsd = diag.verdict, diag.missing, diag.record, diag.lsd_db
-            fitted = diag.candidates[0].fitted if diag.candidates else {}
+            fitted = _fitted_of(diag)
         if verdict != "missing_effect":
             history.append(Step(k, None, lsd, lsd, scenario.fmu, verdict))
             break
@@ -314,6 +314,12 @@ def improve(scenario, measurements, out_dir, *, record: str | Sequence[str] | No
         scenario = load_scenario(add.scenario_file)
     _write_history(history, out)
     return tuple(history)
+
+
+def _fitted_of(diag: Diagnosis) -> dict:
+    """Fitted values of the effect the diagnosis names (the best-scoring candidate need not be it:
+    one that scores higher may have failed its held-out test or signature)."""
+    return next((c.fitted for c in diag.candidates if c.effect == diag.missing), {})
 
 
 def history_table(history) -> str:
