@@ -37,7 +37,8 @@ def main() -> None:
 
     base = build_fmu("GearTwin.Gearbox21", REPO / "modelica", REPO / "build")
     cand = build_fmu("GearTwin.Variants.Gearbox21Candidates", REPO / "modelica", REPO / "build")
-    cases = args.effects or [*CATALOGUE, None, "out_of_catalogue"]
+    # "none": nothing hidden
+    cases = [None if e == "none" else e for e in args.effects] if args.effects else [*CATALOGUE, None, "out_of_catalogue"]
     rows = []
     with LocalExecutor(args.workers) as ex:
         for eff in cases:
