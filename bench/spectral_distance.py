@@ -6,6 +6,11 @@ yardstick.
 
     d = log_spectral_distance(model, measured, fs)           # dB, 0 = same spectral shape
 
+From the shell (``make demo`` after step 8): each record of MODELS against the last stretch of
+the same length of the measured record::
+
+    python bench/spectral_distance.py MEASURED.h5 --record steady --models MODELS.h5 [--channel C]
+
 Definition (``resolution`` Hz Welch PSDs, Hann, 50 % overlap, over [fmin, fmax]):
 
 1. **Measurement floor.** The measured PSD smoothed by a running median over a third of an
@@ -70,3 +75,46 @@ def spectral_distance_report(model, measured, fs: float, *, fmin: float = 20.0, 
 def log_spectral_distance(model, measured, fs: float, **kwargs) -> float:
     """Floor-aware, gain-free log-spectral distance [dB] (see the module docstring)."""
     return spectral_distance_report(model, measured, fs, **kwargs)["distance_db"]
+
+
+def _read(path: str, channel: str) -> list[tuple[str, np.ndarray, float]]:
+    """(record name, channel samples, sample rate [Hz]) of every record of a measurement file
+    (the HDF5 layout of ``docs/measurements.md``, read with h5py alone)."""
+    import h5py
+    out = []
+    with h5py.File(path, "r") as f:
+        for name, g in f["records"].items():
+            fs = float(g.attrs["sample_rate"])
+            out.append((name, np.asarray(g[channel][...], float), fs))
+    return out
+
+
+def main(argv=None) -> int:
+    import argparse
+    ap = argparse.ArgumentParser(description="Floor-aware, gain-free spectral distance of models to a record")
+    ap.add_argument("measured", help="measurement file (HDF5)")
+    ap.add_argument("--record", required=True, help="the measured record")
+    ap.add_argument("--models", required=True, help="measurement file whose records are model signals")
+    ap.add_argument("--channel", default="accel_pinion_casing")
+    args = ap.parse_args(argv)
+    rec = {n: (x, fs) for n, x, fs in _read(args.measured, args.channel)}
+    if args.record not in rec:
+        ap.error(f"no record {args.record!r} in {args.measured} (it has {', '.join(rec)})")
+    x, fs = rec[args.record]
+    rows = []
+    print(f"floor-aware, gain-free spectral distance (bench/spectral_distance.py, 20-5000 Hz, 4 Hz) to "
+          f"{args.measured} record {args.record!r}")
+    print(f"{'model':<10} {'distance [dB]':>13} {'gain [dB]':>9} {'bins above floor':>16}")
+    for name, y, fy in _read(args.models, args.channel):
+        if fy != fs:
+            ap.error(f"model {name!r} is sampled at {fy} Hz, the record at {fs} Hz")
+        r = spectral_distance_report(y, x[-y.size:], fs)
+        rows.append(r["distance_db"])
+        print(f"{name:<10} {r['distance_db']:>13.2f} {r['gain_db']:>+9.1f} {100 * r['above_floor']:>15.0f} %")
+    if len(rows) > 1 and rows[0] > 0:
+        print(f"change: {rows[-1] - rows[0]:+.2f} dB ({100 * (rows[-1] - rows[0]) / rows[0]:+.0f} %)")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -6,6 +6,7 @@ import importlib.util
 from pathlib import Path
 
 import numpy as np
+import pytest
 from scipy import signal as sps
 
 _spec = importlib.util.spec_from_file_location(
@@ -44,3 +45,20 @@ def test_a_missing_resonance_counts_and_silence_under_the_noise_does_not():
     quiet = np.zeros(40000)
     noise = 1e-3 * np.random.default_rng(2).standard_normal(40000)
     assert sd.log_spectral_distance(quiet, noise, FS) < 1e-9
+
+
+def test_the_command_line_scores_each_model_against_the_end_of_the_record(tmp_path, capsys):
+    from twin.measurements import Record, write_measurements
+    measured = _signal(0, n=50000) + 0.01 * np.random.default_rng(5).standard_normal(50000)
+    write_measurements([Record("steady", {"accel_pinion_casing": measured}, {"accel_pinion_casing": "m/s2"}, FS,
+                               nominal_speed=20.0, load=20.0)], tmp_path / "rig.h5")
+    models = [Record(name, {"accel_pinion_casing": 2.0 * _signal(1, resonance=r)}, {"accel_pinion_casing": "m/s2"},
+                     FS, nominal_speed=20.0, load=20.0) for name, r in (("before", False), ("after", True))]
+    write_measurements(models, tmp_path / "models.h5")
+    assert sd.main([str(tmp_path / "rig.h5"), "--record", "steady", "--models", str(tmp_path / "models.h5")]) == 0
+    out = capsys.readouterr().out.splitlines()
+    rows = {line.split()[0]: float(line.split()[1]) for line in out if line.split()[0] in ("before", "after")}
+    assert rows["after"] < rows["before"] - 3.0
+    assert out[-1].startswith(f"change: {rows['after'] - rows['before']:+.2f} dB")
+    with pytest.raises(SystemExit):
+        sd.main([str(tmp_path / "rig.h5"), "--record", "runup", "--models", str(tmp_path / "models.h5")])
