@@ -54,7 +54,7 @@ def correct(expected: str, d) -> bool:
     return d.verdict == "missing_effect" and d.missing == expected
 
 
-def one_case(rig_name: str, seed: int, effect: str, calibrated, out: Path, ex) -> dict:
+def one_case(rig_name: str, seed: int, effect: str, calibrated, out: Path, ex, search: dict | None = None) -> dict:
     from spectral_distance import spectral_distance_report
 
     from twin.effects.catalogue import CATALOGUE
@@ -80,7 +80,7 @@ def one_case(rig_name: str, seed: int, effect: str, calibrated, out: Path, ex) -
     fmu, params = calibrated.fmu_path(), dict(calibrated.parameters)
     t0 = time.perf_counter()
     d = diagnose(fmu, read_records(h5, CHANNEL, ["steady", "runup"]), parameters=params, executor=ex,
-                 duration=2.0)
+                 duration=2.0, **(search or {}))
     wall = time.perf_counter() - t0
     n = int(round(2.0 * fs))
     xm = x[-n:]
@@ -112,6 +112,7 @@ def one_case(rig_name: str, seed: int, effect: str, calibrated, out: Path, ex) -
            "message": d.message, "top_fitted": top.fitted, "unexplained": list(d.unexplained),
            "twin_lsd_before": d.lsd_db, "twin_lsd_after_top": top.lsd_after_db,
            "distance_before_db": dist0, "distance_after_top_db": dist1, "diagnose_s": wall, "rig_s": rig_s,
+           "search": search or "default", "load_average": os.getloadavg()[0],
            "truth_effect": next((r.get("effect") for r in truth.get("records", [truth]) if isinstance(r, dict)
                                  and r.get("effect")), None) if isinstance(truth, dict) else None}
     return row
@@ -144,12 +145,22 @@ def main() -> None:
     ap.add_argument("--effects", nargs="+", default=["none", "pinion_runout", "gear_runout", "drive_ripple",
                                                       "casing_resonance", "local_tooth_fault", "bearing_outer_race"])
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--search", type=float, default=None,
+                    help="s of the record the candidates are searched on (0: the whole record; default: "
+                         "twin.effects.diagnose.SEARCH_S)")
+    ap.add_argument("--search-step", type=float, default=None,
+                    help="RK4 step [s] of the search (0: the operating point's; default: SEARCH_STEP)")
     ap.add_argument("--out", type=Path, default=REPO / "bench_out" / "diagnosis_rigs")
     args = ap.parse_args()
 
     from twin.executor import LocalExecutor
     from twin.scenario import load_scenario
 
+    search = {}
+    if args.search is not None:
+        search["search"] = args.search or None
+    if args.search_step is not None:
+        search["search_step"] = args.search_step or None
     args.out.mkdir(parents=True, exist_ok=True)
     done = args.out / "results.json"
     rows = [r for r in (json.loads(done.read_text()) if done.exists() else [])
@@ -158,7 +169,7 @@ def main() -> None:
         for rig in args.rigs:
             calibrated = load_scenario(args.calibrated / f"{rig}_{args.seed}_cal" / "calibrated.yaml")
             for effect in args.effects:
-                rows.append(one_case(rig, args.seed, effect, calibrated, args.out, ex))
+                rows.append(one_case(rig, args.seed, effect, calibrated, args.out, ex, search))
                 print(json.dumps({k: v for k, v in rows[-1].items() if k != "top_fitted"}), flush=True)
                 (args.out / "results.json").write_text(json.dumps(rows, indent=1, default=str))
     print(f"Machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, {args.workers} workers, "
