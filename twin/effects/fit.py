@@ -89,12 +89,12 @@ def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int, np.ndarra
 
     eff = CATALOGUE[spec.effect]
     n = spec.measured.size
-    m = min(n, spec.search_samples or n)
+    n_search = min(n, spec.search_samples or n)
     op = spec.operating
     if spec.search_step is not None and op.solver_step is not None:
         op = replace(op, solver_step=spec.search_step)
-    short = m < n or op != spec.operating        # search on a shorter or coarser run, score on the whole
-    objective = _Objective(spec.measured[-m:], spec.operating.sample_rate)
+    short = n_search < n or op != spec.operating        # search on a shorter or coarser run, score on the whole
+    objective = _Objective(spec.measured[-n_search:], spec.operating.sample_rate)
     fixed = dict(spec.parameters)
     params = list(eff.fit)
     free = [p for p in params if p.guess is None]
@@ -124,7 +124,7 @@ def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int, np.ndarra
             count += 1
             try:
                 sim = simulate(spec.fmu_path, {**fixed, **base, **{eff.parameter(k): v for k, v in values.items()}},
-                               op, m, spec.channel, retune=not short)
+                               op, n_search, spec.channel, retune=not short)
                 cache[key] = (objective(sim), sim)
             except Exception:  # a diverging trial scores badly; it does not end the diagnosis
                 cache[key] = (1e3, None)
