@@ -16,8 +16,10 @@ $(STAMP): pyproject.toml
 	$(VENV)/bin/pip install -e '.[test]'
 	touch $(STAMP)
 
-# The independent simulators of rigs/ write the records that demo step 6 calibrates to and step 9
-# scores the transfer on (twin/ never imports rigs/: it reads their files).
+# The independent simulators of rigs/ write the records that demo step 6 calibrates to, step 8
+# diagnoses (the same gearbox with the rig's own casing resonance) and step 9 scores the transfer
+# on (twin/ never imports rigs/ or bench/: it reads their files). After step 8, bench/ scores its
+# model before and after twin improve with a distance written apart from twin.compare.
 RIG_RECORDS := --records-per-stage 3 --record-duration 0.3 --damage-sampling snapshot --damage-scatter 0.1 --no-progress
 
 demo: venv
@@ -26,8 +28,13 @@ demo: venv
 	$(VENV)/bin/python -m rigs.ltca target scenarios/lubricated.yaml --out $(DEMO)/rigs/ltca.h5 --seed 4 $(RIG_RECORDS)
 	$(VENV)/bin/python -m rigs.pedestal steady --gearbox 3 --scatter 0.12 --seed 3 --duration 2 --out $(DEMO)/rigs/pedestal_steady.h5
 	$(VENV)/bin/python -m rigs.pedestal runup --gearbox 3 --scatter 0.12 --seed 3 --from 2 --to 20 --duration 6 --out $(DEMO)/rigs/pedestal_runup.h5
+	$(VENV)/bin/python -m rigs.pedestal steady --gearbox 3 --scatter 0.12 --seed 4 --duration 2 --effect casing_resonance --out $(DEMO)/rigs/pedestal_casing_steady.h5
+	$(VENV)/bin/python -m rigs.pedestal runup --gearbox 3 --scatter 0.12 --seed 4 --from 2 --to 20 --duration 6 --effect casing_resonance --out $(DEMO)/rigs/pedestal_casing_runup.h5
 	$(VENV)/bin/twin demo --out $(DEMO) --rig-records $(DEMO)/rigs/lumped.h5 $(DEMO)/rigs/ltca.h5 \
-		--calibration-records $(DEMO)/rigs/pedestal_steady.h5 $(DEMO)/rigs/pedestal_runup.h5
+		--calibration-records $(DEMO)/rigs/pedestal_steady.h5 $(DEMO)/rigs/pedestal_runup.h5 \
+		--hidden-effect-records $(DEMO)/rigs/pedestal_casing_steady.h5 $(DEMO)/rigs/pedestal_casing_runup.h5
+	@printf '\n[8/9, scored apart] step 8: the model before and after twin improve against the record, by bench/\n'
+	$(VENV)/bin/python bench/spectral_distance.py $(DEMO)/rig/pedestal_hidden.h5 --record steady --models $(DEMO)/loop/models.h5
 
 # Two worker processes, whole test files to each (module fixtures are computed once), the files
 # with slow tests first (tests/conftest.py; xdist would otherwise send the largest files first);

@@ -248,7 +248,8 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
 
 def _cmd_demo(args: argparse.Namespace) -> int:
     _lib("twin.demo").run_demo(Path(args.out), stop_time=args.stop_time, rig_records=args.rig_records,
-                               calibration_records=args.calibration_records)
+                               calibration_records=args.calibration_records,
+                               hidden_effect_records=args.hidden_effect_records)
     return 0
 
 
@@ -756,6 +757,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--calibration-records", nargs=2, default=(), metavar=("STEADY", "RUNUP"),
                    help="a steady and a run-up record of an independent simulator (python -m rigs.pedestal ...) "
                         "for step 6")
+    p.add_argument("--hidden-effect-records", nargs=2, default=(), metavar=("STEADY", "RUNUP"),
+                   help="a steady and a run-up record of step 6's gearbox with one of the rig's own effects "
+                        "(python -m rigs.pedestal ... --effect casing_resonance) for step 8")
     p.set_defaults(handler=_cmd_demo)
     return parser
 
