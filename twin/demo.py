@@ -20,7 +20,7 @@ they stop is in the report files it writes and in ``docs/``.
    run-up of step 6's gearbox with a casing resonance of the rig's own hidden
    (``hidden_effect_records``), then ``twin improve`` from that diagnosis, against step 6's
    calibrated scenario; the model before and after is written for the independent distance
-   that ``make demo`` prints next (``bench/spectral_distance.py``).
+   that ``make demo`` prints next (``bench/spectral_distance.py``; :mod:`twin.demo_rig`).
 9. Wear-stage assessment by transfer learning: CNN, MMD and the proposed method on an emulated
    rig, then the proposed method on the records of the independent simulators of ``rigs/``
    (``rig_records``).  The caveats go to ``transfer.md`` in the output directory.
@@ -144,7 +144,8 @@ def run_demo(out_dir: Path | str = "demo_out", *, stop_time: float = 10.0,
     _compare_demo(out_dir)
     history = None
     if hidden_effect_records and rig is not None:
-        history = _loop_demo(out_dir, hidden_effect_records, rig["scenario"])
+        from twin.demo_rig import loop_demo
+        history = loop_demo(out_dir, hidden_effect_records, rig["scenario"])
     else:
         _heading(8, "skipped: no rig records with a hidden effect, or no calibrated rig scenario from step 6 "
                     "(make demo writes both with python -m rigs.pedestal)")
@@ -294,63 +295,6 @@ def _compare_demo(out_dir: Path) -> None:
              for i, f in enumerate(damaged.findings[:4], 1)]
     _lines("\n".join(rows))
     _written(out_dir / "compare_damaged" / "compare.html")
-
-
-def _loop_demo(out_dir: Path, records, calibrated) -> dict:
-    """Step 8: ``twin diagnose`` and ``twin improve`` on a steady record and a run-up of step 6's
-    gearbox of ``rigs/pedestal`` with one of the rig's own effects hidden (``records``: the two
-    files, written by ``python -m rigs.pedestal ... --effect casing_resonance``), against step 6's
-    calibrated scenario ``calibrated``.
-
-    Writes ``loop/models.h5``: the model before (record ``before``) and after ``twin improve``
-    (``after``; the same model when nothing was added), at the operating point the diagnosis
-    measured, as long as the stretch it compared. ``make demo`` scores them against the steady
-    record with ``bench/spectral_distance.py`` (floor-aware, gain-free, apart from ``twin.compare``).
-    """
-    import shutil
-
-    from twin.demo_rig import merge_records
-    from twin.effects.loop import diagnose_scenario, history_table, improve
-    from twin.executor import LocalExecutor
-    from twin.measurements import Record, write_measurements
-    from twin.operating import simulate_at
-    from twin.scenario import load_scenario
-
-    t = time.perf_counter()
-    loop = out_dir / "loop"
-    loop.mkdir(exist_ok=True)
-    (out_dir / "rig").mkdir(exist_ok=True)
-    h5 = merge_records(Path(records[0]), Path(records[1]), out_dir / "rig" / "pedestal_hidden.h5")
-    scenario = load_scenario(calibrated)
-    with LocalExecutor() as ex:
-        diag = diagnose_scenario(scenario, h5, record=["steady", "runup"], json_path=loop / "diagnosis.json",
-                                 executor=ex, progress=False)
-    took = time.perf_counter() - t
-    # variants go into a copy of modelica/, so the demo leaves the repository untouched
-    modelica = out_dir / "modelica"
-    if modelica.exists():
-        shutil.rmtree(modelica)
-    shutil.copytree(REPO / "modelica", modelica, ignore=shutil.ignore_patterns("Variants"))
-    history = improve(scenario, h5, loop, record=["steady", "runup"], max_steps=1, diagnosis=diag,
-                      modelica_dir=modelica, build_dir=out_dir / "build", progress=False)
-    after = load_scenario(loop / f"scenario_{history[-1].effect}.yaml") if history[-1].effect else scenario
-    channel = (scenario.outputs or ("accel_pinion_casing",))[0]
-    fs = diag.operating.sample_rate
-    n = int(round(2.0 * fs))        # the stretch the diagnosis compared (its default duration)
-    models = [Record(name, {channel: simulate_at(s.fmu_path(), dict(s.parameters), diag.operating, n, channel)},
-                     {channel: "m/s2"}, fs, nominal_speed=diag.operating.drive_hz, load=diag.operating.load)
-              for name, s in (("before", scenario), ("after", after))]
-    write_measurements(models, loop / "models.h5")
-    _heading(8, "The loop on a gearbox the twin did not generate: step 6's rigs/pedestal gearbox with a "
-                "casing resonance hidden; twin diagnose --record steady --record runup, then twin improve",
-             time.perf_counter() - t)
-    _lines(f"twin diagnose ({took:.0f} s; candidates searched on 1 s at a 20 us step, scored on 2 s at 10 us):")
-    _lines(diag.table())
-    _lines("twin improve --from-diagnosis:")
-    _lines(history_table(history))
-    _lines("the independent distance (bench/spectral_distance.py) before and after is printed by make demo next")
-    _written(loop / "diagnosis.json", loop / "history.png", loop / "models.h5")
-    return {"diagnosis": diag, "history": history, "records": h5, "models": loop / "models.h5"}
 
 
 def _transfer_demo(out_dir: Path, rig_records=(), epochs: int = 15):

@@ -20,8 +20,9 @@ import numpy as np
 
 from twin.compare import MeasuredRecord, read_record  # noqa: F401  (part of this module's API)
 from twin.effects.catalogue import RELATED_SPAN, effect as get_effect
-from twin.effects.diagnose import (Diagnosis, TrialSpec, active_effects, diagnose, fit_effect,
-                                   record_conditions, related_values, simulate, split_fitted)
+from twin.effects.diagnose import (TrialSpec, active_effects, diagnose, fit_effect, record_conditions,
+                                   related_values, simulate, split_fitted)
+from twin.effects.verdict import Diagnosis
 
 
 def neutral_values(active) -> dict:
@@ -173,7 +174,8 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
     from twin._atomic import atomic_path
     from twin.calibration.problem import write_parameter_set
     from twin.compare import compare_signals
-    from twin.effects.diagnose import _band_error, starting_values
+    from twin.effects.diagnose import starting_values
+    from twin.effects.verdict import _band_error
     from twin.effects.variant import (_REPO_MODELICA, base_of, candidates_model, modelica_root, variant_source,
                                       write_variant)
     from twin.errors import ParameterError

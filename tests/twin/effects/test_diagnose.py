@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from twin.compare import spectral_levels
-from twin.effects.diagnose import Candidate, active_effects, diagnose, judge
+from twin.effects.diagnose import active_effects, diagnose
+from twin.effects.verdict import Candidate, judge
 from twin.errors import MeasurementError, ParameterError
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from twin.effects.diagnose import Candidate, Evidence, judge
+from twin.effects.verdict import Candidate, Evidence, judge
 from twin.errors import MeasurementError, ParameterError
 
 FS = 10_000.0
