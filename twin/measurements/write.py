@@ -163,7 +163,7 @@ def _sidecar_with_fmu_units(src: Path, sidecar, fmu: Path, keep: list[str] | Non
     import csv
 
     from twin.measurements.format import sidecar_candidates
-    from twin.measurements.load import read_sidecar
+    from twin.measurements.csv_read import read_sidecar
 
     found = [Path(sidecar)] if sidecar is not None else [c for c in sidecar_candidates(src) if c.is_file()][:1]
     try:
