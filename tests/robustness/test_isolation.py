@@ -3,6 +3,7 @@ errors) end one task, never the run, and are reported with their signal or exit 
 from __future__ import annotations
 
 import re
+import os
 import tempfile
 from pathlib import Path
 
@@ -79,13 +80,15 @@ def test_retry_runs_a_crashed_task_again_and_not_a_hung_one():
 @pytest.mark.parametrize("mode, kind, words", [(1, WorkerCrashError, "SIGSEGV"), (2, WorkerCrashError, "status 3"),
                                                (5, SimulationError, "on purpose"), (0, None, "")])
 def test_run_isolated_reports_how_the_child_ended(faulty_fmus, mode, kind, words):
-    before = set(Path(tempfile.gettempdir()).glob("twin_run_*"))
+    # Only this process's directories: another test worker may be mid-run beside us.
+    mine = f"twin_run_{os.getpid()}_*"
+    before = set(Path(tempfile.gettempdir()).glob(mine))
     if kind is None:
         assert np.isfinite(run_isolated(simulate_faulty, (str(faulty_fmus["faulty"]), mode)))
     else:
         with pytest.raises(kind, match=words):
             run_isolated(simulate_faulty, (str(faulty_fmus["faulty"]), mode))
-    assert set(Path(tempfile.gettempdir()).glob("twin_run_*")) <= before
+    assert set(Path(tempfile.gettempdir()).glob(mine)) <= before
 
 
 def test_run_isolated_stops_a_hang_at_its_limit(faulty_fmus):
