@@ -38,7 +38,7 @@ def test_structural_options_size_the_per_tooth_arrays(variant_18_35):
     for array in ("tooth_stiffness_factor", "tooth_deviation_offset", "effect_tooth_stiffness_factor",
                   "effect_tooth_offset"):
         assert f"{array}[18]" in variables and f"{array}[19]" not in variables, array
-    assert int(variables["tooth_prev[1]"].find("Integer").get("start")) == 18
+    assert "tooth_pit_field[198]" in variables and "tooth_pit_field[199]" not in variables  # 18 x 11
     assert "z1 = 18, z2 = 35" in root.get("description")
     assert root.find("CoSimulation").get("modelIdentifier") == "GearTwin_Gearbox21_z1_18_z2_35"
     # the kinematics follow: the base radius of an 18-tooth pinion
