@@ -74,7 +74,7 @@ def ensembles(loaded, members):
     class Reference(Ensemble):
         _raw = _reference_raw
 
-        def _streamed(self, data, what="assess", features=False):
+        def _streamed(self, data, what="assess", features=False, facts=None):
             raw, rec, lab, prepared = self._raw(data, what)
             return raw, rec, lab, prepared, None, self._features(prepared) if features else None
 

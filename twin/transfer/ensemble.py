@@ -375,11 +375,12 @@ class Ensemble:
         index (n,), labels (n,), prepared records (:meth:`_streamed`)."""
         return self._streamed(data, what)[:4]
 
-    def _streamed(self, data, what: str = "assess", features: bool = False):
+    def _streamed(self, data, what: str = "assess", features: bool = False, facts=None):
         """:meth:`_raw`, the records read from a path (None otherwise) and, with ``features``,
-        the records' order-check features: :func:`twin.transfer.inference.assess_stream`."""
+        the records' order-check features: :func:`twin.transfer.inference.assess_stream` (which
+        checks each record read from a path against ``facts`` as it is read)."""
         from twin.transfer.inference import assess_stream
-        return assess_stream(self, data, what, features)
+        return assess_stream(self, data, what, features, facts)
 
     def _networks(self):
         """(the members' folded networks, the windows' domain normalisation for them)."""
@@ -467,8 +468,8 @@ class Ensemble:
         self._check()
         pre = self.preprocessing
         streamed = None
-        if isinstance(data, (str, Path)):              # read record by record beside the work on them
-            streamed = self._streamed(data, features=True)
+        if isinstance(data, (str, Path)):              # read record by record beside the work on them,
+            streamed = self._streamed(data, features=True, facts=self.facts)   # each checked as read
             recs = streamed[4]
         else:
             recs = list(data.records if isinstance(data, MeasurementSet) else data)

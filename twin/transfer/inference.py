@@ -298,7 +298,7 @@ class Stream:
         return self._result
 
 
-def assess_stream(ensemble, data, what: str = "assess", features: bool = False):
+def assess_stream(ensemble, data, what: str = "assess", features: bool = False, facts=None):
     """An ensemble's raw network probabilities on the windows of ``data`` (members, n, K), record
     index (n,), labels (n,), prepared records, the records read from a path (None otherwise)
     and, with ``features``, the records' order-check features
@@ -308,18 +308,33 @@ def assess_stream(ensemble, data, what: str = "assess", features: bool = False):
     features computed) on worker threads as soon as it is read, once for all members, while
     the members' networks run on the windows already represented
     (:class:`StackedNetworks`): the two cores share reading, preparing and the networks.
+
+    With ``facts`` (:class:`~twin.transfer.settings.ArchiveFacts`), each record read from a path
+    is checked against the assessor's test as it is read
+    (:func:`~twin.transfer.settings.record_misfit`): after the first misfit no record is
+    prepared any more and the work queued is cancelled; the rest of the file is still read (a
+    file with problems gets its :class:`~twin.errors.MeasurementError` first) and its records'
+    attributes checked, and one :class:`AssessorError` names every misfit
+    (:func:`~twin.transfer.settings.misfit_error`).
     """
     from twin.measurements import MeasurementSet, iter_measurements
     from twin.transfer.preprocess import Prepared, windows_of
+    from twin.transfer.settings import misfit_error, record_misfit
     first, pre = ensemble.members[0], ensemble.preprocessing
-    records = None
+    records, misfits = None, []
     if isinstance(data, (str, Path)):
         records = []
 
         def read(path):
             for r in iter_measurements(path, channels=[pre.channel_of("target")], tachometer=False):
                 records.append(r)
-                yield [r]
+                reason = None if facts is None else record_misfit(r, facts)
+                if reason is not None:
+                    misfits.append(reason)
+                    if len(misfits) == 1:      # the first: stop preparing (below)
+                        yield None
+                elif not misfits:              # after a misfit the records are only checked
+                    yield [r]
         pieces = read(data)
     else:
         if isinstance(data, MeasurementSet):
@@ -350,6 +365,12 @@ def assess_stream(ensemble, data, what: str = "assess", features: bool = False):
             prepared.extend(p)
 
         for piece in pieces:
+            if piece is None:                  # a misfit: what is queued is not prepared, and the
+                for fut in queue:              # rest of the file is only read and checked
+                    fut.cancel()
+                for _ in pieces:
+                    pass
+                raise misfit_error(misfits, facts, what)
             queue.append(pool.submit(represent, piece))
             while queue and queue[0].done():
                 take()
@@ -359,4 +380,3 @@ def assess_stream(ensemble, data, what: str = "assess", features: bool = False):
         raise AssessorError(f"{what}: no records")
     f = {k: np.concatenate([v[k] for v in feats]) for k in feats[0]} if features else None
     return stream.result(), np.concatenate(recs), np.concatenate(labs), prepared, records, f
-

@@ -32,7 +32,7 @@ import numpy as np
 from twin.transfer.errors import AssessorError
 
 __all__ = ["ArchiveFacts", "DAMAGE_KINDS", "REMOVE_LEVEL", "archive_facts", "check_records", "class_prior_for",
-           "preprocessing_for"]
+           "misfit_error", "preprocessing_for", "record_misfit"]
 
 DAMAGE_KINDS = ("pitting_density", "wear_depth")
 REMOVE_LEVEL = {"pitting_density": True, "wear_depth": False}
@@ -157,14 +157,43 @@ def class_prior_for(facts: ArchiveFacts) -> str:
     return "ordinal"
 
 
+def record_misfit(record, facts: ArchiveFacts) -> str | None:
+    """Why the assessor of ``facts`` cannot read ``record`` (``"'name' (speed 10 Hz, ...)"``), or None.
+
+    Only the record's attributes are read: its ``nominal_speed`` more than
+    :attr:`ArchiveFacts.speed_tolerance` from the test's, its ``load`` more than
+    :attr:`ArchiveFacts.load_tolerance`, or a ``damage_kind`` attribute naming another damage.
+    """
+    reasons = []
+    speed = record.nominal_speed
+    if speed is not None and abs(speed / facts.nominal_speed - 1.0) > facts.speed_tolerance:
+        reasons.append(f"speed {record.nominal_speed:g} Hz")
+    if record.load is not None and facts.nominal_load and (
+            abs(record.load / facts.nominal_load - 1.0) > facts.load_tolerance):
+        reasons.append(f"load {record.load:g} N.m")
+    kind = (record.metadata or {}).get("damage_kind")
+    if kind is not None and str(kind) != facts.damage_kind:
+        reasons.append(f"damage kind {kind}")
+    return f"'{record.name}' ({', '.join(reasons)})" if reasons else None
+
+
+def misfit_error(misfits, facts: ArchiveFacts, what: str = "rig") -> AssessorError:
+    """The one-line error refusing the records of ``misfits`` (:func:`record_misfit`'s strings)."""
+    bad = list(misfits)
+    more = f" and {len(bad) - 5} more" if len(bad) > 5 else ""
+    return AssessorError(
+        f"{what}: {len(bad)} record(s) do not fit the assessor's test ({facts.damage_kind} at "
+        f"{facts.nominal_speed:g} Hz +- {100 * facts.speed_tolerance:.0f} %, {facts.nominal_load:g} N.m +- "
+        f"{100 * facts.load_tolerance:.0f} %): {', '.join(bad[:5])}{more}; assess them with an assessor trained "
+        "on an archive of their test")
+
+
 def check_records(records, facts: ArchiveFacts, what: str = "rig") -> list[str]:
     """Refuse records the assessor of ``facts`` cannot read; return notes on what was assumed.
 
-    A record is refused (one :class:`AssessorError` naming every such record) when its
-    ``nominal_speed`` lies more than :attr:`ArchiveFacts.speed_tolerance` from the test's, its
-    ``load`` more than :attr:`ArchiveFacts.load_tolerance`, or its ``damage_kind`` attribute names
-    another damage.  A record without ``nominal_speed`` or ``load`` is taken at the test's and
-    noted.
+    A record is refused (one :class:`AssessorError` naming every such record,
+    :func:`misfit_error`) when :func:`record_misfit` finds a reason.  A record without
+    ``nominal_speed`` or ``load`` is taken at the test's and noted.
 
     Parameters
     ----------
@@ -175,26 +204,13 @@ def check_records(records, facts: ArchiveFacts, what: str = "rig") -> list[str]:
     """
     bad, unknown = [], []
     for r in records:
-        reasons = []
         if r.nominal_speed is None:
             unknown.append(r.name)
-        elif abs(r.nominal_speed / facts.nominal_speed - 1.0) > facts.speed_tolerance:
-            reasons.append(f"speed {r.nominal_speed:g} Hz")
-        if r.load is not None and facts.nominal_load and (
-                abs(r.load / facts.nominal_load - 1.0) > facts.load_tolerance):
-            reasons.append(f"load {r.load:g} N.m")
-        kind = (r.metadata or {}).get("damage_kind")
-        if kind is not None and str(kind) != facts.damage_kind:
-            reasons.append(f"damage kind {kind}")
-        if reasons:
-            bad.append(f"'{r.name}' ({', '.join(reasons)})")
+        reason = record_misfit(r, facts)
+        if reason is not None:
+            bad.append(reason)
     if bad:
-        more = f" and {len(bad) - 5} more" if len(bad) > 5 else ""
-        raise AssessorError(
-            f"{what}: {len(bad)} record(s) do not fit the assessor's test ({facts.damage_kind} at "
-            f"{facts.nominal_speed:g} Hz +- {100 * facts.speed_tolerance:.0f} %, {facts.nominal_load:g} N.m +- "
-            f"{100 * facts.load_tolerance:.0f} %): {', '.join(bad[:5])}{more}; assess them with an assessor trained "
-            "on an archive of their test")
+        raise misfit_error(bad, facts, what)
     notes = []
     if unknown:
         notes.append(f"{what}: {len(unknown)} record(s) have no nominal_speed (first '{unknown[0]}'); taken at the "

@@ -90,6 +90,33 @@ def test_records_that_do_not_fit_are_refused_before_training(trained, tmp_path):
         train_ensemble(arc, rig_records(), tmp_path / "f", members=1)
 
 
+def test_a_file_with_misfits_is_refused_as_read_without_preparing_the_rest(trained, tmp_path, monkeypatch):
+    _, _, _, ens, _ = trained
+    from twin.transfer.assessor import Assessor
+    recs = rig_records(per_stage=2, seed=8)
+    recs[0] = replace(recs[0], nominal_speed=10.0)                 # the first record misfits
+    recs[4] = replace(recs[4], load=5.0)
+    path = write_measurements(recs, tmp_path / "mixed.h5")
+    prepared = []
+    real = Assessor._prepared
+
+    def counted(self, data, *a, **kw):
+        prepared.append([r.name for r in data])
+        return real(self, data, *a, **kw)
+    monkeypatch.setattr(Assessor, "_prepared", counted)
+    with pytest.raises(AssessorError) as err:
+        ens.assess(path)
+    msg = str(err.value)
+    assert "\n" not in msg and "2 record(s) do not fit" in msg
+    assert "'rec00' (speed 10 Hz)" in msg and "'rec04' (load 5 N.m)" in msg
+    assert prepared == []                                          # nothing prepared after the first misfit
+    recs[0] = rig_records(per_stage=2, seed=8)[0]                  # a later misfit: the records before it only
+    path = write_measurements(recs, tmp_path / "late.h5")
+    with pytest.raises(AssessorError, match=r"1 record\(s\) do not fit.*'rec04' \(load 5 N.m\)"):
+        ens.assess(path)
+    assert {n for names in prepared for n in names} <= {f"rec{i:02d}" for i in range(4)}
+
+
 def test_loading_refuses_what_is_not_an_ensemble(tmp_path):
     with pytest.raises(AssessorError, match="ensemble.json"):
         Ensemble.load(tmp_path)
