@@ -23,22 +23,21 @@ from __future__ import annotations
 import ctypes
 import hashlib
 import itertools
-import math
 import shutil
 import tempfile
 import warnings
 import weakref
 import zipfile
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from twin._progress import progress_bar
-from twin.checks import whole_multiple
 from twin.errors import FMUError, ParameterError, SimulationError, TwinWarning
+from twin.fmu_capture import Block, FMUCapture, RunEnd
+from twin.fmu_description import OUTPUT_INTERVAL, STEP_SIZE, DefaultExperiment, FMUDescription, float_or_none
+from twin.fmu_values import FMUValues
 from twin.results import SimulationResult
 from twin.variables import Variable, variables_from_description
 
@@ -46,8 +45,6 @@ __all__ = ["FMU", "Variable", "DefaultExperiment", "RunEnd", "Block", "simulate_
            "is_gearbox_model", "STEP_SIZE", "OUTPUT_INTERVAL"]
 
 _STATUS = ["OK", "Warning", "Discard", "Error", "Fatal", "Pending"]
-STEP_SIZE = "solver.step_size"
-OUTPUT_INTERVAL = "solver.output_interval"
 
 # fmpy getter/setter per FMI type (an enumeration is an Integer in FMI 2.0, an Int64 in FMI 3.0)
 _ACCESS = {
@@ -97,32 +94,6 @@ def _shared_logger():
     return _SHARED["logger"]
 
 
-@dataclass(frozen=True)
-class DefaultExperiment:
-    """The model's ``DefaultExperiment`` (None where it gives no value); times in s."""
-
-    start_time: float | None = None
-    stop_time: float | None = None
-    step_size: float | None = None
-    tolerance: float | None = None
-
-
-@dataclass(frozen=True)
-class RunEnd:
-    """The FMU ended the run itself at ``time`` [s]; ``reason`` says how (and its message)."""
-
-    time: float
-    reason: str
-
-
-@dataclass(frozen=True)
-class Block:
-    """Samples from one capture: ``time`` shape (m,), one column per name, each (m,) of its dtype."""
-
-    time: np.ndarray
-    columns: tuple[np.ndarray, ...]
-
-
 def _sha256(path: Path) -> str:
     h = hashlib.sha256()
     with open(path, "rb") as f:
@@ -131,16 +102,12 @@ def _sha256(path: Path) -> str:
     return h.hexdigest()
 
 
-def _float_or_none(value) -> float | None:
-    try:
-        f = float(value)
-    except (TypeError, ValueError):
-        return None
-    return f if math.isfinite(f) else None
-
-
-class FMU:
+class FMU(FMUDescription, FMUValues, FMUCapture):
     """An FMI 2.0 or FMI 3.0 Co-Simulation FMU opened for simulation.
+
+    This class makes the FMI calls; what it declares (:class:`~twin.fmu_description.FMUDescription`),
+    values by name (:class:`~twin.fmu_values.FMUValues`) and the sampling of a run
+    (:class:`~twin.fmu_capture.FMUCapture`) are its bases.
 
     Parameters
     ----------
@@ -183,7 +150,7 @@ class FMU:
         self.variables: dict[str, Variable] = variables_from_description(md)
         de = md.defaultExperiment
         self.default_experiment = DefaultExperiment(
-            *(_float_or_none(getattr(de, a, None)) if de is not None else None
+            *(float_or_none(getattr(de, a, None)) if de is not None else None
               for a in ("startTime", "stopTime", "stepSize", "tolerance")))
         self._unzip = tempfile.mkdtemp(prefix="twin_fmu_")
         try:
@@ -205,124 +172,10 @@ class FMU:
         self.initial_parameters: dict[str, Any] = {}
         self.ended: RunEnd | None = None
 
-    # -- description -----------------------------------------------------------------------
-    @property
-    def model_name(self) -> str:
-        return self.model_description.modelName
-
-    @property
-    def guid(self) -> str:
-        """The FMI 2.0 ``guid`` or FMI 3.0 ``instantiationToken``."""
-        return self.model_description.guid
-
-    @property
-    def description(self) -> str:
-        return self.model_description.description or ""
-
-    @property
-    def rebuildable(self) -> bool:
-        """True for FMUs built by ``fmu_build``, whose structural constants ``twin build --set`` changes."""
-        return str(self.model_description.generationTool or "").startswith("gear-twin fmu_build")
-
-    def _by(self, *causalities: str) -> list[Variable]:
-        return sorted((v for v in self.variables.values() if v.causality in causalities),
-                      key=lambda v: v.value_reference)
-
-    @property
-    def parameters(self) -> list[Variable]:
-        """Parameters (FMI 3.0 structural parameters included), by value reference."""
-        return self._by("parameter", "structuralParameter")
-
-    @property
-    def inputs(self) -> list[Variable]:
-        return self._by("input")
-
-    @property
-    def outputs(self) -> list[Variable]:
-        """Every output, of any type, by value reference."""
-        return self._by("output")
-
-    @property
-    def unit_definitions(self) -> dict:
-        """The FMU's ``UnitDefinitions`` with a ``BaseUnit``, as :class:`twin.units.Unit` by name."""
-        from twin.units import BASE, Unit
-        out = {}
-        for u in self.model_description.unitDefinitions or ():
-            b = getattr(u, "baseUnit", None)
-            if b is not None:
-                out[u.name] = Unit(u.name, tuple(int(getattr(b, k, 0) or 0) for k in BASE),
-                                   float(b.factor if b.factor is not None else 1.0),
-                                   float(b.offset if b.offset is not None else 0.0))
-        return out
-
-    @property
-    def recordable_outputs(self) -> list[Variable]:
-        """The outputs twin can record (scalars of every type but Binary and Clock)."""
-        return [v for v in self.outputs if v.unsupported_reason is None]
-
-    def warn_unrecorded_outputs(self) -> None:
-        """Warn (:class:`~twin.errors.TwinWarning`) about outputs that recording every output leaves out."""
-        skipped = [v for v in self.outputs if v.unsupported_reason is not None]
-        if skipped:
-            listed = ", ".join(f"{v.name} ({v.type}{list(v.shape) if v.shape else ''})" for v in skipped)
-            warnings.warn(TwinWarning(f"{self.model_name}: not recorded: {listed}; twin records scalar variables "
-                                      "of every type but Binary and Clock"), stacklevel=2)
-
-    def structural_values(self) -> dict[str, int]:
-        """The model's Integer constants (``z1``, ``z2``, ``n_profile``, ...): fixed when the FMU
-        was built, so read from its model description."""
-        return {v.name: int(v.start) for v in self.variables.values()
-                if v.kind == "integer" and v.variability == "constant" and v.start is not None}
-
-    @property
-    def supports_output_buffer(self) -> bool:
-        return OUTPUT_INTERVAL in self.variables
-
-    def variable(self, name: str) -> Variable:
-        try:
-            return self.variables[name]
-        except KeyError:
-            close = [n for n in self.variables if name.lower() in n.lower()][:5]
-            hint = f"; similar: {', '.join(close)}" if close else ""
-            raise ParameterError(f"{self.model_name} has no variable {name!r}{hint}") from None
-
-    def experiment(self, start_time: float | None = None, stop_time: float | None = None,
-                   output_interval: float | None = None, *, fmpy_grid: bool = True) -> tuple[float, float, float]:
-        """(start, stop, output interval) [s]: the values given, else the model's default experiment.
-
-        Start: ``startTime``, else 0.  Stop: ``stopTime``, else start + 1 s.  Output interval, as
-        ``fmpy.simulate_fmu`` chooses it over the model's own experiment: the FMI 3.0
-        ``fixedInternalStepSize``, else ``stepSize``, doubled until the run has at most 1000
-        intervals (where that does not divide the run, the largest doubling that does: the twin's
-        samples are whole intervals, fmpy would end on a shorter one); else fmpy's automatic
-        interval (500 to 1000 samples).  With a stop time given, or ``fmpy_grid=False``
-        (scenarios), the model's step is taken as it is, so a vibration model keeps its sample rate.
-        """
-        de = self.default_experiment
-        start = float(start_time) if start_time is not None else (de.start_time if de.start_time is not None else 0.0)
-        stop = float(stop_time) if stop_time is not None else (de.stop_time if de.stop_time is not None else start + 1.0)
-        if not stop > start:
-            raise SimulationError(f"stop_time ({stop} s) must be after start_time ({start} s)")
-        fixed = _float_or_none(getattr(self.model_description.coSimulation, "fixedInternalStepSize", None))
-        step = de.step_size if de.step_size is not None and de.step_size > 0 else None
-        if output_interval is not None:
-            interval = float(output_interval)
-        elif fmpy_grid and (fixed or step) and stop_time is None:
-            interval = float(fixed or step)
-            while (stop - start) / interval > 1000:     # fmpy's rule, so both give the same samples
-                interval *= 2
-            while not whole_multiple(stop - start, interval) and interval > float(fixed or step):
-                interval /= 2                           # fmpy would end on a shorter interval
-        elif step:
-            interval = step
-        elif fixed:
-            interval = fixed
-        else:
-            from fmpy.util import auto_interval
-            interval = float(auto_interval(stop - start))
-        if not interval > 0:
-            raise SimulationError(f"output_interval must be > 0 s, got {interval!r}")
-        return start, stop, interval
+    def _auto_interval(self, span: float) -> float:
+        """fmpy's automatic output interval [s] for a run of ``span`` s (500 to 1000 samples)."""
+        from fmpy.util import auto_interval
+        return float(auto_interval(span))
 
     # -- lifecycle -------------------------------------------------------------------------
     def _logger(self, status, message):
@@ -493,33 +346,6 @@ class FMU:
             pass
 
     # -- values ----------------------------------------------------------------------------
-    def _typed(self, values: Mapping[str, Any], *, initialised: bool) -> dict[str, Any]:
-        """``values`` converted to their variables' types; every problem in one ParameterError."""
-        out, problems = {}, []
-        for name, value in values.items():
-            try:
-                v = self.variable(name)
-                if v.variability == "constant" and v.kind in ("integer", "boolean") and self.rebuildable:
-                    from twin.variants import rebuild_hint
-                    raise ParameterError(rebuild_hint(self.model_name, name, value))
-                reason = v.read_only_reason(self.model_name)
-                if reason:
-                    raise ParameterError(reason)
-                if initialised:
-                    if v.causality not in ("parameter", "input"):
-                        raise ParameterError(f"'{name}' is a start value of {self.model_name}; it can only be "
-                                             "set before the run starts")
-                    if v.causality == "parameter" and v.variability != "tunable":
-                        raise ParameterError(f"'{name}' is a {v.variability} parameter and cannot change "
-                                             "during a run")
-                out[name] = v.coerce(value)
-            except ParameterError as exc:
-                problems.append(str(exc))
-        if problems:
-            raise ParameterError(problems[0] if len(problems) == 1 else
-                                 f"{len(problems)} bad values:\n  " + "\n  ".join(problems))
-        return out
-
     def _groups(self, variables: Iterable[Variable]) -> dict[str, list[int]]:
         """fmpy accessor suffix -> positions in ``variables``."""
         access = _ACCESS[self.fmi_version]
@@ -559,48 +385,6 @@ class FMU:
                     x = bool(x)
                 out[i] = x
         return out
-
-    def set(self, values: Mapping[str, Any]) -> None:
-        """Set parameters, inputs or (before the run) start values by name.
-
-        Values are converted to each variable's type (see :meth:`twin.variables.Variable.coerce`).
-        Constants, structural and calculated parameters, and fixed parameters during a run are
-        refused by name, all problems in one :class:`ParameterError`.
-        """
-        typed = self._typed(values, initialised=self._initialized)
-        self.instantiate()
-        self._write(typed)
-
-    def get(self, names: str | Sequence[str]):
-        """Current values by name: one value for one name (float, int, bool or str), else a
-        float array when every name is a float variable and a list otherwise.
-
-        Variables of every type are read (value references are unique per type only, so each is
-        read with its own type's call); Binary, Clock and array variables are refused by name.
-        """
-        self.instantiate()
-        single = isinstance(names, str)
-        names = [names] if single else list(names)
-        variables = [self.variable(n) for n in names]
-        vals = self._read(variables)
-        if single:
-            return vals[0]
-        if all(v.kind == "float" for v in variables):
-            return np.array(vals, dtype=float)
-        return vals
-
-    def get_values(self, names: Sequence[str]) -> list:
-        """Current values of ``names`` as a list of Python values of their types (float, int,
-        bool, str; an enumeration's integer value)."""
-        self.instantiate()
-        return self._read([self.variable(n) for n in names])
-
-    def parameter_values(self) -> dict[str, Any]:
-        """Current value of every parameter of a supported type, by name."""
-        params = [v for v in self.parameters if v.unsupported_reason is None]
-        if not params:
-            return {}
-        return dict(zip((v.name for v in params), self._read(params)))
 
     # -- stepping --------------------------------------------------------------------------
     def _do_step(self, h: float) -> bool:
@@ -647,18 +431,6 @@ class FMU:
         except Exception:       # an FMU may not provide the status; the step start is used then
             return None
 
-    def _end(self, t: float, h: float, last, how: str) -> bool:
-        """Record that the FMU ended the run within the step [t, t + h]."""
-        last = _float_or_none(last)
-        tol = 1e-9 * max(1.0, abs(t + h))
-        if last is None or not t - tol <= last <= t + h + tol:
-            last = t                 # not reported (or nonsense): the step start is the last valid time
-        message = "; ".join(self._messages[-3:])
-        self._messages.clear()
-        self.ended = RunEnd(min(max(last, t), t + h), f"{how} at t={last:.9g} s" + (f": {message}" if message else ""))
-        self.time = self.ended.time
-        return False
-
     def step(self, dt: float) -> None:
         """Advance one communication step of ``dt`` seconds (or less, if the FMU ends the run:
         then :attr:`ended` is set)."""
@@ -681,155 +453,7 @@ class FMU:
     def free_state(self, state) -> None:
         self._call(self._fn("FreeFMUState"), self._slave.freeFMUState, state[0])
 
-    # -- capture ---------------------------------------------------------------------------
-    def _recorded(self, names: Iterable[str] | None) -> list[Variable]:
-        """The variables to record: ``names`` (checked: they exist and have a supported type),
-        or every output of a supported type."""
-        if names is None:
-            return self.recordable_outputs
-        variables, problems = [], []
-        for n in names:
-            try:
-                v = self.variable(n)
-                if v.unsupported_reason:
-                    raise ParameterError(v.unsupported_reason + "; it cannot be recorded")
-                if v.causality == "independent":
-                    raise ParameterError(f"'{n}' is the independent variable; it is the result's time axis")
-                variables.append(v)
-            except ParameterError as exc:
-                problems.append(str(exc))
-        if problems:
-            raise ParameterError(problems[0] if len(problems) == 1 else "\n  ".join(problems))
-        return variables
-
-    def run(self, stop_time: float, output_interval: float, *, outputs: Iterable[str] | None = None,
-            communication_step: float | None = None, progress: bool = False, callback=None) -> SimulationResult:
-        """Simulate from the current time to ``stop_time`` and return the sampled outputs.
-
-        Parameters
-        ----------
-        stop_time : end time [s].
-        output_interval : output sample period [s] (1e-5 for 100 kHz).
-        outputs : names to record (default: every output of a supported type).
-        communication_step : how often ``callback`` runs [s]; default 0.1 s (one Python call per
-            10,000 samples at 100 kHz for buffered FMUs).
-        callback : ``callback(fmu, t)`` called after every communication step (events, hooks).
-
-        Returns a :class:`SimulationResult` whose ``time`` has shape (n,) with
-        n = round((stop_time - start) / output_interval) + 1, or fewer samples when the FMU ends
-        the run itself (``ended_by_fmu``; the last sample is at the FMU's last valid time).  Its
-        parameters are :attr:`initial_parameters`.
-        """
-        if not self._initialized:
-            self.setup(self.time, stop_time=stop_time)
-        if not output_interval > 0:
-            raise SimulationError(f"output_interval must be > 0 s, got {output_interval!r}", time=self.time)
-        variables = self._recorded(outputs)
-        k0 = round((self.time - self._t_start) / output_interval)
-        n_samples = int(round((stop_time - self._t_start) / output_interval)) - k0
-        if n_samples < 1:
-            raise SimulationError(f"stop_time {stop_time} s leaves no output sample after t={self.time} s",
-                                  time=self.time)
-        per_step = max(1, int(round((communication_step or 0.1) / output_interval)))
-        names = [v.name for v in variables]
-        blocks = [Block(np.array([self.time]), tuple(np.array([x], dtype=v.dtype)
-                                                     for v, x in zip(variables, self._read(variables))))]
-        bar = progress_bar(n_samples, progress, self.model_name, "samples")
-        k = 0
-        try:
-            while k < n_samples and self.ended is None:
-                m = min(per_step, n_samples - k)
-                block = self.capture_block(self._t_start + (k0 + k + m) * output_interval, output_interval, names)
-                blocks.append(block)
-                k += m
-                if callback is not None and self.ended is None:
-                    callback(self, self.time)
-                bar.update(m)
-        finally:
-            bar.close()
-        return self._result(variables, blocks, output_interval)
-
-    def _result(self, variables: Sequence[Variable], blocks: Sequence[Block], output_interval: float) -> SimulationResult:
-        time = np.concatenate([b.time for b in blocks])
-        columns = [np.concatenate([b.columns[j] for b in blocks]) for j in range(len(variables))]
-        for v, col in zip(variables, columns):
-            if v.kind == "float":
-                bad = ~np.isfinite(col)
-                if bad.any():
-                    i = int(np.argmax(bad))
-                    raise SimulationError(f"output {v.name} is not finite", time=float(time[i]))
-        return SimulationResult(
-            time=time, signals={v.name: c for v, c in zip(variables, columns)},
-            units={v.name: v.unit for v in variables}, sample_rate=1.0 / output_interval,
-            parameters=dict(self.initial_parameters), model_name=self.model_name, guid=self.guid,
-            fmu_sha256=self.sha256, types={v.name: v.type for v in variables},
-            enumerations={v.name: dict(v.items) for v in variables if v.items},
-            ended_by_fmu=self.ended is not None, end_reason=self.ended.reason if self.ended else "")
-
-    def capture(self, t_end: float, output_interval: float, names: Sequence[str]) -> np.ndarray:
-        """Advance to ``t_end`` and return float outputs sampled every ``output_interval``.
-
-        Returns shape (m, len(names)): the samples at t + output_interval, ..., t_end, where
-        m = round((t_end - t) / output_interval).  For variables of other types, or FMUs that may
-        end the run themselves, use :meth:`capture_block`; here such an end is a SimulationError.
-        """
-        variables = [self.variable(n) for n in names]
-        not_float = [v.name for v in variables if v.kind != "float"]
-        if not_float:
-            raise ParameterError(f"capture() returns floats; {', '.join(not_float)} "
-                                 f"{'is not a float variable' if len(not_float) == 1 else 'are not float variables'} "
-                                 "(capture_block returns every type)")
-        block = self.capture_block(t_end, output_interval, names)
-        if self.ended is not None:
-            raise SimulationError(f"{self.model_name} ended the run itself before t={t_end:.6g} s: "
-                                  f"{self.ended.reason}", time=self.time)
-        out = np.empty((block.time.size, len(names)))
-        for j, c in enumerate(block.columns):
-            out[:, j] = c
-        return out
-
-    def capture_block(self, t_end: float, output_interval: float, names: Sequence[str]) -> Block:
-        """Advance to ``t_end`` and return the samples of ``names`` every ``output_interval``.
-
-        Samples are at the grid points start + k * output_interval after the current time up to
-        ``t_end``; FMUs built by fmu_build fill an internal buffer during one doStep, other FMUs
-        get one doStep and one get per type per sample.  If the FMU ends the run itself, the block
-        stops there: its last sample is at the FMU's last valid time (on the grid when within
-        1e-9 of a grid point) and :attr:`ended` is set.
-        """
-        # snap to the sample grid t_start + k*interval, which is where the FMU samples, so float
-        # drift over many captures cannot drop or add a sample
-        k_now = round((self.time - self._t_start) / output_interval)
-        k_end = round((t_end - self._t_start) / output_interval)
-        m = int(k_end - k_now)
-        if m < 1:
-            raise SimulationError(f"capture to t={t_end} s leaves no sample after t={self.time} s", time=self.time)
-        variables = self._recorded(names)
-        if self._buffer_fn is not None and all(v.type in ("Real", "Float64") for v in variables):
-            return self._capture_buffered(k_now, m, output_interval, variables)
-        times = np.empty(m)
-        columns = [np.empty(m, dtype=v.dtype) for v in variables]
-        n = 0
-        for j in range(m):
-            t_next = self._t_start + (k_now + j + 1) * output_interval
-            if not self._do_step(t_next - self.time):
-                t_last = self.ended.time
-                if abs(t_last - t_next) <= 1e-9 * output_interval:
-                    t_last = t_next
-                previous = self._t_start + (k_now + j) * output_interval
-                if t_last > previous + 1e-9 * output_interval:     # a sample the grid does not have yet
-                    times[n] = t_last
-                    for c, x in zip(columns, self._read(variables)):
-                        c[n] = x
-                    n += 1
-                break
-            self.time = t_next
-            times[n] = t_next
-            for c, x in zip(columns, self._read(variables)):
-                c[n] = x
-            n += 1
-        return Block(times[:n], tuple(c[:n] for c in columns))
-
+    # -- capture from the output buffer of FMUs built by fmu_build ------------------------------
     def _capture_buffered(self, k_now: int, m: int, output_interval: float, variables: Sequence[Variable]) -> Block:
         all_outputs = [v.name for v in self.outputs]
         try:
