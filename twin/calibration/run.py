@@ -48,7 +48,7 @@ from pathlib import Path
 import numpy as np
 
 from twin.errors import ScenarioError
-from twin.scenario import CALIBRATION_SCHEMA
+from twin.scenario_schema import CALIBRATION_SCHEMA
 
 
 @dataclass(frozen=True)

@@ -11,7 +11,7 @@ from twin.calibration.modal_fit import mode_errors
 from twin.calibration.pairing import (MATCH_REACH, PAIRINGS, REFUSE_COHERENCE, REFUSE_MISMATCH, MeasuredShapes,
                                       Pairing, mac, mode_reach, pair_modes, refused, shape_mismatch, shape_refusals)
 from twin.calibration.sensitivity import Candidate, ModelModes, Sensitivity, match_measured
-from twin.scenario import CALIBRATION_SCHEMA
+from twin.scenario_schema import CALIBRATION_SCHEMA
 from twin.signals.shapes import ChannelShape
 
 CHANNELS = ("accel_pinion_casing", "accel_gear_casing")
