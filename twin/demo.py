@@ -159,7 +159,7 @@ def _gear_errors_demo(base, modelica_dir: Path, stop_time: float, pinion_hz: flo
     """The same run with a gear of its own: the variant with per-gear-tooth errors, one gear drawn
     as the archive draws it; its sidebands at the gear's shaft order against the perfect gear's."""
     from fmu_build import build_fmu
-    from twin.archive import draw_wheel
+    from twin.record_gears import draw_wheel
     from twin.fmu import simulate_fmu
     from twin.signals.gearmesh import sideband_energy_ratio
     from twin.signals.spectral import amplitude_spectrum

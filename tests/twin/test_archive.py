@@ -103,7 +103,7 @@ class _FixedDraw:
 
 
 def test_tooth_errors_by_hand():
-    from twin.archive import tooth_errors
+    from twin.record_gears import tooth_errors
     teeth = 4
     healthy = {"k_pair[1]": 2.0, "k_pair[2]": 2.0, "profile_deviation[1]": 0.0, "profile_deviation[2]": 0.0}
     pitted = {**healthy, "k_pair[1]": 1.6, "k_pair[2]": 1.6}                           # L = 0.2
@@ -126,7 +126,7 @@ def test_tooth_errors_by_hand():
 
 
 def test_tooth_compliance_factors_keep_the_mean_deflection_by_hand():
-    from twin.archive import tooth_compliance_factors
+    from twin.record_gears import tooth_compliance_factors
     # Healthy flank stiffness 1 everywhere; the uniform damage halves it at mid path, linearly
     # in between (three nodes, as the FMU interpolates): the loss is t / 2, with t running from 0
     # at either end to 1 at mid path, so mean(1 / k_damaged) = int_0^1 dt / (1 - t / 2) = 2 ln 2.
@@ -143,7 +143,7 @@ def test_tooth_compliance_factors_keep_the_mean_deflection_by_hand():
 
 
 def test_tooth_errors_runout_and_identical_teeth():
-    from twin.archive import tooth_errors
+    from twin.record_gears import tooth_errors
     rng = np.random.default_rng(3)
     healthy = {"k_pair[1]": 1.0}
     none = tooth_errors(rng, {}, 19, healthy, healthy)
@@ -172,7 +172,7 @@ def test_archive_with_tooth_errors_keeps_every_other_draw(archive_pair, gearbox_
 
 
 def test_each_record_names_the_gear_it_was_simulated_with(gearbox_fmu, tmp_path):
-    from twin.archive import draw_pinion, pinion_parameters, tooth_errors
+    from twin.record_gears import draw_pinion, pinion_parameters, tooth_errors
     from twin.measurements import load_measurements
     sc = _small()
     bounds = {"pitch_error": 2e-6, "runout": 10e-6, "tooth_damage_scatter": 0.5}
@@ -254,7 +254,7 @@ def test_gear_errors_need_the_variant(gearbox_fmu, wheel_fmu, tmp_path, monkeypa
 def test_wheel_draw_by_hand():
     """The gear's teeth sit at the cumulative sum of its single pitch deviations, which closes over
     the revolution, plus the run-out; zero bounds give a perfect gear."""
-    from twin.archive import draw_wheel, runout_deviation
+    from twin.record_gears import draw_wheel, runout_deviation
     assert not np.any(draw_wheel(np.random.default_rng(0), {}, 52).deviation)
     w = draw_wheel(np.random.default_rng(4), {"wheel_pitch_error": 2e-6}, 52)
     # replay the draws: sd, the 52 single deviations, then run-out and phase
@@ -275,7 +275,7 @@ def test_wheel_draw_by_hand():
 def test_archive_with_wheel_errors_keeps_every_other_draw(archive_pair, wheel_fmu, tmp_path):
     """A wheel of its own per record changes the signals and nothing else the archive draws; the
     records keep it, as set in the FMU, and with pinion errors too each keeps both."""
-    from twin.archive import draw_wheel
+    from twin.record_gears import draw_wheel
     a, _ = archive_pair
     sc = _small(workers=2)
     bounds = {"wheel_pitch_error": 1.5e-6, "wheel_runout": 10e-6}

@@ -15,7 +15,7 @@ Data (built once per task and cached in ``data_dir``, keyed by the settings belo
   fixed casing resonances, which no augmentation of recorded signals reproduces; so the archive
   is simulated over a range that covers the rig's (the emulated rig scatters by 2 % and 10 %).
   With the scenario's 1 % the rig's fastest records were the ones misassessed.
-  Each record also has a pinion of its own (:func:`twin.archive.tooth_errors`): run-out
+  Each record also has a pinion of its own (:func:`twin.record_gears.tooth_errors`): run-out
   up to 10 um peak to peak, per-tooth damage factors with a relative sd up to 0.5 (pitting) / 0.1
   (wear, which the hunting tooth ratio 19:52 evens out), and, in the wear archive only, pitch
   errors with an sd up to 2 um (ISO 1328 class 5 for m = 3 mm, d = 57 mm allows a single pitch
@@ -24,7 +24,7 @@ Data (built once per task and cached in ``data_dir``, keyed by the settings belo
   otherwise identical, and with identical teeth its shaft-order sidebands sat 21-23 dB below the
   mesh harmonics, against -7 to -17 dB on the emulated rig (bench/transfer_diagnostics.py).
   A tooth's pitting factor keeps its mean compliance along the path
-  (:func:`twin.archive.tooth_compliance_factors`).
+  (:func:`twin.record_gears.tooth_compliance_factors`).
   Many short records rather than a few long ones: what the network must learn to ignore is the
   spread *between* records (operating point, sensor gain, the damage within its stage), and a
   record's later windows add little of it.  At the same number of windows, hence the same
@@ -80,12 +80,12 @@ class DataSettings:
     source_speed_scatter: float = 0.03
     source_load_scatter: float = 0.15
     # each source record's pinion: bounds of its pitch-error sd [m], run-out [m] and relative
-    # tooth-to-tooth damage sd (twin.archive.tooth_errors); 0 = identical, perfect teeth
+    # tooth-to-tooth damage sd (twin.record_gears.tooth_errors); 0 = identical, perfect teeth
     source_pitch_error: float = 2e-6
     source_runout: float = 10e-6
     source_tooth_damage_scatter: float = 0.5
     # each source record's gear (wheel): bounds of its single-pitch-deviation sd and run-out [m]
-    # (twin.archive.draw_wheel); 0 = a perfect gear
+    # (twin.record_gears.draw_wheel); 0 = a perfect gear
     source_wheel_pitch_error: float = 0.0
     source_wheel_runout: float = 0.0
     # which rig measures the target: an emulated rig (RIGS), simulated here, or the name of a rig
@@ -148,7 +148,7 @@ TASK_CLASS_PRIOR = {"pitting": "ordinal", "wear": "source"}
 
 # Changes of how the archive is simulated that the settings above do not show.  Data cached under
 # another value are rebuilt.  2: per-tooth pitting factors keep each tooth's mean compliance
-# (twin.archive.tooth_compliance_factors, 2026-11-24) instead of its mean stiffness.
+# (twin.record_gears.tooth_compliance_factors, 2026-11-24) instead of its mean stiffness.
 ARCHIVE_RULES = 2
 
 

@@ -101,7 +101,7 @@ class TargetShift:
 
 def runout_offsets(runout: float, phase: float, teeth: int = N_PINION_TEETH) -> dict[str, float]:
     """``tooth_deviation_offset[1..teeth]`` [m] of an eccentric pinion (>= 0, ``runout`` peak to peak)."""
-    from twin.archive import runout_deviation
+    from twin.record_gears import runout_deviation
     dev = runout_deviation(runout, phase, teeth)
     return {f"tooth_deviation_offset[{k + 1}]": float(d) for k, d in enumerate(dev)}
 
