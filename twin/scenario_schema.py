@@ -60,7 +60,10 @@ CALIBRATION_SCHEMA: dict[str, Any] = {
         "n_gen": {"type": "integer", "minimum": 1},
         "record": {"type": "string"},
         "natural_frequencies": {"type": "array", "items": {"type": "number", "exclusiveMinimum": 0}, "minItems": 1},
-        "foundation_modes": {"type": "array", "items": {"type": "number", "exclusiveMinimum": 0}},
+        "foundation_modes": {"oneOf": [{"type": "array", "items": {"type": "number", "exclusiveMinimum": 0}},
+                                       {"type": "string"}],
+                             "description": "the foundation's modes, removed from the measured ones (paper: hammer "
+                                            "test on the casing root): in Hz, or the name of a hammer-test record"},
         "record_duration": {"type": "number", "exclusiveMinimum": 0},
         "settle_time": {"type": "number", "minimum": 0},
         "band": {"type": "array", "items": {"type": "number", "minimum": 0}, "minItems": 2, "maxItems": 2},

@@ -7,7 +7,8 @@ Scenario block (every key but ``parameters`` optional)::
       modes_from: runup           # record whose run-up (or hammer test) gives the measured modes
       min_confidence: 0.3         # modes of that record used for calibration
       natural_frequencies: [22, 87, 218, 430]   # or typed by hand [Hz]
-      foundation_modes: [13, 41]  # removed from the measured modes (paper: hammer test)
+      foundation_modes: [13, 41]  # removed from the measured modes (paper: hammer test), in Hz
+                                  #   or the name of a hammer-test record to read them from
       record: steady              # steady record for the signal objectives (default: the first other one)
       objectives: [correlation, modes]   # of waveform, correlation, frequencies, modes
       algorithm: mogoa            # or nsga2
@@ -146,16 +147,40 @@ def measured_modes(spec: dict, mset, source: str, out_dir: Path, *, with_damping
         raise ScenarioError([(source, "calibration.natural_frequencies",
                               "give the measured natural frequencies, or modes_from: RECORD to read them from a "
                               "run-up or hammer record")])
-    if spec.get("foundation_modes"):
-        kept, removed = remove_foundation_modes(freqs, np.asarray(spec["foundation_modes"]))
+    foundation = spec.get("foundation_modes")
+    if isinstance(foundation, str):
+        foundation = foundation_modes_of(foundation, spec, mset, source, out_dir)
+    if foundation is not None and len(foundation):
+        kept, removed = remove_foundation_modes(freqs, np.asarray(foundation, float))
         keep = np.isin(freqs, kept)
         freqs, rel, damping, confidence = freqs[keep], rel[keep], damping[keep], confidence[keep]
         if shapes is not None:
             shapes = replace(shapes, vectors=shapes.vectors[keep], coherence=shapes.coherence[keep])
-        print(f"removed foundation modes {list(np.round(removed, 1))} Hz from the measured list")
+        print(f"removed foundation modes {[round(float(f), 1) for f in removed]} Hz from the measured list")
     if with_damping:
         return freqs, rel, what, damping, confidence, channels, shapes
     return freqs, rel, what
+
+
+def foundation_modes_of(name: str, spec: dict, mset, source: str, out_dir: Path) -> np.ndarray:
+    """(q,) natural frequencies [Hz] of the foundation read from the hammer-test record ``name``
+    (a force channel in N, see :func:`twin.modes.survey_record`), the paper's impact test on the
+    casing root: the modes the calibration must not fit with the gearbox.  Modes below the
+    block's ``min_confidence`` are left in; the survey is written to ``foundation_modes.json``."""
+    from twin.modes import MIN_CONFIDENCE, survey_record, write_survey_json
+
+    where = "calibration.foundation_modes"
+    if name not in mset.names:
+        raise ScenarioError([(source, where, f"no record {name!r} in the measurements "
+                                             f"(they have {', '.join(mset.names)})")])
+    record = mset[name]
+    if not any(record.units[c] == "N" for c in record.channel_names):
+        raise ScenarioError([(source, where, f"record {name!r} is not a hammer test (it has no force channel "
+                                             "in N): give the foundation's modes from an impact test, or in Hz")])
+    survey = survey_record(record)
+    write_survey_json(survey, out_dir / "foundation_modes.json", record=name)
+    threshold = float(spec.get("min_confidence", MIN_CONFIDENCE))
+    return np.array([m.frequency for m in survey.modes if m.confidence >= threshold])
 
 
 def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, executor=None,
@@ -188,7 +213,10 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
         print(f"note: {note}")
     freqs, rel_sd, modes_what, damping, confidence, seen_by, shapes = measured_modes(spec, mset, source, out_dir,
                                                                                      with_damping=True)
-    steady_name = spec.get("record") or next((n for n in mset.names if n != spec.get("modes_from")), mset.names[0])
+    # the first record that neither gives the modes nor is the foundation's hammer test
+    not_steady = {spec.get("modes_from"), spec.get("foundation_modes") if isinstance(spec.get("foundation_modes"), str)
+                  else None}
+    steady_name = spec.get("record") or next((n for n in mset.names if n not in not_steady), mset.names[0])
     if steady_name not in mset.names:
         raise ScenarioError([(source, "calibration.record", f"no record {steady_name!r} in the measurements")])
     rec = mset[steady_name]

@@ -91,3 +91,37 @@ def test_bad_calibration_block_lists_problems(gearbox_fmu, rig, tmp_path):
     bare = scenario_from_dict({"version": 1, "name": "c", "fmu": str(gearbox_fmu), "stop_time": 1.0})
     with pytest.raises(ScenarioError, match="no calibration block"):
         run_calibration(bare, rig, tmp_path / "o2", progress=False)
+
+
+def _hammer(name="hammer", modes=((87.0, 0.02), (218.0, 0.015), (512.0, 0.02)), fs=8192.0, hits=6):
+    """A hammer test: 6 hits 1 s apart on three modes, force [N] and acceleration [m/s2]."""
+    import scipy.signal as sps
+    rng = np.random.default_rng(0)
+    n = int(hits * fs)
+    force = np.zeros(n)
+    for i in range(hits):
+        k = int((i + 0.1) * fs)
+        force[k:k + 8] = (1.0 + 0.2 * rng.standard_normal()) * np.hanning(8)
+    t = np.arange(n) / fs
+    accel = sum(sps.lsim(sps.TransferFunction([1.0, 0.0, 0.0], [1.0, 4 * math.pi * zeta * f, (2 * math.pi * f) ** 2]),
+                         force, t)[1] for f, zeta in modes)
+    accel = accel + 1e-3 * np.std(accel) * rng.standard_normal(n)
+    return Record(name, {"hammer": force, "accel_pinion_casing": accel}, {"hammer": "N", "accel_pinion_casing": "m/s2"},
+                  fs)
+
+
+def test_foundation_modes_read_from_a_hammer_record(tmp_path):
+    """The paper's procedure: the run-up's modes less those an impact test on the casing shows."""
+    from twin.calibration.run import measured_modes
+    from twin.measurements import MeasurementSet
+
+    steady = Record("steady", {"accel_pinion_casing": np.zeros(1000)}, {"accel_pinion_casing": "m/s2"}, 1e4)
+    mset = MeasurementSet((steady, _hammer()))
+    spec = {"natural_frequencies": [45.0, 87.5, 219.0, 433.0, 515.0], "foundation_modes": "hammer"}
+    freqs, _, _ = measured_modes(spec, mset, "s.yaml", tmp_path)
+    assert list(freqs) == [45.0, 433.0]
+    assert (tmp_path / "foundation_modes.json").exists()
+    with pytest.raises(ScenarioError, match="'steady' is not a hammer test"):
+        measured_modes({**spec, "foundation_modes": "steady"}, mset, "s.yaml", tmp_path)
+    with pytest.raises(ScenarioError, match="no record 'impact'"):
+        measured_modes({**spec, "foundation_modes": "impact"}, mset, "s.yaml", tmp_path)
