@@ -299,7 +299,9 @@ def clipping_problems(channel: str, x: np.ndarray, unit: str) -> list[str]:
     :data:`CLIP_MIN_RUN` consecutive samples sit exactly at it, or when more than
     ``max(1, CLIP_MAX_FRACTION * n)`` samples do (a smooth signal reaches its extreme
     once; a saturated converter holds it). Constant channels are not checked: they have no
-    excursion that could have been cut. ``x`` must be finite.
+    excursion that could have been cut; nor is an extreme of exactly zero that holds most of
+    the samples, the rest level of an impulsive channel (a hammer's force between its hits).
+    ``x`` must be finite.
     """
     n = x.size
     if n == 0 or x.max() == x.min():
@@ -308,6 +310,8 @@ def clipping_problems(channel: str, x: np.ndarray, unit: str) -> list[str]:
     for side, level in (("maximum", x.max()), ("minimum", x.min())):
         at = x == level
         count = int(at.sum())
+        if level == 0.0 and 2 * count > n:
+            continue
         run = count if count <= 1 else _longest_run(at)       # a noisy signal's extreme: one sample
         if run >= CLIP_MIN_RUN or count > max(1.0, CLIP_MAX_FRACTION * n):
             out.append(f"channel '{channel}' is clipped at its {side} {float(level):.9g} {unit}".rstrip()

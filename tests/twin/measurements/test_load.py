@@ -545,3 +545,14 @@ def test_polyphase_resampling_is_scipys_resample_poly(up, down, n):
     y = polyphase(x, up, down)
     assert y.shape == ref.shape
     np.testing.assert_allclose(y, ref, rtol=0, atol=1e-12 * np.abs(ref).max())
+
+
+def test_a_hammer_force_at_rest_between_hits_is_not_clipping(write_h5, tmp_path):
+    """An impact test's force is exactly zero between its hits; a clipped hit is still refused."""
+    force = np.zeros(N)
+    for i, k in enumerate(range(100, N - 20, N // 4)):
+        force[k:k + 7] = (50.0 + 3.0 * i) * np.hanning(9)[1:8] * np.linspace(1.0, 0.9, 7)   # one peak sample
+    assert load_measurements(_one(write_h5, tmp_path / "h.h5", force, unit="N"))[0].n_samples == N
+    force[force > 40.0] = 40.0                                  # the hits cut at the amplifier's limit
+    with pytest.raises(MeasurementError, match="clipped at its maximum 40 N"):
+        load_measurements(_one(write_h5, tmp_path / "h2.h5", force, unit="N"))
