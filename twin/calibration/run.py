@@ -82,7 +82,7 @@ def _col(model: float, measured: float) -> str:
     return f"{model:13.1f} {100 * (model - measured) / measured:+9.1f}"
 
 
-def _block(scenario, modes_from: str | None, pairing: str | None = None) -> dict:
+def _block(scenario, modes_from: str | None, pairing: str | None = None, foundation_from: str | None = None) -> dict:
     import jsonschema
 
     spec = scenario.raw.get("calibration")
@@ -97,6 +97,8 @@ def _block(scenario, modes_from: str | None, pairing: str | None = None) -> dict
         spec["modes_from"] = modes_from
     if pairing is not None:
         spec["pairing"] = pairing
+    if foundation_from is not None:
+        spec["foundation_modes"] = foundation_from
     errors = [(str(scenario.source), "calibration." + ".".join(map(str, e.absolute_path)),
                "must be 'auto' or a mapping of parameter name to [lower, upper]"
                if e.validator == "oneOf" else e.message)
@@ -185,9 +187,11 @@ def foundation_modes_of(name: str, spec: dict, mset, source: str, out_dir: Path)
 
 def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, executor=None,
                     progress: bool = True, seed: int | None = None, resume: bool = False,
-                    modes_from: str | None = None, pairing: str | None = None) -> CalibrationReport:
-    """Calibrate the scenario's FMU to a measurement file (see the module docstring); ``modes_from``
-    and ``pairing`` override the calibration block's keys."""
+                    modes_from: str | None = None, pairing: str | None = None,
+                    foundation_from: str | None = None) -> CalibrationReport:
+    """Calibrate the scenario's FMU to a measurement file (see the module docstring); ``modes_from``,
+    ``pairing`` and ``foundation_from`` (a hammer record: ``foundation_modes``) override the
+    calibration block's keys."""
     from twin._atomic import check_output_dir
     from twin.calibration.levels import fit_levels, has_levels, panel_participations
     from twin.calibration.modal_fit import mode_errors, on_bounds
@@ -201,7 +205,7 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
     from twin.measurements import load_measurements
     from twin.measurements.resample import resample_record
 
-    spec = _block(scenario, modes_from, pairing)
+    spec = _block(scenario, modes_from, pairing, foundation_from)
     pairing = spec.get("pairing", "frequency")
     source = str(scenario.source)
     out_dir = check_output_dir(out_dir, "calibration output", create=True)

@@ -7,6 +7,7 @@ from pathlib import Path
 
 from twin.commands.common import lib, local_executor, positive_int
 
+
 def add_subcommands(sub) -> None:
     """Register ``calibrate``, ``modes``, ``sensitivity`` and ``compare``."""
     p = sub.add_parser("calibrate", help="calibrate a scenario's FMU to measurements (NSGA-II or MOGOA)")
@@ -19,6 +20,9 @@ def add_subcommands(sub) -> None:
     p.add_argument("--modes-from", metavar="RECORD",
                    help="read the measured modes from this run-up or hammer record (see twin modes); without a "
                         "calibration block the parameters are chosen automatically")
+    p.add_argument("--foundation-from", metavar="RECORD",
+                   help="hammer-test record of the foundation (casing root): its modes are left out of the "
+                        "measured ones, as the paper does")
     _add_pairing_option(p)
     p.add_argument("--no-progress", action="store_true", help="quiet")
     p.set_defaults(handler=_cmd_calibrate)
@@ -42,7 +46,8 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     report = lib("twin.calibration.run").run_calibration(scenario, Path(args.measurements), Path(args.out),
                                                           progress=not args.no_progress, seed=args.seed,
                                                           resume=args.resume, modes_from=args.modes_from,
-                                                          pairing=args.pairing)
+                                                          pairing=args.pairing,
+                                                          foundation_from=args.foundation_from)
     print(f"modes: {report.modes_source}")
     print(report.table())
     for n in report.notes:

@@ -125,3 +125,10 @@ def test_foundation_modes_read_from_a_hammer_record(tmp_path):
         measured_modes({**spec, "foundation_modes": "steady"}, mset, "s.yaml", tmp_path)
     with pytest.raises(ScenarioError, match="no record 'impact'"):
         measured_modes({**spec, "foundation_modes": "impact"}, mset, "s.yaml", tmp_path)
+
+
+def test_foundation_from_overrides_the_block(gearbox_fmu):
+    from twin.calibration.run import _block
+
+    assert _block(_scenario(gearbox_fmu), None, None, "impact")["foundation_modes"] == "impact"
+    assert _block(_scenario(gearbox_fmu), None)["foundation_modes"] == [13.0]
