@@ -94,7 +94,8 @@ def _shared_logger():
     return _SHARED["logger"]
 
 
-def _sha256(path: Path) -> str:
+def file_sha256(path: Path) -> str:
+    """The SHA-256 of a file (hex), which results record to name the FMU that made them."""
     h = hashlib.sha256()
     with open(path, "rb") as f:
         for chunk in iter(lambda: f.read(1 << 20), b""):
@@ -146,7 +147,7 @@ class FMU(FMUDescription, FMUValues, FMUCapture):
             raise FMUError(f"{self.path}: FMI version {md.fmiVersion} is not supported (2.0 and 3.0 are)")
         if md.coSimulation is None:
             raise FMUError(f"{self.path}: the FMU does not support Co-Simulation (it is Model Exchange only)")
-        self.sha256 = _sha256(self.path)
+        self.sha256 = file_sha256(self.path)
         self.variables: dict[str, Variable] = variables_from_description(md)
         de = md.defaultExperiment
         self.default_experiment = DefaultExperiment(
@@ -308,9 +309,12 @@ class FMU(FMUDescription, FMUValues, FMUCapture):
         if self._slave is not None:
             self._call(self._fn("Reset"), self._slave.reset)
         self.time = 0.0
+        self._t_start = 0.0
         self._buffer_interval = None
         self._initialized = False
         self.ended = None
+        self.initial_parameters = {}
+        self._messages.clear()
 
     def close(self) -> None:
         if self._slave is not None:

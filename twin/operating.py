@@ -54,11 +54,11 @@ def simulate_operating_point(fmu_path: str | Path, speed_hz: float, load_nm: flo
     accelerations beyond the bound or vibration growing at these constant inputs are a
     :class:`~twin.errors.SimulationError`.
     """
-    from twin.fmu import FMU
+    from twin.fmu_pool import reused
     from twin.plausibility import check_parameters, checked_capture
 
     start, inputs = operating_point(speed_hz, load_nm)
-    with FMU(fmu_path) as fmu:
+    with reused(fmu_path) as fmu:       # trials run the same FMU many times: opened once per process
         params = {**(parameters or {}), **start}
         check_parameters(fmu, params)
         fmu.setup(0.0, parameters=params, inputs=inputs)

@@ -147,7 +147,7 @@ def simulate_runup(fmu_path, parameters: Mapping[str, float], shaft_hz: np.ndarr
     motor's slip), updated every ``chunk`` s (linear within the record's speed profile). The run
     starts ``settle`` s before the stretch at the first speed, so it begins without a transient.
     """
-    from twin.fmu import FMU
+    from twin.fmu_pool import reused
     from twin.operating import operating_point
     from twin.plausibility import check_parameters
 
@@ -160,7 +160,7 @@ def simulate_runup(fmu_path, parameters: Mapping[str, float], shaft_hz: np.ndarr
     start, inputs = operating_point(shaft_hz[0] + slip_hz, load)
     per = max(1, int(round(chunk * sample_rate)))
     out = np.empty(n)
-    with FMU(fmu_path) as fmu:
+    with reused(fmu_path) as fmu:
         params = {**params, **start}
         check_parameters(fmu, params)
         fmu.setup(0.0, parameters=params, inputs=inputs)
