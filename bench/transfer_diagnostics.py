@@ -3,7 +3,7 @@
     python bench/transfer_diagnostics.py --data-dir DIR [--rig rig|blind|lumped|ltca] [--task wear]
 
 Reads the source archive and the target records that ``bench/transfer.py`` built in DIR
-(``twin.transfer.benchmark.prepare_task``; nothing is simulated or trained here) and prints, per
+(``twin.transfer.benchmark_data.prepare_task``; nothing is simulated or trained here) and prints, per
 stage and per domain, the following. Target labels are read here, for diagnosis only.
 
 * the mean and spread of each record's log RMS, after the domain's mean is removed: the

@@ -53,7 +53,7 @@ model, so ``assess`` windows new data exactly as training did):
      ``remove_level=True`` (or ``normalise="window"``) removes it where a stage's level step is
      within the rig's gain scatter, as for pitting: tooth-local damage shows in the spectral
      shape, and the early pitting stages differ in level by only ~19 % per stage
-     (``twin.transfer.benchmark.TASK_REMOVE_LEVEL``).
+     (``twin.transfer.benchmark_data.TASK_REMOVE_LEVEL``).
    * ``"waveform"`` -- the paper's raw samples, normalised as in step 4.
 
    Why the default changed from the paper's waveform: on the benchmark's pitting task (same data),

@@ -206,7 +206,7 @@ def test_prepare_task_keeps_each_rigs_data_apart_and_reuses_it(tmp_path, monkeyp
     import twin.archive
     import twin.degradation_run
     import twin.scenario
-    import twin.transfer.benchmark
+    import twin.transfer.benchmark_data
     import twin.transfer.domain
     from twin.transfer.benchmark import prepare_task
 
@@ -237,7 +237,7 @@ def test_prepare_task_keeps_each_rigs_data_apart_and_reuses_it(tmp_path, monkeyp
     assert calls[n:] == [("source", "source_wear.h5"), ("target", "target_wear.h5")]
     assert rig[0].read_text() == "3" and blind[0].read_text() == "32"                       # the blind pair untouched
     # data built under other archive rules (the same settings, older code) are rebuilt too
-    monkeypatch.setattr(twin.transfer.benchmark, "ARCHIVE_RULES", twin.transfer.benchmark.ARCHIVE_RULES + 1)
+    monkeypatch.setattr(twin.transfer.benchmark_data, "ARCHIVE_RULES", twin.transfer.benchmark_data.ARCHIVE_RULES + 1)
     n = len(calls)
     prepare_task("wear", tmp_path, rig_settings("wear", "blind"), progress=False)
     assert calls[n:] == [("source", "source_wear_blind.h5"), ("target", "target_wear_blind.h5")]
