@@ -22,7 +22,8 @@ each is reported, the machine being shared):
 * **assess** -- the whole ``Ensemble.assess`` of the file (2 members and more) with each path:
   reading, preprocessing, networks, class-prior rule, agreement, order check.
 
-Both paths' stages are compared window by window (they must be identical) and the largest
+First, the CPU time of each stage of the assessment alone (one thread): the work the two cores
+share.  Both paths' stages are compared window by window (they must be identical) and the largest
 difference of a probability printed.  Prints the machine, its load and a Markdown table.
 """
 from __future__ import annotations
@@ -97,6 +98,49 @@ def ensembles(loaded, members):
     return out
 
 
+def stage_profile(loaded, path: Path, repeats: int) -> list[tuple[str, float]]:
+    """CPU time per window of each stage of an assessment, each run alone on one thread (torch
+    with one thread), the fastest of ``repeats``: what the two cores must share."""
+    import torch
+
+    from twin.measurements import iter_measurements
+    from twin.transfer.inference import StackedNetworks
+    from twin.transfer.preprocess import windows_of
+
+    first, pre = loaded.members[0], loaded.preprocessing
+    before = torch.get_num_threads()
+    torch.set_num_threads(1)
+
+    def cpu(f):
+        best, out = float("inf"), None
+        for _ in range(repeats):
+            c = time.process_time()
+            out = f()
+            best = min(best, time.process_time() - c)
+        return out, best
+    try:
+        recs, t_read = cpu(lambda: list(iter_measurements(path, channels=[pre.channel_of("target")], tachometer=False)))
+        prep, t_res = cpu(lambda: [first._prepared([r], None, "assess", "target")[0] for r in recs])
+        (raw, _, _), t_rep = cpu(lambda: windows_of(prep, pre, "assess"))
+        _, normalise = loaded._networks()
+        x, t_norm = cpu(lambda: normalise(raw))
+        _, t_feat = cpu(lambda: loaded._features(prep))
+        one = StackedNetworks([first.network_], threads=1)
+        _, t_net = cpu(lambda: one.probabilities(x if x.ndim == 2 else x[0]))
+        streamed = loaded._streamed(path, features=True, facts=loaded.facts)
+        ens = object.__new__(type(loaded))
+        ens.__dict__.update(loaded.__dict__)
+        ens._streamed = lambda *a, **k: streamed            # the verdict from the streamed numbers
+        _, t_post = cpu(lambda: ens.assess(path, time_ordered=False))
+    finally:
+        torch.set_num_threads(before)
+    n = raw.shape[0]
+    return [(k, 1e3 * v / n) for k, v in [("read (HDF5, gzip)", t_read), ("resample", t_res),
+                                            ("windows + multitaper spectra", t_rep), ("domain normalisation", t_norm),
+                                            ("order-check features", t_feat), ("one member's network", t_net),
+                                            ("verdict (rule, agreement, order check)", t_post)]]
+
+
 def timed(f, *args):
     t, c = time.perf_counter(), time.process_time()
     out = f(*args)
@@ -121,6 +165,10 @@ def main() -> None:
     counts = [int(v) for v in args.members.split(",")]
     print(f"Machine: {machine()}; torch {torch.__version__}, {torch.get_num_threads()} threads by default; "
           f"load average at the start {os.getloadavg()[0]:.1f}", flush=True)
+    prof = stage_profile(loaded, path, args.repeats)
+    print("CPU per window of each stage alone (1 thread, fastest of the repeats):", flush=True)
+    for k, v in prof:
+        print(f"  {k}: {v:.3f} ms")
     rows = []
     for m in counts:
         members = [loaded.members[i % len(loaded.members)] for i in range(m)]
@@ -155,7 +203,8 @@ def main() -> None:
           "whole assess before -> batched [ms/window] | identical stages |")
     print("|---|---|---|---|---|---|---|")
     for m, n, b, c, same, diff in rows:
-        whole = f"{b['assess_before']:.2f} -> {b['assess_after']:.2f}" if "assess_before" in b else ""
+        whole = f"{b['assess_before']:.2f} -> {b['assess_after']:.2f} (CPU {c['assess_after']:.2f})" \
+            if "assess_before" in b else ""
         print(f"| {m} | {b['before']:.2f} | {b['after']:.2f} | {b['before'] / b['after']:.1f}x | "
               f"{c['before']:.2f} -> {c['after']:.2f} | {whole} | {'yes' if same else 'NO'} ({diff:.0e}) |")
 
