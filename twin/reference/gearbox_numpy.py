@@ -27,6 +27,10 @@ matching velocities ``vx4, vy4, ..., vx11, vy11``.  :data:`STATE_NAMES` lists th
 
 Every function that takes a state accepts ``x`` of shape ``(42,)`` or ``(42, m)`` (``m``
 states side by side, e.g. a whole stored trajectory) and returns arrays shaped accordingly.
+
+This module is one file on purpose, above the project's usual module size: the pure-Python
+reference FMU (:mod:`twin.reference.gearbox_pythonfmu`) ships it as a single resource and
+imports it by file name inside the FMU, so it must stand alone (numpy only, no package imports).
 """
 from __future__ import annotations
 
