@@ -158,6 +158,18 @@ def test_target_channel_reaches_the_saved_ensemble_and_assess(tmp_path):
     args = p.parse_args(["assess", str(tmp_path / "ens"), str(rig), "--json", str(tmp_path / "stages.json")])
     assert args.handler(args) == 0
     assert len(json.loads((tmp_path / "stages.json").read_text())["records"]) == 6
+    # records whose test does not fit: refused by name in one line, nothing written
+    from dataclasses import replace
+
+    from twin.transfer.errors import AssessorError
+    recs = list(load_measurements(rig).records)
+    recs[0], recs[3] = replace(recs[0], nominal_speed=10.0), replace(recs[3], load=5.0)
+    bad = write_measurements(recs, tmp_path / "misfit.h5")
+    args = p.parse_args(["assess", str(tmp_path / "ens"), str(bad), "--json", str(tmp_path / "bad.json")])
+    with pytest.raises(AssessorError, match=r"^assess: 2 record\(s\) do not fit .*'rec00' \(speed 10 Hz\), "
+                                            r"'rec03' \(load 5 N.m\)[^\n]*$"):
+        args.handler(args)
+    assert not (tmp_path / "bad.json").exists()
 
 
 def test_agreement_of_two_seeds_and_its_refusals(tmp_path, capsys):
