@@ -4,7 +4,8 @@ A run-up (any record with a tachometer, an encoder or a speed channel) goes thro
 :func:`twin.signals.runup.analyse_runup`; a hammer test (a force channel in N) through
 :func:`twin.signals.impact.analyse_impacts`. With several vibration channels each is analysed
 and the results are merged: a mode seen by any sensor is a mode of the structure, kept with the
-estimate of the sensor that saw it most clearly.
+estimate of the sensor that saw it most clearly. With ``fdd`` the channels' cross-spectral matrix
+adds the modes no single channel separates (a close mode of another shape under a hump).
 
     survey = survey_file("rig.h5", record="runup")
     survey.frequencies(min_confidence=0.5)      # Hz, ascending
@@ -24,6 +25,9 @@ from twin.signals.survey import Line, ModalSurvey, Mode, Order
 VIBRATION_UNITS = ("m/s2", "m/s", "m")
 #: Default confidence a mode needs to be used for calibration.
 MIN_CONFIDENCE = 0.3
+#: Whether a run-up with several vibration channels is also read through their cross-spectral
+#: matrix (frequency-domain decomposition, :mod:`twin.signals.fdd`) by default.
+FDD = False
 
 
 def shaft_angle(record) -> np.ndarray | None:
@@ -86,8 +90,12 @@ def _force_channel(record) -> str | None:
 
 
 def survey_record(record, *, channels=None, fmin: float | None = None, fmax: float | None = None,
-                  resolution: float | None = None) -> ModalSurvey:
-    """Modes, fixed lines and orders of one record (see the module docstring)."""
+                  resolution: float | None = None, fdd: bool | None = None) -> ModalSurvey:
+    """Modes, fixed lines and orders of one record (see the module docstring).
+
+    ``fdd``: with two or more vibration channels of a run-up, also read the channels' cross-spectral
+    matrix for modes the per-channel search misses (:mod:`twin.signals.fdd`); default ``FDD``.
+    """
     from twin.signals.impact import analyse_impacts
     from twin.signals.runup import analyse_runup
 
@@ -120,9 +128,19 @@ def survey_record(record, *, channels=None, fmin: float | None = None, fmax: flo
             surveys.append(replace(analyse_runup(np.asarray(record[c])[keep], record.sample_rate, angle, fmin=fmin,
                                                  fmax=fmax, resolution=resolution), channels=(c,)))
         if len(vib) > 1:
-            return with_shapes(merge_surveys(surveys), [np.asarray(record[c], float)[keep] for c in vib], vib,
-                               record.sample_rate)
+            xs = [np.asarray(record[c], float)[keep] for c in vib]
+            merged = merge_surveys(surveys)
+            if FDD if fdd is None else fdd:
+                merged = with_fdd(merged, xs, record.sample_rate, angle)
+            return with_shapes(merged, xs, vib, record.sample_rate)
     return merge_surveys(surveys)
+
+
+def with_fdd(survey: ModalSurvey, xs, fs: float, angle) -> ModalSurvey:
+    """The survey with the modes the channels' cross-spectral matrix adds (:mod:`twin.signals.fdd`)."""
+    from twin.signals.fdd import fdd_modes
+
+    return replace(survey, modes=fdd_modes(xs, fs, angle, survey))
 
 
 def with_shapes(survey: ModalSurvey, xs, names, fs: float) -> ModalSurvey:

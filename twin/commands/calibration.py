@@ -117,7 +117,7 @@ def _cmd_modes(args: argparse.Namespace) -> int:
         if path is not None:
             check_parent(path)
     survey = modes.survey_file(Path(args.measurements), args.record, channels=args.channel, fmin=args.fmin,
-                               fmax=args.fmax, resolution=args.resolution)
+                               fmax=args.fmax, resolution=args.resolution, fdd=args.fdd)
     print(modes.survey_table(survey, args.min_confidence))
     if args.json:
         modes.write_survey_json(survey, args.json, file=str(args.measurements), record=args.record,
@@ -138,6 +138,9 @@ def _add_modes_parser(sub) -> None:
     p.add_argument("--fmin", type=float, help="lowest frequency [Hz] (default: 4 bins)")
     p.add_argument("--fmax", type=float, help="highest frequency [Hz] (default: min(0.4 fs, 10 kHz))")
     p.add_argument("--resolution", type=float, help="bin spacing [Hz] (default: from the record length)")
+    p.add_argument("--fdd", action=argparse.BooleanOptionalAction, default=None,
+                   help="with two or more vibration channels, also read their cross-spectral matrix for close modes "
+                        "of different shapes (frequency-domain decomposition; default: off)")
     p.add_argument("--min-confidence", type=float, default=0.3,
                    help="confidence a mode needs to be used for calibration (default: 0.3)")
     p.add_argument("--json", type=Path, help="write the modes, lines and orders here")

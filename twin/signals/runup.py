@@ -391,14 +391,22 @@ class _View:
 
 
 def _cut_lines(f: np.ndarray, z: np.ndarray, lines) -> np.ndarray:
-    """z with each line's bins replaced by a straight line between its neighbours.
+    """z with each line's bins replaced by a straight line between its neighbours (see _line_cuts)."""
+    out = z.copy()
+    for lo, hi in _line_cuts(f, z, lines):
+        out[lo:hi] = np.interp(f[lo:hi], [f[lo - 1], f[hi]], [out[lo - 1], out[hi]])
+    return out
+
+
+def _line_cuts(f: np.ndarray, z: np.ndarray, lines) -> list[tuple[int, int]]:
+    """Bins [lo, hi) each line of a dB spectrum z covers.
 
     The cut is as wide as the line's window leakage reaches above the level around it: a
     line 40 dB above a resonance hump leaks over +-5 bins of a Hann window, one 10 dB above it
     over +-2.
     """
-    out = z.copy()
     df = f[1] - f[0]
+    cuts = []
     for ln in lines:
         p = int(round(ln.frequency / df))
         if not 1 <= p < f.size - 1:
@@ -408,9 +416,8 @@ def _cut_lines(f: np.ndarray, z: np.ndarray, lines) -> np.ndarray:
         leak = 10 * np.log10(np.maximum(_KERNEL[_KERNEL_OFFSETS >= 0] / _KERNEL.max(), 1e-30)) + height
         h = int(np.ceil(reach[np.flatnonzero(leak > 0.0)].max() if (leak > 0.0).any() else 1.0))
         h = max(2, min(h + 1, 8))
-        lo, hi = max(p - h, 1), min(p + h + 1, f.size - 1)
-        out[lo:hi] = np.interp(f[lo:hi], [f[lo - 1], f[hi]], [out[lo - 1], out[hi]])
-    return out
+        cuts.append((max(p - h, 1), min(p + h + 1, f.size - 1)))
+    return cuts
 
 
 def _shaft_harmonic(fc: float, speed, df: float) -> float | None:
