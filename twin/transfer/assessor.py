@@ -39,37 +39,24 @@ same machine gives bit-identical weights and predictions.
 from __future__ import annotations
 
 import math
-import time
 from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 
 from twin.transfer.assessment import Assessment, RecordAssessment
-from twin.transfer.errors import AssessorError, ClassPriorWarning
-from twin.transfer.preprocess import (Augmentation, Preprocessing, Prepared, augmented_windows, domain_normaliser,
-                                      prepare, windows_of)
+from twin.transfer.errors import AssessorError
+from twin.transfer.matching import CLASS_PRIOR_WARN_DROP, CLASS_PRIORS, ClassPriorMatch, class_prior_warns
+from twin.transfer.preprocess import Augmentation, Preprocessing, Prepared, domain_normaliser, prepare, windows_of
 
-__all__ = ["Assessment", "Assessor", "METHODS", "RecordAssessment"]
+__all__ = ["Assessment", "Assessor", "CLASS_PRIOR_WARN_DROP", "CLASS_PRIORS", "METHODS", "RecordAssessment",
+           "class_prior_warns"]
 
 METHODS = ("cnn", "mmd", "proposed", "coral")
-CLASS_PRIORS = ("source", "ordinal", None)
-# How far the class-prior match may lower the adaptation windows' mean confidence before fit warns
-# (twin.transfer.prior.confidence_drop).  The middle of the gap in the runs that chose it
-# (2026-11-23, docs/experiments.md): on the balanced benchmark and blind rigs the match cost at most 0.019, on
-# run-to-failure-like subsets of the benchmark rig, where it costs 7-16 points of accuracy, at least
-# 0.066.  Unseen imbalanced sets afterwards: at least 0.053.  The share of windows moved (the earlier
-# statistic, 8 %) overlapped: up to 14 % on balanced data, from 7.8 % on imbalanced.
-CLASS_PRIOR_WARN_DROP = 0.04
 _EVAL_BATCH = 256
 
 
-def class_prior_warns(confidence_drop: float) -> bool:
-    """``fit``'s rule: does a class-prior match that cost this much mean confidence warn?"""
-    return confidence_drop > CLASS_PRIOR_WARN_DROP
-
-
-class Assessor:
+class Assessor(ClassPriorMatch):
     """Wear-stage assessor trained on labelled twin data and unlabelled rig data.
 
     Parameters
@@ -326,11 +313,7 @@ class Assessor:
             :data:`CLASS_PRIOR_WARN_DROP` (see ``class_prior_confidence_drop_``): it had to push
             windows the network was sure of into other stages.
         """
-        import torch
-
-        from twin._progress import progress_bar
-        from twin.transfer.losses import class_contrastive_loss, coral_loss, mmd_loss, pseudo_label_gate
-        from twin.transfer.model import Network
+        from twin.transfer.training import train_network
 
         self._check_params()
         pre, aug = self._pre, self._aug()
@@ -344,220 +327,30 @@ class Assessor:
         self.target_normaliser_ = domain_normaliser(xt, pre, reference=self.source_normaliser_)
         xs_fixed = self.source_normaliser_(xs_fixed)
         xt = self.target_normaliser_(xt)
-        mon = None
+        score_monitor = None
         if monitor is not None:
             mdata, mlabels = monitor if isinstance(monitor, tuple) else (monitor, None)
             mx, _, my = windows_of(self._prepared(mdata, mlabels, "monitor", "target"), pre, "monitor")
-            mon = (self.target_normaliser_(mx), my)
+            mx, known = self.target_normaliser_(mx), my >= 0
 
-        device = self._device()
-        prev_threads = torch.get_num_threads()
-        prev_det = torch.are_deterministic_algorithms_enabled()
-        torch.set_num_threads(self.n_threads)
-        torch.use_deterministic_algorithms(True)
-        try:
-            torch.manual_seed(int(self.seed))
-            rng = np.random.default_rng(int(self.seed))
-            net = Network(k, pre.window).to(device)
-            opt = torch.optim.SGD(net.parameters(), lr=self.lr, momentum=0.9, weight_decay=5e-4)
-            n_s = xs_fixed.shape[0]
-            steps = math.ceil(n_s / self.batch_size)
-            total = steps * self.epochs
-            xt_t = torch.from_numpy(xt).unsqueeze(1).to(device)
-            adapt = self.method != "cnn"
-            history = []
-            self.target_log_weights_ = np.zeros(k)      # the monitor sees the network as trained
-            self.ordinal_anchors_ = None
-            bar = progress_bar(self.epochs, self.progress, f"train {self.method}", "epoch")
-            t_start = time.perf_counter()
-            step = 0
-            t_perm = rng.permutation(xt.shape[0])
-            t_pos = 0
-            for epoch in range(self.epochs):
-                if aug is not None:
-                    xs, ys = augmented_windows(src, pre, aug, rng)
-                    xs = self.source_normaliser_(xs)
-                else:
-                    xs, ys = xs_fixed, ys_fixed
-                xs_t = torch.from_numpy(xs).unsqueeze(1).to(device)
-                ys_t = torch.from_numpy(ys.astype(np.int64)).to(device)
-                perm = rng.permutation(n_s)
-                net.train()
-                sums = dict(loss=0.0, cls=0.0, align=0.0, con=0.0, correct=0, seen=0, gated=0, tseen=0)
-                for b in range(steps):
-                    idx = torch.from_numpy(perm[b * self.batch_size:(b + 1) * self.batch_size])
-                    if idx.numel() < 2:         # a batch of one cannot be batch-normalised
-                        continue
-                    lr = self.lr / (1 + 10 * step / total) ** 0.75
-                    for group in opt.param_groups:
-                        group["lr"] = lr
-                    xb, yb = xs_t[idx], ys_t[idx]
-                    align = con = torch.zeros((), device=device)
-                    if adapt:
-                        if t_pos + idx.numel() > len(t_perm):
-                            t_perm, t_pos = rng.permutation(xt.shape[0]), 0
-                        tidx = torch.from_numpy(t_perm[t_pos:t_pos + idx.numel()])
-                        t_pos += idx.numel()
-                        g, logits = net(torch.cat([xb, xt_t[tidx]]))
-                        gs, gt = g[: idx.numel()], g[idx.numel():]
-                        ls, lt = logits[: idx.numel()], logits[idx.numel():]
-                        align = coral_loss(gs, gt) if self.method == "coral" else mmd_loss(gs, gt)
-                        if self.method == "proposed":
-                            pt = torch.softmax(lt.detach(), dim=1)
-                            yt, mask = pseudo_label_gate(pt, epoch, self.threshold, self.warmup_epochs)
-                            con = class_contrastive_loss(gs, yb, gt, yt, mask, self.margin, self.pairs,
-                                                         self.contrastive_reduction)
-                            sums["gated"] += int(mask.sum())
-                            sums["tseen"] += int(mask.numel())
-                    else:
-                        _, ls = net(xb)
-                    cls = torch.nn.functional.cross_entropy(ls, yb)
-                    loss = cls + self.alpha * align + (self.beta * con if self.method == "proposed" else 0.0)
-                    opt.zero_grad(set_to_none=True)
-                    loss.backward()
-                    opt.step()
-                    step += 1
-                    n_b = idx.numel()
-                    sums["loss"] += float(loss.detach()) * n_b
-                    sums["cls"] += float(cls.detach()) * n_b
-                    sums["align"] += float(align.detach()) * n_b
-                    sums["con"] += float(con.detach()) * n_b
-                    sums["correct"] += int((ls.argmax(1) == yb).sum())
-                    sums["seen"] += n_b
-                seen = max(sums["seen"], 1)
-                rec = {"epoch": epoch + 1, "loss": sums["loss"] / seen, "cls": sums["cls"] / seen,
-                       "align": sums["align"] / seen, "con": sums["con"] / seen,
-                       "source_acc": sums["correct"] / seen,
-                       "gate": sums["gated"] / sums["tseen"] if sums["tseen"] else 0.0, "lr": lr}
-                if mon is not None:
-                    self.network_ = net
-                    self.n_classes_ = k
-                    p = self._proba_windows(mon[0])
-                    known = mon[1] >= 0
-                    rec["monitor_acc"] = (float(np.mean(p.argmax(1)[known] == mon[1][known]))
-                                          if known.any() else None)
-                history.append(rec)
-                bar.update(1)
-            bar.close()
-            self.fit_time_ = time.perf_counter() - t_start
-        finally:
-            torch.set_num_threads(prev_threads)
-            torch.use_deterministic_algorithms(prev_det)
-        net.eval()
+            def score_monitor(net) -> float | None:
+                self.network_, self.n_classes_ = net, k
+                p = self._proba_windows(mx)
+                return float(np.mean(p.argmax(1)[known] == my[known])) if known.any() else None
+
+        self.target_log_weights_ = np.zeros(k)      # the monitor sees the network as trained
+        self.ordinal_anchors_ = None
+        net, history, self.fit_time_ = train_network(self, src, xs_fixed, ys_fixed, xt, k, pre, aug,
+                                                     self.source_normaliser_, self._device(), score_monitor)
         self.network_ = net
         self.n_classes_ = k
         self.classes_ = np.arange(k)
         self.history_ = history
         self.source_prior_ = np.bincount(ys_fixed.astype(np.int64), minlength=k) / ys_fixed.size
         self._fit_match(self._forward(xt)[1])
-        self.n_source_windows_ = int(n_s)
+        self.n_source_windows_ = int(xs_fixed.shape[0])
         self.n_target_windows_ = int(xt.shape[0])
         return self
-
-    def rematch(self, target_unlabelled, class_prior: str | None) -> "Assessor":
-        """A copy of this fitted assessor that stages rig data by another class-prior rule.
-
-        The network, the normalisers and the history are shared; only the match is fitted anew, on
-        the rig's unlabelled adaptation data (the ``target_unlabelled`` given to :meth:`fit`).
-        ``fit`` trains the same network under every rule (the match comes after training), so with
-        the data ``fit`` saw the copy is what ``fit(..., class_prior=class_prior)`` would have given,
-        bit for bit, in the time of one forward pass instead of a training run.  The use: ``fit``
-        warned that the match cost confidence (rig data far from the twin's stage proportions, a
-        run-to-failure history say), and the rig is to be staged with ``class_prior=None`` or the
-        other rule, without retraining.
-
-        Parameters
-        ----------
-        target_unlabelled : records, HDF5/CSV path, or windows (n, window)
-            The rig's adaptation data; labels, if any, are not read.
-        class_prior : {"source", "ordinal", None}
-            The rule, as for the constructor.
-
-        Returns
-        -------
-        Assessor
-            A new fitted assessor; this one is unchanged.
-
-        Raises
-        ------
-        AssessorError
-            Not fitted; an unknown rule; a match asked of the source-only CNN (it reads no rig data);
-            a match asked of an assessor loaded from a file written before ``source_prior_`` was saved
-            (retrain it).
-
-        Warns
-        -----
-        ClassPriorWarning
-            As :meth:`fit`, when the offsets would cost the adaptation windows much confidence.
-        """
-        import copy
-
-        self._check_fitted()
-        if class_prior not in CLASS_PRIORS:
-            raise AssessorError(f"rematch: class_prior={class_prior!r} is invalid: use 'source', 'ordinal' or None")
-        if self.method == "cnn" and class_prior is not None:
-            raise AssessorError(f"rematch: class_prior={class_prior!r} asks the source-only CNN to read rig data; "
-                                "it matches nothing (use class_prior=None, or a method that adapts)")
-        if class_prior is not None and getattr(self, "source_prior_", None) is None:
-            raise AssessorError("rematch: this assessor has no record of the twin's stage proportions "
-                                "(source_prior_; assessors saved before it was written lack it): retrain it with "
-                                f"class_prior={class_prior!r}")
-        x, *_ = self._windows(target_unlabelled, "rematch", "target")
-        new = copy.copy(self)
-        new.class_prior = class_prior
-        new._fit_match(self._forward(x)[1])
-        return new
-
-    def _fit_match(self, p_adapt: np.ndarray) -> None:
-        """Fit this assessor's class-prior rule to the adaptation windows' network probabilities
-        ``p_adapt`` (n, K), and record its diagnostics (:meth:`_class_prior_check`)."""
-        from twin.transfer.prior import match_class_prior, ordinal_anchors
-        self.target_log_weights_, self.ordinal_anchors_ = np.zeros(p_adapt.shape[1]), None
-        prior = None
-        if self.method != "cnn" and self.class_prior is not None:
-            prior = self.source_prior_
-            if self.class_prior == "source":
-                self.target_log_weights_ = match_class_prior(p_adapt, prior)
-            else:
-                self.ordinal_anchors_ = ordinal_anchors(p_adapt, prior)
-        self._class_prior_check(p_adapt, prior)
-
-    def _class_prior_check(self, p_adapt: np.ndarray, prior: np.ndarray | None) -> None:
-        """Record how the match (offsets or ordinal) re-assesses the adaptation windows ``p_adapt``
-        (n, K); warn when the offsets cost the windows much confidence (the symptom of rig data that
-        break the match's assumption; a rig that only shifts the boundaries moves the windows the
-        network was unsure of)."""
-        from twin.transfer.prior import confidence_drop, match_class_prior, ordinal_probabilities, stage_moves
-        if getattr(self, "ordinal_anchors_", None) is None:
-            self.adaptation_stage_counts_, self.class_prior_moved_ = stage_moves(p_adapt, self.target_log_weights_)
-            self.class_prior_confidence_drop_ = confidence_drop(p_adapt, self.target_log_weights_)
-        else:
-            k = p_adapt.shape[1]
-            before, after = p_adapt.argmax(1), ordinal_probabilities(p_adapt, self.ordinal_anchors_).argmax(1)
-            self.adaptation_stage_counts_ = np.stack([np.bincount(before, minlength=k),
-                                                      np.bincount(after, minlength=k)])
-            self.class_prior_moved_ = float(np.mean(before != after))
-            # The ordinal confidence measures the distance from a boundary, not comparable with the
-            # network's.  Whether the rig data break the proportion assumption is a property of the
-            # data, so the warning reads what the offsets would have cost (they are not applied).
-            self.class_prior_confidence_drop_ = confidence_drop(p_adapt, match_class_prior(p_adapt, prior))
-        if prior is not None and class_prior_warns(self.class_prior_confidence_drop_):
-            import warnings
-            k = p_adapt.shape[1]
-            counts = ", ".join(map(str, self.adaptation_stage_counts_[0]))
-            warnings.warn(
-                f"the class-prior match lowered the mean confidence of the {p_adapt.shape[0]} rig adaptation "
-                f"windows by {100 * self.class_prior_confidence_drop_:.1f} points (more than "
-                f"{100 * CLASS_PRIOR_WARN_DROP:.0f}) and moved {100 * self.class_prior_moved_:.1f} % of them to "
-                f"another stage. Unmatched, they read as stages 0..{k - 1}: {counts}; the match assumes the "
-                f"proportions {', '.join(f'{v:.2f}' for v in prior)}. It had to push windows the network was sure "
-                f"of into other stages. Either the rig's data do not cover the stages in those proportions (a "
-                f"run-to-failure history, say): stage them without the match, no retraining needed "
-                f"(rematch(rig, class_prior=None); twin rematch ASSESSOR RIG --class-prior none --out DIR); "
-                f"or the rig's records do not fall into the twin's "
-                f"stages, and no setting here fixes that: compare the model with the rig (twin compare, "
-                f"twin diagnose).",
-                ClassPriorWarning, stacklevel=4)
 
     # ---- inference ------------------------------------------------------------------------------
     def _check_fitted(self) -> None:
