@@ -34,6 +34,7 @@ import numpy as np
 from scipy import signal as sps
 from scipy.optimize import least_squares
 
+from twin.signals import peaks as pk
 from twin.signals import runup as ru
 from twin.signals._checks import SignalError
 from twin.signals.shapes import complex_slices
@@ -91,7 +92,7 @@ class _Matrix:
         if bad.all():
             raise SignalError("every bin is covered by an order track; nothing stationary is left")
         trace_db = 10 * np.log10(np.maximum(np.real(np.einsum("faa->f", G)), tiny))
-        for lo, hi in ru._line_cuts(self.f, trace_db, survey.lines):
+        for lo, hi in pk._line_cuts(self.f, trace_db, survey.lines):
             bad[lo:hi] = True
         good = np.flatnonzero(~bad)
         for a in range(G.shape[1]):
@@ -138,16 +139,16 @@ def _mode(m: _Matrix, z: np.ndarray, p: int, prom: float, lo: int, hi: int, slic
           evidence: dict) -> Mode | None:
     """A mode from the peak at bin p of the dB curve z (fit over [lo, hi)), or None for a line."""
     f, df = m.f, m.df
-    width = ru._half_power_width(f, z, p)
-    narrow = np.isfinite(width) and width <= ru.LINE_WIDTH_BINS * df
+    width = pk._half_power_width(f, z, p)
+    narrow = np.isfinite(width) and width <= pk.LINE_WIDTH_BINS * df
     masked = ~m.keep
     if narrow:
-        steady, fluct, _ = ru._steadiness(slices_db, masked, z, p)
+        steady, fluct, _ = pk._steadiness(slices_db, masked, z, p)
         if steady:
             return None
     else:
-        fluct = ru._fluctuation_db(slices_db, masked, p)
-    fn, zeta, r2, fn_sd = ru._sdof_fit(f, z, p, lo, hi, df)
+        fluct = pk._fluctuation_db(slices_db, masked, p)
+    fn, zeta, r2, fn_sd = pk._sdof_fit(f, z, p, lo, hi, df)
     # presence: the share of the slices in which the bin stands clear of the slice's own median
     # level around it (one octave), as the survey counts it
     hw = max(5, int(round(f[p] * (np.sqrt(2) - 1) / df)))
@@ -166,7 +167,7 @@ def _mode(m: _Matrix, z: np.ndarray, p: int, prom: float, lo: int, hi: int, slic
 
 def _window(m: _Matrix, z: np.ndarray, p: int, left: int | None, right: int | None) -> tuple[int, int]:
     """Fit window around bin p: the hump, at most half-way to the neighbouring peaks."""
-    width = ru._half_power_width(m.f, z, p)
+    width = pk._half_power_width(m.f, z, p)
     reach = int(np.clip(np.ceil(2.5 * (width if np.isfinite(width) else 4 * m.df) / m.df), 4, 200))
     lo = max(p - reach, (left + p) // 2 if left is not None else m.band[0], 1)
     hi = min(p + reach + 1, (right + p) // 2 + 1 if right is not None else m.band[-1] + 1)
@@ -289,14 +290,14 @@ def _pair_fit(f: np.ndarray, z: np.ndarray, p: int, lo: int, hi: int, df: float,
               ) -> tuple[float, float, float] | None:
     """(fn [Hz], zeta, R^2) of the mode at bin p of a dB curve, with a known neighbour (fb [Hz], zeta_b).
 
-    The survey's single-mode model (see :func:`twin.signals.runup._sdof_fit`) with the neighbour's
+    The survey's single-mode model (see :func:`twin.signals.peaks._sdof_fit`) with the neighbour's
     response added at a free complex weight ``c``:
     ``10 log10(a^2 |H(f; fn, zeta) + c H(f; fb, zeta_b) + beta|^2 + n)``.
     """
     ff, zz = f[lo:hi], z[lo:hi]
     if ff.size < 8:
         return None
-    grid = ff[:, None] + ru._KERNEL_OFFSETS[None, :] * df
+    grid = ff[:, None] + pk._KERNEL_OFFSETS[None, :] * df
     rb = grid / fb
     hb = 1.0 / (1 - rb * rb + 2j * zeta_b * rb)
 
@@ -304,9 +305,9 @@ def _pair_fit(f: np.ndarray, z: np.ndarray, p: int, lo: int, hi: int, df: float,
         fn, zeta, la, cr, ci, beta, ln = x
         r = grid / fn
         h = 1.0 / (1 - r * r + 2j * zeta * r) + (cr + 1j * ci) * hb + beta
-        return 10 * np.log10((10 ** la * np.abs(h) ** 2) @ ru._KERNEL + 10 ** ln)
+        return 10 * np.log10((10 ** la * np.abs(h) ** 2) @ pk._KERNEL + 10 ** ln)
 
-    width = ru._half_power_width(f, z, p)
+    width = pk._half_power_width(f, z, p)
     zeta0 = float(np.clip(width / (2 * f[p]) if np.isfinite(width) else 0.02, 2e-3, 0.2))
     peak = 10 ** (z[p] / 10)
     floor0 = max(10 ** (np.min(zz) / 10), peak * 1e-6)
