@@ -27,7 +27,7 @@ VIBRATION_UNITS = ("m/s2", "m/s", "m")
 MIN_CONFIDENCE = 0.3
 #: Whether a run-up with several vibration channels is also read through their cross-spectral
 #: matrix (frequency-domain decomposition, :mod:`twin.signals.fdd`) by default.
-FDD = False
+FDD = True
 
 
 def shaft_angle(record) -> np.ndarray | None:

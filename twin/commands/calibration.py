@@ -140,7 +140,7 @@ def _add_modes_parser(sub) -> None:
     p.add_argument("--resolution", type=float, help="bin spacing [Hz] (default: from the record length)")
     p.add_argument("--fdd", action=argparse.BooleanOptionalAction, default=None,
                    help="with two or more vibration channels, also read their cross-spectral matrix for close modes "
-                        "of different shapes (frequency-domain decomposition; default: off)")
+                        "of different shapes (frequency-domain decomposition; default: on)")
     p.add_argument("--min-confidence", type=float, default=0.3,
                    help="confidence a mode needs to be used for calibration (default: 0.3)")
     p.add_argument("--json", type=Path, help="write the modes, lines and orders here")

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from twin.measurements import Record
-from twin.modes import MIN_CONFIDENCE, survey_record
+from twin.modes import FDD, MIN_CONFIDENCE, survey_record
 from twin.signals import SignalError
 from twin.signals.fdd import fdd_modes
 
@@ -63,6 +63,7 @@ def test_a_single_mode_is_not_split(runup_factory, seed):
 
 def test_one_channel_survey_is_unchanged_and_fdd_needs_two(runup_factory):
     rec, _ = _pair(runup_factory, 180.0, 0.04, 0)
+    assert FDD and [m.frequency for m in survey_record(rec).modes] == [m.frequency for m in survey_record(rec, fdd=True).modes]
     a = survey_record(rec, channels=[CHANNELS[0]], fdd=True)
     b = survey_record(rec, channels=[CHANNELS[0]], fdd=False)
     assert [m.frequency for m in a.modes] == [m.frequency for m in b.modes]
