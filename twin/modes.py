@@ -140,7 +140,9 @@ def with_fdd(survey: ModalSurvey, xs, fs: float, angle) -> ModalSurvey:
     """The survey with the modes the channels' cross-spectral matrix adds (:mod:`twin.signals.fdd`)."""
     from twin.signals.fdd import fdd_modes
 
-    return replace(survey, modes=fdd_modes(xs, fs, angle, survey))
+    modes = fdd_modes(xs, fs, angle, survey)
+    return replace(survey, modes=tuple(replace(m, evidence={**m.evidence, "channels": list(survey.channels)})
+                                       if "found_by" in m.evidence else m for m in modes))
 
 
 def with_shapes(survey: ModalSurvey, xs, names, fs: float) -> ModalSurvey:

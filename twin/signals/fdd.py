@@ -12,17 +12,21 @@ modes have different shapes at the sensors, the channels' cross-spectral matrix 
    order sweeping through, a transient) left out. The fixed lines are cut (each element
    interpolated across the line's bins).
 2. **Singular values.** Per bin ``G = U S U^H``; ``s1`` is the power of the dominant shape
-   ``u1``. A peak of ``s1`` is a mode; one the per-channel search lacks is added.
+   ``u1``. A peak of ``s1`` is a mode; one of a single shape (MAC of ``u1`` between the hump's
+   half-power flanks >= 0.9) that the per-channel search lacks is added.
 3. **Close modes.** Inside each hump of ``s1``, the dominant mode is cancelled by projecting the
    matrix off its shape ``phi = u1`` at the peak: ``r(f) = trace(P G P)``, ``P = I - phi phi^H``.
    What a mode of another shape contributes survives the projection, so a second mode under the
    hump stands out as a peak of ``r`` away from the first (a modal filter built from the data; unlike
    the per-bin ``s2`` it does not peak where the two modes cross over). The first singular vector
    changes across such a hump: the MAC between ``u1`` at its two half-power flanks is reported.
+   The hump's own mode is then refitted on the power of its shape, ``u1^H G u1``, with the second
+   mode's response as a coherent neighbour; the pair replaces the per-channel fits inside the hump
+   (which sit between the two modes).
 
-Frequency and damping of each new mode by the survey's single-mode fit to the dB curve it was
-found on (``s1`` or ``r``), confidence as the survey's. Frequencies in Hz, levels in dB re the local
-floor.
+Frequency and damping of the other new modes by the survey's single-mode fit to the dB curve they
+were found on (``s1`` or ``r``), confidence as the survey's. Frequencies in Hz, levels in dB re the
+local floor.
 """
 from __future__ import annotations
 
@@ -225,7 +229,7 @@ def fdd_modes(xs: Sequence, fs: float, angle, survey: ModalSurvey, *, min_confid
         lo, hi = _window(m, z1, p, idx[j - 1] if j > 0 else None, idx[j + 1] if j + 1 < idx.size else None)
         a, b = _flanks(z1, p, lo, hi)
         mac = _mac(m.u1[a], m.u1[b])
-        base = {"flank_mac": round(mac, 3), "channels": "all"}
+        base = {"flank_mac": round(mac, 3)}
         second = _close_mode(m, p, lo, hi, base)
         dominant = _dominant(m, p, pr, lo, hi, second, base) if second is not None else None
         if dominant is not None and second.confidence >= min_confidence:
