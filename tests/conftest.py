@@ -84,6 +84,12 @@ def walls_fmu(fmu_dir) -> Path:
 
 
 @pytest.fixture(scope="session")
+def tilting_walls_fmu(fmu_dir) -> Path:
+    """The shafts model on casing walls that also tilt the housings (GearTwin.Gearbox21TiltingWalls)."""
+    return build_shared("GearTwin.Gearbox21TiltingWalls", fmu_dir)
+
+
+@pytest.fixture(scope="session")
 def wheel_fmu(fmu_dir) -> Path:
     """The variant with the gear's own tooth errors (GearTwin.Variants.Gearbox21WheelErrors)."""
     return build_shared("GearTwin.Variants.Gearbox21WheelErrors", fmu_dir)

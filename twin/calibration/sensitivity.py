@@ -6,7 +6,8 @@
    shaft stiffnesses to within a factor 1.6, couplings, bearings and supports to within a factor
    3-4; where the model computes a shaft from its geometry, its diameter within -15/+20 % and its
    bearing span within -20/+25 %; where it computes casing walls from a plate geometry, the wall
-   thickness within -20/+40 % and each panel size within -20/+20 %), narrowed to the model's own
+   thickness within -20/+40 %, each panel size within -20/+20 % and the lever arm by which a wall
+   tilts a housing within -30/+20 %), narrowed to the model's own
    ``min``/``max`` when it declares them.
 2. **Modes.** The model is linearised about the operating point (:mod:`twin.linearize`) with
    the sensor outputs and the mesh excitation; a model mode counts as *visible* when it makes a
@@ -59,6 +60,9 @@ PHYSICS_BOUNDS: tuple[tuple[str, tuple[str, ...], tuple[float, float], str], ...
      "cast wall thickness: casting tolerance (about 1 mm on 8 mm) and the ribs and bosses that stiffen a panel, -20/+40 %"),
     ("m", ("wall panel size",), (0.8, 1.2),
      "wall panel size: where the clamped edges act (fillets, flanges, ribs), -20/+20 %"),
+    ("m", ("tilt lever arm",), (0.7, 1.2),
+     "tilt lever arm of a housing on a wall: the housing's boss and its joint to the end wall raise the pivot "
+     "above the wall's mid-plane (-30 %), the wall's thickness and fillets lower it (+20 %)"),
     ("", ("calibration multiplier", "pair stiffness"), (0.6, 1.5),
      "mesh stiffness: ISO 6336 single-pair stiffness is good to about -40/+50 %"),
 )
