@@ -11,7 +11,7 @@ share of the mode's kinetic energy; the part with the largest share names the mo
 | ``gear lateral x`` / ``y`` | ``vx10`` / ``vy10``: the gear on its shaft | ``m10`` |
 | ``input pedestals x`` / ``y`` | ``vx4``, ``vx6`` / ``vy4``, ``vy6`` | ``m4``, ``m6`` |
 | ``output pedestals x`` / ``y`` | ``vx9``, ``vx11`` / ``vy9``, ``vy11`` | ``m9``, ``m11`` |
-| ``casing`` | ``vx_casing``, ``vy_casing`` / ``w_casing`` (GearTwin.Gearbox21Casing); ``casing.qd[k]`` (the wall modes of GearTwin.Gearbox21Walls, mass-normalised) | ``m_casing`` / ``I_casing``; 1 (modal states carry sqrt of the modal mass) |
+| ``casing`` | ``vx_casing``, ``vy_casing`` / ``w_casing`` (GearTwin.Gearbox21Casing); ``casing.qd[k]`` (the wall modes of GearTwin.Gearbox21Walls and Gearbox21TiltingWalls, mass-normalised) | ``m_casing`` / ``I_casing``; 1 (modal states carry sqrt of the modal mass) |
 | ``sensor path`` | a sensor's panel or mount modes (massless: only when nothing else moves) | |
 
 In GearTwin.Gearbox21Shafts the shaft bends under its gear and its mass moves with it: the shaft

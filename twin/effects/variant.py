@@ -46,12 +46,12 @@ def candidates_model(base: str = BASE_MODEL) -> str:
 def base_of(parameter_names) -> str:
     """The base model an FMU extends, read from its parameters (a sensor model means
     :data:`MEASURED_MODEL`). Raises :class:`twin.errors.ParameterError` for a model with a casing
-    (``GearTwin.Gearbox21Casing``, ``Gearbox21Shafts``, ``Gearbox21Walls``), which has no candidate model."""
+    (``GearTwin.Gearbox21Casing`` and the models that extend it), which has no candidate model."""
     names = set(parameter_names)
     if "m_casing" in names:
         from twin.errors import ParameterError
         raise ParameterError("the effect catalogue has no candidate model for GearTwin.Gearbox21Casing or "
-                             "Gearbox21Shafts or Gearbox21Walls (a casing on mounts); diagnose a twin calibrated as "
+                             "the models that extend it (a casing on mounts); diagnose a twin calibrated as "
                              f"{MEASURED_MODEL} or {BASE_MODEL}")
     return MEASURED_MODEL if any(n.startswith("sensor_pinion.") for n in names) else BASE_MODEL
 
