@@ -75,6 +75,12 @@ CALIBRATION_SCHEMA: dict[str, Any] = {
         "evaluation_timeout": {"type": "number", "exclusiveMinimum": 0,
                                "description": "s; an evaluation still running then is stopped and scored infeasible "
                                               "(default 600)"},
+        "speed": {"type": "number", "exclusiveMinimum": 0,
+                  "description": "Hz: operating speed of typed natural frequencies without a measurement file "
+                                 "(default: the constant operating.speed)"},
+        "load": {"type": "number", "minimum": 0,
+                 "description": "N.m: operating load of typed natural frequencies without a measurement file "
+                                "(default: the constant operating.load)"},
     },
 }
 

@@ -83,11 +83,13 @@ def write_html(report, scenario, measurements, path: Path) -> None:
                 + html.escape(report.sensitivity.table()) + "</pre>")
     source = html.escape(report.modes_source)
     notes = "".join(f"<p>{html.escape(n)}</p>" for n in report.notes)
+    psd = ('<h2>PSD before and after</h2><img src="report_psd.png" style="max-width:100%">'
+           if measurements is not None else "")
     doc = f"""<!doctype html><html><head><meta charset="utf-8"><title>Calibration: {html.escape(scenario.name)}</title>
 <style>body{{font-family:sans-serif;max-width:60em;margin:2em auto}}table{{border-collapse:collapse}}
 td,th{{border:1px solid #ccc;padding:.25em .6em;text-align:right}}</style></head><body>
 <h1>Calibration of {html.escape(scenario.fmu)} ({html.escape(scenario.name)})</h1>
-<p>Measurements: {html.escape(str(measurements))}. Modes: {source}. Algorithm: {r.algorithm}, {r.n_evals} evaluations
+<p>Measurements: {html.escape(str(measurements) if measurements is not None else "none (typed modes only)")}. Modes: {source}. Algorithm: {r.algorithm}, {r.n_evals} evaluations
 ({r.failed_evals} failed and scored infeasible), then a least-squares polish on the modes.</p>
 {warn}{notes}
 <h2>Natural frequencies (paper Table 2 for this run)</h2>
@@ -100,7 +102,7 @@ td,th{{border:1px solid #ccc;padding:.25em .6em;text-align:right}}</style></head
 <p>Files: calibrated.yaml (the calibrated scenario), calibrated.json, calibrated.ssv (SSP parameter values),
 calibrated.ssp (SSP package: the FMU bound to the calibrated values), knee.json,
 pareto.csv, checkpoint.json.</p>
-<h2>PSD before and after</h2><img src="report_psd.png" style="max-width:100%">
+{psd}
 </body></html>"""
     with atomic_path(path) as tmp:
         Path(tmp).write_text(doc)

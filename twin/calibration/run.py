@@ -20,6 +20,8 @@ Scenario block (every key but ``parameters`` optional)::
       refine: true                # polish the pick by least squares on the modes (default)
       pairing: frequency          # measured to model modes: frequency (default) or shape (opt-in)
       evaluation_timeout: 600     # s; an evaluation still running then is stopped, scored infeasible
+      speed: 20                   # Hz and N.m: the operating point of typed modes without a measurement
+      load: 20                    #   file (default: the scenario's constant operating speed and load)
 
 ``parameters: auto`` chooses the parameters the measured modes can identify, with bounds from
 physics (:mod:`twin.calibration.sensitivity`). The default objectives are the paper's
@@ -28,6 +30,11 @@ physics (:mod:`twin.calibration.sensitivity`). The default objectives are the pa
 nearest visible model mode within 15 %; ``pairing: shape`` pairs by frequency, shape at the
 sensors and each model mode's reach (:mod:`twin.calibration.pairing`), an opt-in that scored
 worse on the rigs.
+
+Without a measurement file (``measurements=None``) the block must type ``natural_frequencies``
+and have only the ``modes`` objective (the default then): a published table of modes calibrates
+the twin alone. The operating point is ``speed``/``load`` of the block, else the scenario's
+constant ``operating.speed``/``operating.load``; there is no level fit and no PSD overlay.
 
 Outputs in ``out_dir``:
 - ``calibrated.yaml``: the calibrated scenario, which ``twin compare``, ``diagnose``,
@@ -38,7 +45,7 @@ Outputs in ``out_dir``:
 - ``knee.json``, ``pareto.csv``, ``checkpoint.json``;
 - ``modes.json`` (modes read from a record), ``sensitivity.json`` (with ``parameters: auto``);
 - ``report.html`` with the paper's Table 2 for this run, warnings (parameters ending on a bound)
-  and PSD overlays before and after (``report_psd.png``).
+  and PSD overlays before and after (``report_psd.png``, with a measurement file).
 """
 from __future__ import annotations
 
@@ -185,11 +192,12 @@ def foundation_modes_of(name: str, spec: dict, mset, source: str, out_dir: Path)
     return np.array([m.frequency for m in survey.modes if m.confidence >= threshold])
 
 
-def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, executor=None,
+def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Path, *, executor=None,
                     progress: bool = True, seed: int | None = None, resume: bool = False,
                     modes_from: str | None = None, pairing: str | None = None,
                     foundation_from: str | None = None) -> CalibrationReport:
-    """Calibrate the scenario's FMU to a measurement file (see the module docstring); ``modes_from``,
+    """Calibrate the scenario's FMU to a measurement file, or with ``measurements=None`` to the
+    block's typed natural frequencies alone (see the module docstring); ``modes_from``,
     ``pairing`` and ``foundation_from`` (a hammer record: ``foundation_modes``) override the
     calibration block's keys."""
     from twin._atomic import check_output_dir
@@ -201,9 +209,9 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
                                           check_calibration_parameters, evaluate_candidate, write_parameter_set)
     from twin.calibration.report import psd_overlay, write_html, write_pareto
     from twin.calibration.sensitivity import model_modes, mode_sensitivity
+    from twin.calibration.typed_modes import modes_only_objectives, typed_operating_point
     from twin.executor import make_executor
     from twin.measurements import load_measurements
-    from twin.measurements.resample import resample_record
 
     spec = _block(scenario, modes_from, pairing, foundation_from)
     pairing = spec.get("pairing", "frequency")
@@ -212,44 +220,34 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
     duration = float(spec.get("record_duration", 0.3))
     settle = float(spec.get("settle_time", 0.1))
     channel = (scenario.outputs or ("accel_pinion_casing",))[0]
-    mset = load_measurements(measurements)
-    for note in mset.notes:
-        print(f"note: {note}")
-    freqs, rel_sd, modes_what, damping, confidence, seen_by, shapes = measured_modes(spec, mset, source, out_dir,
-                                                                                     with_damping=True)
-    # the first record that neither gives the modes nor is the foundation's hammer test
-    not_steady = {spec.get("modes_from"), spec.get("foundation_modes") if isinstance(spec.get("foundation_modes"), str)
-                  else None}
-    steady_name = spec.get("record") or next((n for n in mset.names if n not in not_steady), mset.names[0])
-    if steady_name not in mset.names:
-        raise ScenarioError([(source, "calibration.record", f"no record {steady_name!r} in the measurements")])
-    rec = mset[steady_name]
-    if channel not in rec:
-        raise ScenarioError([(source, "output.variables", f"record {rec.name!r} has no channel {channel!r} "
-                              f"(it has {', '.join(rec.channel_names)})")])
-    if rec.sample_rate != scenario.sample_rate:
-        rec, note = resample_record(rec, scenario.sample_rate)
-        if note:
-            print(f"note: {note}")
-    if rec.nominal_speed is None or rec.load is None:
-        raise ScenarioError([(str(measurements), f"records.{rec.name}",
-                              "calibration needs the record attributes nominal_speed [Hz] and load [N.m]")])
-    if rec.duration < duration:
-        raise ScenarioError([(str(measurements), f"records.{rec.name}",
-                              f"the record lasts {rec.duration:.3g} s, shorter than record_duration {duration:g} s")])
     auto = spec["parameters"] == "auto"
-    default_obj = (["waveform", "correlation", "frequencies"]
-                   if not auto and not spec.get("modes_from") else ["correlation", "modes"])
-    objectives = tuple(spec.get("objectives", default_obj))
-    band = spec.get("band", [10.0, 5000.0])
-    n = int(round(duration * rec.sample_rate))
     fmu = scenario.fmu_path()
     # the model's modes are read at the sensors the measured ones were seen by (those it has)
     outputs = _outputs(fmu)
+    rec = None
+    if measurements is None:
+        objectives = modes_only_objectives(spec, source)
+        freqs, rel_sd, modes_what, damping, confidence, seen_by, shapes = measured_modes(spec, None, source, out_dir,
+                                                                                         with_damping=True)
+        signal, sample_rate = np.zeros(0), scenario.sample_rate
+        speed_hz, load_nm = typed_operating_point(scenario, spec)
+    else:
+        mset = load_measurements(measurements)
+        for note in mset.notes:
+            print(f"note: {note}")
+        freqs, rel_sd, modes_what, damping, confidence, seen_by, shapes = measured_modes(spec, mset, source, out_dir,
+                                                                                         with_damping=True)
+        rec = _steady_record(spec, mset, scenario, channel, duration, source, measurements)
+        default_obj = (["waveform", "correlation", "frequencies"]
+                       if not auto and not spec.get("modes_from") else ["correlation", "modes"])
+        objectives = tuple(spec.get("objectives", default_obj))
+        n = int(round(duration * rec.sample_rate))
+        signal, sample_rate = np.asarray(rec[channel][-n:], float), rec.sample_rate
+        speed_hz, load_nm = float(rec.nominal_speed), float(rec.load)
+    band = spec.get("band", [10.0, 5000.0])
     mode_channels = tuple(c for c in seen_by if c in outputs) or (channel,)
-    target = CalibrationTarget(np.asarray(rec[channel][-n:], float), rec.sample_rate, float(rec.nominal_speed),
-                               float(rec.load), freqs, channel=channel, fmin=band[0], fmax=band[1],
-                               objectives=objectives, mode_rel_sd=rel_sd, mode_channels=mode_channels,
+    target = CalibrationTarget(signal, sample_rate, speed_hz, load_nm, freqs, channel=channel, fmin=band[0],
+                               fmax=band[1], objectives=objectives, mode_rel_sd=rel_sd, mode_channels=mode_channels,
                                mode_shapes=shapes if len(mode_channels) > 1 and pairing == "shape" else None,
                                pairing=pairing)
     fixed = dict(scenario.parameters)
@@ -303,7 +301,7 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
                            nominal=nominal or None)
         chosen = dict(result.chosen)
         levels = None
-        if has_levels(fmu, channel):
+        if rec is not None and has_levels(fmu, channel):
             # the level of the spectrum: sensor gain, roughness and process-force levels (three runs)
             level_kw = dict(speed_hz=target.drive_hz, load_nm=target.load, channel=channel, fmin=band[0],
                             fmax=min(band[1], 0.45 * rec.sample_rate), settle=settle)
@@ -331,15 +329,17 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
         for w in warnings:
             print(f"warning: {w}")
     full = {**fixed, **chosen}
+    against = (f"{Path(measurements).name}, {modes_what}" if measurements is not None
+               else f"modes {modes_what} at {speed_hz:g} Hz, {load_nm:g} N.m")
     write_parameter_set(full, out_dir / "calibrated.json")
     write_parameter_set(full, out_dir / "calibrated.ssv", name=f"{scenario.name}-calibrated", fmu=fmu)
     from twin.ssp import write_ssp
     write_ssp(fmu, full, out_dir / "calibrated.ssp", name=f"{scenario.name}-calibrated",
-              description=f"{scenario.name}: parameters calibrated to {Path(measurements).name}")
+              description=f"{scenario.name}: parameters calibrated to {against}")
     write_parameter_set({**fixed, **result.knee}, out_dir / "knee.json")
     write_pareto(result, objectives, out_dir / "pareto.csv")
     scenario_file = write_calibrated_scenario(scenario, out_dir / "calibrated.yaml", "calibrated.json",
-                                              note=f"{Path(measurements).name}, {modes_what}", calibrated=chosen)
+                                              note=against, calibrated=chosen)
     if "modes" in objectives:
         mb = mode_errors(model_modes(fmu, {**fixed, **nominal}, **kw), freqs, target.rel_sd, target.mode_shapes,
                          pairing=pairing)[1]
@@ -351,9 +351,37 @@ def run_calibration(scenario, measurements: str | Path, out_dir: str | Path, *, 
         mb, ma = b[match_modes(b, freqs)], a[match_modes(a, freqs)]
     report = CalibrationReport(result, freqs, mb, ma, before, after, out_dir, objectives, tuple(warnings),
                                sensitivity, modes_what, scenario_file, notes)
-    psd_overlay(fmu, target, {**fixed, **nominal}, chosen, settle, duration, out_dir / "report_psd.png")
+    if rec is not None:
+        psd_overlay(fmu, target, {**fixed, **nominal}, chosen, settle, duration, out_dir / "report_psd.png")
     write_html(report, scenario, measurements, out_dir / "report.html")
     return report
+
+
+def _steady_record(spec: dict, mset, scenario, channel: str, duration: float, source: str, measurements):
+    """The steady record of the signal objectives, resampled to the scenario's rate, checked."""
+    from twin.measurements.resample import resample_record
+
+    # the first record that neither gives the modes nor is the foundation's hammer test
+    not_steady = {spec.get("modes_from"), spec.get("foundation_modes") if isinstance(spec.get("foundation_modes"), str)
+                  else None}
+    steady_name = spec.get("record") or next((n for n in mset.names if n not in not_steady), mset.names[0])
+    if steady_name not in mset.names:
+        raise ScenarioError([(source, "calibration.record", f"no record {steady_name!r} in the measurements")])
+    rec = mset[steady_name]
+    if channel not in rec:
+        raise ScenarioError([(source, "output.variables", f"record {rec.name!r} has no channel {channel!r} "
+                              f"(it has {', '.join(rec.channel_names)})")])
+    if rec.sample_rate != scenario.sample_rate:
+        rec, note = resample_record(rec, scenario.sample_rate)
+        if note:
+            print(f"note: {note}")
+    if rec.nominal_speed is None or rec.load is None:
+        raise ScenarioError([(str(measurements), f"records.{rec.name}",
+                              "calibration needs the record attributes nominal_speed [Hz] and load [N.m]")])
+    if rec.duration < duration:
+        raise ScenarioError([(str(measurements), f"records.{rec.name}",
+                              f"the record lasts {rec.duration:.3g} s, shorter than record_duration {duration:g} s")])
+    return rec
 
 
 #: Casing panel modes a sensor path of GearTwin.Gearbox21Measured can hold.

@@ -12,7 +12,8 @@ def add_subcommands(sub) -> None:
     """Register ``calibrate``, ``modes``, ``sensitivity`` and ``compare``."""
     p = sub.add_parser("calibrate", help="calibrate a scenario's FMU to measurements (NSGA-II or MOGOA)")
     p.add_argument("scenario", metavar="SCENARIO", help="scenario .yaml with a calibration block")
-    p.add_argument("--measurements", required=True, help="measurement HDF5 (or CSV + sidecar)")
+    p.add_argument("--measurements", help="measurement HDF5 (or CSV + sidecar); without it the block's typed "
+                                           "natural_frequencies alone, on the modes objective")
     p.add_argument("--out", default="calibration", help="output directory (default: calibration)")
     p.add_argument("--workers", type=positive_int, help="local worker processes for the evaluations")
     p.add_argument("--seed", type=int, help="override the scenario's seed")
@@ -43,7 +44,8 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     scenario = lib("twin.scenario").load_scenario(Path(args.scenario))
     if args.workers is not None:
         scenario = scenario.with_overrides(executor={"type": "local", "workers": args.workers})
-    report = lib("twin.calibration.run").run_calibration(scenario, Path(args.measurements), Path(args.out),
+    measurements = Path(args.measurements) if args.measurements else None
+    report = lib("twin.calibration.run").run_calibration(scenario, measurements, Path(args.out),
                                                           progress=not args.no_progress, seed=args.seed,
                                                           resume=args.resume, modes_from=args.modes_from,
                                                           pairing=args.pairing,
