@@ -213,9 +213,15 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
     from twin.executor import make_executor
     from twin.measurements import load_measurements
 
+    source = str(scenario.source)
+    if measurements is None and scenario.raw.get("calibration") is None:
+        raise ScenarioError([(source, "calibration", "the scenario has no calibration block: without --measurements "
+                              "it must type the measured natural_frequencies [Hz]")])
     spec = _block(scenario, modes_from, pairing, foundation_from)
     pairing = spec.get("pairing", "frequency")
-    source = str(scenario.source)
+    if measurements is None:       # refused before anything is written
+        objectives = modes_only_objectives(spec, source)
+        speed_hz, load_nm = typed_operating_point(scenario, spec)
     out_dir = check_output_dir(out_dir, "calibration output", create=True)
     duration = float(spec.get("record_duration", 0.3))
     settle = float(spec.get("settle_time", 0.1))
@@ -226,11 +232,9 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
     outputs = _outputs(fmu)
     rec = None
     if measurements is None:
-        objectives = modes_only_objectives(spec, source)
         freqs, rel_sd, modes_what, damping, confidence, seen_by, shapes = measured_modes(spec, None, source, out_dir,
                                                                                          with_damping=True)
         signal, sample_rate = np.zeros(0), scenario.sample_rate
-        speed_hz, load_nm = typed_operating_point(scenario, spec)
     else:
         mset = load_measurements(measurements)
         for note in mset.notes:

@@ -141,7 +141,8 @@ def test_cli_calibrate_with_modes_from_and_no_calibration_block(gearbox_fmu, rig
                  str(tmp_path / "o"), "--no-progress"]) == 2
     assert "no record 'nope'" in capsys.readouterr().err
     assert main(["calibrate", str(sc), "--out", str(tmp_path / "o")]) == 2
-    assert "the following arguments are required: --measurements" in capsys.readouterr().err
+    assert "no calibration block: without --measurements it must type the measured natural_frequencies" in \
+        capsys.readouterr().err
     assert main(["calibrate", str(sc), "--measurements", str(path), "--pairing", "nearest"]) == 2
     assert "argument --pairing: invalid choice: 'nearest'" in capsys.readouterr().err
 
