@@ -447,9 +447,10 @@ def scenario_sensitivity(scenario, measurements: str | Path | None = None, *, mo
     """The sensitivity study ``parameters: auto`` runs (:class:`twin.calibration.sensitivity.Sensitivity`).
 
     Measured modes from ``modes_from`` (or the scenario's calibration block) when measurements
-    are given; otherwise the model's own first ``n_modes`` visible modes, i.e. what a run-up of
-    a rig exactly like the model would identify. The operating point is the steady record's, or
-    the scenario's speed and load at its start time (20 Hz, 20 N.m when it has none).
+    are given, else the block's typed ``natural_frequencies``; otherwise the model's own first
+    ``n_modes`` visible modes, i.e. what a run-up of a rig exactly like the model would identify.
+    The operating point is the steady record's, else the block's ``speed`` and ``load``, else the
+    scenario's speed and load at its start time (20 Hz, 20 N.m when it has none).
     ``pairing`` (default: the block's ``pairing``, else ``"frequency"``) as in ``twin calibrate``.
     """
     import tempfile
@@ -465,6 +466,7 @@ def scenario_sensitivity(scenario, measurements: str | Path | None = None, *, mo
     load = scenario.inputs.get("load_torque")
     speed_hz = speed(scenario.start_time) / (2 * np.pi) if speed is not None else 20.0
     load_nm = load(scenario.start_time) if load is not None else 20.0
+    speed_hz, load_nm = float(spec.get("speed", speed_hz)), float(spec.get("load", load_nm))
     channel = (scenario.outputs or ("accel_pinion_casing",))[0]
     fmu = scenario.fmu_path()
     values = dict(scenario.parameters)

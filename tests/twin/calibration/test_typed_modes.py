@@ -92,3 +92,14 @@ def test_cli_without_measurements_refuses_a_signal_objective(gearbox_fmu, tmp_pa
                                                     "objectives": ["waveform"]}}))
     assert main(["calibrate", str(path), "--out", str(tmp_path / "out")]) == 2
     assert "calibration.objectives: waveform need a measured record" in capsys.readouterr().err
+
+
+def test_twin_sensitivity_studies_the_typed_modes_at_the_blocks_operating_point(gearbox_fmu, monkeypatch):
+    import twin.calibration.sensitivity as sensitivity
+    from twin.calibration.run import scenario_sensitivity
+    seen = {}
+    monkeypatch.setattr(sensitivity, "mode_sensitivity", lambda fmu, values, freqs, **kw: seen.update(kw, freqs=freqs))
+    sc = _scenario(gearbox_fmu, {"speed": 20, "load": 20}, parameters="auto", natural_frequencies=[400.0, 900.0],
+                   speed=12.5, load=7)
+    scenario_sensitivity(sc)
+    assert (seen["speed_hz"], seen["load_nm"]) == (12.5, 7.0) and list(seen["freqs"]) == [400.0, 900.0]
