@@ -4,7 +4,8 @@ Each step prints a heading and a short table or a few figures; what the figures 
 they stop is in the report files it writes and in ``docs/``.
 
 1. Build the 21-DOF gearbox FMU from ``modelica/`` (cached by source hash).
-2. Its natural frequencies next to the paper's measured ones (Table 2).
+2. Its natural frequencies next to the paper's measured ones (Table 2), and ``twin calibrate`` on
+   those published modes alone (no record).
 3. Simulate the healthy rig at 20 Hz / 20 N.m for ``stop_time`` seconds at 100 kHz output.
 4. Write the signals to HDF5 and a spectrum plot with the gear-mesh harmonics marked; the same run
    with a gear that has tooth errors of its own.
@@ -53,6 +54,26 @@ def _lines(text: str) -> None:
 
 def _written(*paths) -> None:
     print(INDENT + "written: " + ", ".join(str(p) for p in paths))
+
+
+def _paper_calibration(fmu: Path, out_dir: Path) -> None:
+    """``twin calibrate`` on the paper's measured modes alone (no record: ``--measurements`` left out)."""
+    from twin.calibration.run import run_calibration
+    from twin.scenario import scenario_from_dict
+
+    t = time.perf_counter()
+    scenario = scenario_from_dict({
+        "version": 1, "name": "paper_table2", "fmu": str(fmu), "stop_time": 0.2,
+        "output": {"variables": ["accel_pinion_casing"]}, "executor": {"type": "local", "workers": 2},
+        "calibration": {"parameters": "auto", "natural_frequencies": list(MEASURED_MODES_HZ),
+                        "speed": SHAFT_HZ, "load": LOAD_NM}})
+    report = run_calibration(scenario, None, out_dir / "paper_calibration", progress=False)
+    within = int(np.sum(np.abs(report.after_modes / np.asarray(MEASURED_MODES_HZ) - 1) <= 0.08))
+    _lines(f"\ntwin calibrate on these measured modes alone ({time.perf_counter() - t:.0f} s): {within} of "
+           f"{len(MEASURED_MODES_HZ)} within 8 % (the paper's model: 8 of 8); 'none': no twin mode that shows at "
+           "the sensor lies within 15 %")
+    _lines(report.table())
+    _written(out_dir / "paper_calibration" / "calibrated.yaml")
 
 
 def run_demo(out_dir: Path | str = "demo_out", *, stop_time: float = 10.0,
@@ -108,6 +129,7 @@ def run_demo(out_dir: Path | str = "demo_out", *, stop_time: float = 10.0,
     rows += [f"{i:4d}   {m:13.0f}   {f:10.1f}   {100 * (f - m) / m:+8.1f} %"
              for i, (m, f) in enumerate(zip(MEASURED_MODES_HZ, freqs), 1)]
     _lines("\n".join(rows))
+    _paper_calibration(fmu, out_dir)
 
     t = time.perf_counter()
     result = simulate_fmu(fmu, stop_time=stop_time, output_interval=1e-5,
