@@ -54,13 +54,13 @@ def test_the_wall_parameters_follow_the_stated_geometry(walls_fmu):
     assert not {"side_wall_frequency", "side_wall_modal_mass", "wall_damping"} & set(cands)
 
 
-def test_the_walls_couple_both_ways_and_conservatively(walls_fmu):
-    # K = -M A[v, x] over every mechanical coordinate, the wall modes in mass-normalised
-    # coordinates (mass 1): symmetric only if the walls push the pedestals back as they are pushed
+def _stiffness(fmu_path) -> tuple[np.ndarray, list]:
+    """K = -M A[v, x] over every mechanical coordinate (the wall modes in mass-normalised
+    coordinates, mass 1) and those coordinates as (position, velocity, mass)."""
     start, inputs = operating_point(20.0, 20.0)
     quiet = {"pinion_roughness.rms": 0.0, "gear_roughness.rms": 0.0, "process.rms": 0.0}
-    A, names = state_jacobian(walls_fmu, parameters={**quiet, **start}, inputs=inputs, samples=1)
-    masses = mass_values(walls_fmu, {})
+    A, names = state_jacobian(fmu_path, parameters={**quiet, **start}, inputs=inputs, samples=1)
+    masses = mass_values(fmu_path, {})
     dofs = [(f"theta{i}", f"omega{i}", masses[f"I{i}"]) for i in (1, 2, 3, 5, 7, 8, 10, 12, 13)]
     dofs += [(f"{a}{i}", f"v{a}{i}", masses[f"m{i}"]) for a in "xy" for i in (4, 5, 6, 9, 10, 11)]
     dofs += [("x_casing", "vx_casing", masses["m_casing"]), ("y_casing", "vy_casing", masses["m_casing"]),
@@ -69,7 +69,12 @@ def test_the_walls_couple_both_ways_and_conservatively(walls_fmu):
     pos = [names.index(p) for p, _, _ in dofs]
     vel = [names.index(v) for _, v, _ in dofs]
     M = np.array([m for _, _, m in dofs])
-    K = -M[:, None] * A[np.ix_(vel, pos)]
+    return -M[:, None] * A[np.ix_(vel, pos)], dofs
+
+
+def test_the_walls_couple_both_ways_and_conservatively(walls_fmu):
+    # K (_stiffness) is symmetric only if the walls push the pedestals back as they are pushed
+    K, dofs = _stiffness(walls_fmu)
     assert np.abs(K - K.T).max() < 1e-6 * np.abs(np.diag(K)).max()
     # a wall mode is driven by its housing's pedestals (input shaft, horizontal: pedestals 4 and 6)
     with FMU(walls_fmu) as fmu:
@@ -180,19 +185,7 @@ def test_the_tilting_walls_follow_the_stated_geometry(tilting_walls_fmu):
 
 
 def test_the_tilting_walls_couple_both_ways_and_conservatively(tilting_walls_fmu):
-    start, inputs = operating_point(20.0, 20.0)
-    quiet = {"pinion_roughness.rms": 0.0, "gear_roughness.rms": 0.0, "process.rms": 0.0}
-    A, names = state_jacobian(tilting_walls_fmu, parameters={**quiet, **start}, inputs=inputs, samples=1)
-    masses = mass_values(tilting_walls_fmu, {})
-    dofs = [(f"theta{i}", f"omega{i}", masses[f"I{i}"]) for i in (1, 2, 3, 5, 7, 8, 10, 12, 13)]
-    dofs += [(f"{a}{i}", f"v{a}{i}", masses[f"m{i}"]) for a in "xy" for i in (4, 5, 6, 9, 10, 11)]
-    dofs += [("x_casing", "vx_casing", masses["m_casing"]), ("y_casing", "vy_casing", masses["m_casing"]),
-             ("phi_casing", "w_casing", masses["I_casing"])]
-    dofs += [(f"casing.q[{k}]", f"casing.qd[{k}]", 1.0) for k in range(1, 5)]
-    pos = [names.index(p) for p, _, _ in dofs]
-    vel = [names.index(v) for _, v, _ in dofs]
-    M = np.array([m for _, _, m in dofs])
-    K = -M[:, None] * A[np.ix_(vel, pos)]
+    K, dofs = _stiffness(tilting_walls_fmu)
     assert np.abs(K - K.T).max() < 1e-6 * np.abs(np.diag(K)).max()
     i = {p: k for k, (p, _, _) in enumerate(dofs)}
     with FMU(tilting_walls_fmu) as fmu:

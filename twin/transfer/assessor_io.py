@@ -31,6 +31,20 @@ def _finite_numbers(value, n: int) -> np.ndarray | None:
     return arr if np.all(np.isfinite(arr)) else None
 
 
+def read_saved_json(path: Path, fmt: str, versions: tuple[int, ...]) -> dict:
+    """The JSON file of a saved assessor or ensemble, checked for its ``format`` and one of the
+    readable ``versions`` (the last is the current one); AssessorError naming the file otherwise."""
+    try:
+        cfg = json.loads(path.read_text())
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise AssessorError(f"'{path}' is not valid JSON: {exc}") from None
+    if not isinstance(cfg, dict) or cfg.get("format") != fmt or cfg.get("format_version") not in versions:
+        found = cfg if not isinstance(cfg, dict) else cfg.get("format")
+        version = cfg.get("format_version") if isinstance(cfg, dict) else None
+        raise AssessorError(f"'{path}' has format {found!r} version {version!r}; expected {fmt!r} {versions[-1]}")
+    return cfg
+
+
 def save_assessor(self, directory: str | Path) -> Path:
     """Write ``config.json`` (parameters, preprocessing, history) and ``weights.pt`` atomically.
 
@@ -85,13 +99,7 @@ def load_assessor(cls, directory: str | Path, device: str | None = None) -> "Ass
     for f in (cfg_file, w_file):
         if not f.is_file():
             raise AssessorError(f"'{d}' is not a saved assessor: '{f.name}' is missing")
-    try:
-        cfg = json.loads(cfg_file.read_text())
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise AssessorError(f"'{cfg_file}' is not valid JSON: {exc}") from None
-    if cfg.get("format") != SAVE_FORMAT or cfg.get("format_version") not in _READABLE_VERSIONS:
-        raise AssessorError(f"'{cfg_file}' has format {cfg.get('format')!r} version "
-                            f"{cfg.get('format_version')!r}; expected {SAVE_FORMAT!r} {SAVE_VERSION}")
+    cfg = read_saved_json(cfg_file, SAVE_FORMAT, _READABLE_VERSIONS)
     params = dict(cfg["params"])
     version = cfg["format_version"]
     if version < 4:     # trained before the class-prior match existed

@@ -114,7 +114,7 @@ def train_ensemble(source, target, out, *, members: int = DEFAULT_MEMBERS, metho
     import multiprocessing as mp
     from concurrent.futures import ProcessPoolExecutor
 
-    from twin._atomic import atomic_path, check_output_dir
+    from twin._atomic import check_output_dir
     from twin._progress import progress_bar
     from twin.measurements import MeasurementSet, load_measurements
     from twin.transfer.settings import (archive_facts, check_records, class_prior_for, preprocessing_for,
@@ -427,13 +427,9 @@ class Ensemble:
         f = d / "ensemble.json"
         if not f.is_file():
             raise AssessorError(f"'{d}' is not a saved assessor ensemble: 'ensemble.json' is missing")
-        try:
-            cfg = json.loads(f.read_text())
-        except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-            raise AssessorError(f"'{f}' is not valid JSON: {exc}") from None
-        if cfg.get("format") != ENSEMBLE_FORMAT or cfg.get("format_version") != ENSEMBLE_VERSION:
-            raise AssessorError(f"'{f}' has format {cfg.get('format')!r} version {cfg.get('format_version')!r}; "
-                                f"expected {ENSEMBLE_FORMAT!r} {ENSEMBLE_VERSION}")
+        from twin.transfer.assessor_io import read_saved_json
+
+        cfg = read_saved_json(f, ENSEMBLE_FORMAT, (ENSEMBLE_VERSION,))
         ens = cls([d / m for m in cfg["members"]], ArchiveFacts.from_dict(cfg["facts"]))
         k = ens.n_classes_
         anchors = cfg.get("anchors")
