@@ -124,6 +124,8 @@ def measured_modes(spec: dict, mset, source: str, out_dir: Path, *, with_damping
     from twin.modes import MIN_CONFIDENCE, survey_record, write_survey_json
     from twin.signals import remove_foundation_modes
 
+    if isinstance(spec.get("foundation_modes"), str):      # refused before any survey is run or written
+        _hammer_record(spec["foundation_modes"], mset, source)
     if spec.get("modes_from"):
         name = spec["modes_from"]
         if name not in mset.names:
@@ -171,13 +173,9 @@ def measured_modes(spec: dict, mset, source: str, out_dir: Path, *, with_damping
     return freqs, rel, what
 
 
-def foundation_modes_of(name: str, spec: dict, mset, source: str, out_dir: Path) -> np.ndarray:
-    """(q,) natural frequencies [Hz] of the foundation read from the hammer-test record ``name``
-    (a force channel in N, see :func:`twin.modes.survey_record`), the paper's impact test on the
-    casing root: the modes the calibration must not fit with the gearbox.  Modes below the
-    block's ``min_confidence`` are left in; the survey is written to ``foundation_modes.json``."""
-    from twin.modes import MIN_CONFIDENCE, survey_record, write_survey_json
-
+def _hammer_record(name: str, mset, source: str):
+    """The record ``name`` of ``mset`` if it is a hammer test (a force channel in N); ScenarioError
+    naming it otherwise."""
     where = "calibration.foundation_modes"
     if name not in mset.names:
         raise ScenarioError([(source, where, f"no record {name!r} in the measurements "
@@ -186,7 +184,17 @@ def foundation_modes_of(name: str, spec: dict, mset, source: str, out_dir: Path)
     if not any(record.units[c] == "N" for c in record.channel_names):
         raise ScenarioError([(source, where, f"record {name!r} is not a hammer test (it has no force channel "
                                              "in N): give the foundation's modes from an impact test, or in Hz")])
-    survey = survey_record(record)
+    return record
+
+
+def foundation_modes_of(name: str, spec: dict, mset, source: str, out_dir: Path) -> np.ndarray:
+    """(q,) natural frequencies [Hz] of the foundation read from the hammer-test record ``name``
+    (a force channel in N, see :func:`twin.modes.survey_record`), the paper's impact test on the
+    casing root: the modes the calibration must not fit with the gearbox.  Modes below the
+    block's ``min_confidence`` are left in; the survey is written to ``foundation_modes.json``."""
+    from twin.modes import MIN_CONFIDENCE, survey_record, write_survey_json
+
+    survey = survey_record(_hammer_record(name, mset, source))
     write_survey_json(survey, out_dir / "foundation_modes.json", record=name)
     threshold = float(spec.get("min_confidence", MIN_CONFIDENCE))
     return np.array([m.frequency for m in survey.modes if m.confidence >= threshold])

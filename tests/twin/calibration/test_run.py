@@ -125,6 +125,10 @@ def test_foundation_modes_read_from_a_hammer_record(tmp_path):
         measured_modes({**spec, "foundation_modes": "steady"}, mset, "s.yaml", tmp_path)
     with pytest.raises(ScenarioError, match="no record 'impact'"):
         measured_modes({**spec, "foundation_modes": "impact"}, mset, "s.yaml", tmp_path)
+    # a bad hammer record is refused before the run-up is surveyed (and its modes.json written)
+    with pytest.raises(ScenarioError, match="no record 'impact'"):
+        measured_modes({"modes_from": "steady", "foundation_modes": "impact"}, mset, "s.yaml", tmp_path / "o")
+    assert not (tmp_path / "o").exists()
 
 
 def test_foundation_from_overrides_the_block(gearbox_fmu):
