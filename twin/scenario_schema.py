@@ -72,6 +72,10 @@ CALIBRATION_SCHEMA: dict[str, Any] = {
                     "description": "how measured modes are paired with model modes: frequency (the nearest visible "
                                    "model mode within 15 %, default) or shape (frequency, shape at the sensors and "
                                    "reach)"},
+        "visibility": {"enum": ["mesh", "run-up"],
+                       "description": "which excitations make a model mode visible (a pairing candidate): the "
+                                      "mesh's alone (default) or any of a run-up's (mesh, drive and load torque, "
+                                      "lateral forces at the gears, the process force)"},
         "evaluation_timeout": {"type": "number", "exclusiveMinimum": 0,
                                "description": "s; an evaluation still running then is stopped and scored infeasible "
                                               "(default 600)"},

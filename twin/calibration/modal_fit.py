@@ -48,9 +48,9 @@ def mode_errors(model: ModelModes, measured: np.ndarray, rel_sd: np.ndarray, sha
 
 def modes_objective(fmu_path, values: Mapping[str, float], measured, rel_sd, *, speed_hz: float, load_nm: float,
                     channels=("accel_pinion_casing",), shapes: MeasuredShapes | None = None,
-                    pairing: str = "frequency") -> tuple[float, np.ndarray]:
+                    pairing: str = "frequency", visibility: str = "mesh") -> tuple[float, np.ndarray]:
     """Mean squared z over the measured modes, and the matched model frequencies [Hz]."""
-    mm = model_modes(fmu_path, values, speed_hz=speed_hz, load_nm=load_nm, channels=channels)
+    mm = model_modes(fmu_path, values, speed_hz=speed_hz, load_nm=load_nm, channels=channels, visibility=visibility)
     z, matched = mode_errors(mm, np.asarray(measured, float), np.asarray(rel_sd, float), shapes, pairing=pairing)
     return float(np.mean(z ** 2)), matched
 
@@ -58,7 +58,7 @@ def modes_objective(fmu_path, values: Mapping[str, float], measured, rel_sd, *, 
 def fit_modes(fmu_path, names, lower, upper, nominal, x0, measured, rel_sd, *, fixed: Mapping[str, float],
               speed_hz: float, load_nm: float, channels=("accel_pinion_casing",), max_iter: int = 15,
               shapes: MeasuredShapes | None = None, pairing: str = "frequency",
-              start_pairing: Pairing | None = None) -> np.ndarray:
+              start_pairing: Pairing | None = None, visibility: str = "mesh") -> np.ndarray:
     """Fit of the parameters ``names`` to the measured modes by damped Gauss-Newton (Levenberg-
     Marquardt) in log-parameters with the bounds' prior; returns the values (d,).
 
@@ -76,7 +76,7 @@ def fit_modes(fmu_path, names, lower, upper, nominal, x0, measured, rel_sd, *, f
     half = 0.5 * (hi - lo)
     measured = np.asarray(measured, float)
     rel_sd = np.asarray(rel_sd, float)
-    kw = dict(speed_hz=speed_hz, load_nm=load_nm, channels=channels)
+    kw = dict(speed_hz=speed_hz, load_nm=load_nm, channels=channels, visibility=visibility)
 
     def at(u):
         return model_modes(fmu_path, {**fixed, **{n: float(v) for n, v in zip(names, nominal * np.exp(u))}}, **kw)

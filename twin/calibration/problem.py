@@ -53,6 +53,7 @@ class CalibrationTarget:
     mode_shapes: object | None = None       # MeasuredShapes of the measured modes at those sensors, or None
     mode_pairing: object | None = None      # Pairing at the nominal set (shape pairing), or None
     pairing: str = "frequency"              # how measured and model modes are paired (frequency or shape)
+    visibility: str = "mesh"                # which excitations make a model mode visible (mesh or run-up)
 
     @property
     def needs_simulation(self) -> bool:
@@ -117,7 +118,7 @@ def evaluate_candidate(task: EvalTask) -> tuple[np.ndarray, dict]:
         values["modes"], matched = modes_objective(task.fmu_path, task.parameters, tg.natural_frequencies, tg.rel_sd,
                                                    speed_hz=tg.drive_hz, load_nm=tg.load,
                                                    channels=tg.mode_channels or (tg.channel,), shapes=tg.mode_shapes,
-                                                   pairing=tg.pairing)
+                                                   pairing=tg.pairing, visibility=tg.visibility)
         info["matched_frequencies"] = matched.tolist()
     return np.array([values[o] for o in tg.objectives]), info
 
@@ -266,6 +267,8 @@ def calibration_identity(fmu_path: Path, space: ParameterSpace, target: Calibrat
                                               "teeth", "objectives") if hasattr(target, k)}
     if getattr(target, "pairing", "frequency") != "frequency":     # the default keeps earlier identities
         fields["pairing"] = target.pairing
+    if getattr(target, "visibility", "mesh") != "mesh":
+        fields["visibility"] = target.visibility
     h.update(json.dumps({"names": list(space.names), "lower": space.lower.tolist(), "upper": space.upper.tolist(),
                          "settings": {k: (dict(v) if isinstance(v, Mapping) else v) for k, v in settings.items()},
                          "target": fields,
@@ -371,7 +374,7 @@ def _calibrate(fmu_path, space, target, ex, *, algorithm, pop_size, n_gen, seed,
                                              speed_hz=target.drive_hz, load_nm=target.load,
                                              channels=target.mode_channels or (target.channel,),
                                              shapes=target.mode_shapes, pairing=target.pairing,
-                                             start_pairing=target.mode_pairing))
+                                             start_pairing=target.mode_pairing, visibility=target.visibility))
         else:
             chosen = space.to_dict(refine_modes(Path(fmu_path), space, target, start, fixed=fixed))
     return CalibrationResult(space.names, X, F, chosen, space.to_dict(X[knee]),

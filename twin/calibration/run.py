@@ -227,6 +227,7 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
                               "it must type the measured natural_frequencies [Hz]")])
     spec = _block(scenario, modes_from, pairing, foundation_from)
     pairing = spec.get("pairing", "frequency")
+    visibility = spec.get("visibility", "mesh")
     if measurements is None:       # refused before anything is written
         objectives = modes_only_objectives(spec, source)
         speed_hz, load_nm = typed_operating_point(scenario, spec)
@@ -261,7 +262,7 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
     target = CalibrationTarget(signal, sample_rate, speed_hz, load_nm, freqs, channel=channel, fmin=band[0],
                                fmax=band[1], objectives=objectives, mode_rel_sd=rel_sd, mode_channels=mode_channels,
                                mode_shapes=shapes if len(mode_channels) > 1 and pairing == "shape" else None,
-                               pairing=pairing)
+                               pairing=pairing, visibility=visibility)
     fixed = dict(scenario.parameters)
     if not auto:       # unknown or non-physical names and bounds: refused before the first evaluation
         check_calibration_parameters(fmu, ParameterSpace.from_bounds(spec["parameters"]),
@@ -274,7 +275,7 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
         if auto:
             sensitivity = mode_sensitivity(fmu, fixed, freqs, speed_hz=target.drive_hz, load_nm=target.load,
                                            rel_sd=rel_sd, channels=mode_channels, executor=ex,
-                                           shapes=target.mode_shapes, pairing=pairing)
+                                           shapes=target.mode_shapes, pairing=pairing, visibility=visibility)
             target = replace(target, mode_pairing=sensitivity.pairing)
             if not sensitivity.chosen:
                 (out_dir / "sensitivity.json").write_text(json.dumps(sensitivity.to_dict(), indent=2))
@@ -302,7 +303,7 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
             nominal = {}
         space = ParameterSpace.from_bounds(bounds)
         fixed = {k: v for k, v in fixed.items() if k not in space.names}
-        kw = dict(speed_hz=target.drive_hz, load_nm=target.load, channels=mode_channels)
+        kw = dict(speed_hz=target.drive_hz, load_nm=target.load, channels=mode_channels, visibility=visibility)
         shaft = target.measured_shaft_hz if target.needs_simulation else target.drive_hz
         before, _ = evaluate_candidate(EvalTask(str(fmu), {**fixed, **nominal}, target, settle, duration, shaft))
         result = calibrate(fmu, space, target, algorithm=spec.get("algorithm", "mogoa"),
@@ -470,6 +471,7 @@ def scenario_sensitivity(scenario, measurements: str | Path | None = None, *, mo
     if modes_from is not None:
         spec["modes_from"] = modes_from
     pairing = pairing or spec.get("pairing", "frequency")
+    visibility = spec.get("visibility", "mesh")
     speed = scenario.inputs.get("motor_speed_ref")
     load = scenario.inputs.get("load_torque")
     speed_hz = speed(scenario.start_time) / (2 * np.pi) if speed is not None else 20.0
@@ -492,8 +494,9 @@ def scenario_sensitivity(scenario, measurements: str | Path | None = None, *, mo
         freqs = np.asarray(spec["natural_frequencies"], float)
         rel = np.zeros(freqs.size)
     else:
-        mm = model_modes(fmu, values, speed_hz=speed_hz, load_nm=load_nm, channels=(channel,))
+        mm = model_modes(fmu, values, speed_hz=speed_hz, load_nm=load_nm, channels=(channel,), visibility=visibility)
         freqs = mm.frequency[mm.visible][:n_modes]
         rel = np.zeros(freqs.size)
     return mode_sensitivity(fmu, values, freqs, speed_hz=speed_hz, load_nm=load_nm, rel_sd=rel, channels=channels,
-                            executor=executor, shapes=shapes if len(channels) > 1 else None, pairing=pairing)
+                            executor=executor, shapes=shapes if len(channels) > 1 else None, pairing=pairing,
+                            visibility=visibility)

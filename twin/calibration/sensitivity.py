@@ -10,8 +10,15 @@
    tilts a housing within -30/+20 %), narrowed to the model's own
    ``min``/``max`` when it declares them.
 2. **Modes.** The model is linearised about the operating point (:mod:`twin.linearize`) with
-   the sensor outputs and the mesh excitation; a model mode counts as *visible* when it makes a
-   peak of the mesh-to-sensor response, the way a measured mode shows in a run-up.
+   the sensor outputs and the excitations of a run-up (:data:`RUNUP_EXCITATIONS`): the mesh (a
+   transmission error), the drive and the brake torque, and a force at each gear in each lateral
+   direction and across the line of action (shaft-order run-out and unbalance, the process force).
+   A model mode counts as *visible* when it makes a peak of an excitation-to-sensor response, the
+   way a measured mode shows in a run-up: with ``visibility="mesh"`` (default) of the mesh
+   column's, with ``visibility="run-up"`` of any column's (:data:`VISIBILITY`). Every column's
+   visible modes are kept (``ModelModes.visible_by``) whichever rule is used. A mode's level
+   (``gain_db``) is always the mesh column's: the columns' units differ (m, N.m, N), and the mesh
+   is what excites the modes most in a geared run-up, so levels stay comparable between rules.
 3. **Pairing and sensitivities** ``S[i, j] = d ln f_i / d ln p_j`` by one-sided differences (2 %),
    modes followed by their shapes (MAC) so that two crossing modes are not confused
    (:mod:`twin.calibration.pairing`). With ``pairing="frequency"`` (default) the measured modes
@@ -75,6 +82,22 @@ MODEL_FORM = 0.01
 MESH_EXCITATION = "profile_deviation"
 #: Levels of the broadband sources of GearTwin.Gearbox21Measured, set to zero to linearise.
 BROADBAND_LEVELS = ("pinion_roughness.rms", "gear_roughness.rms", "process.rms")
+#: Which excitation-to-sensor responses make a model mode visible: the mesh's alone (default), or
+#: any of a run-up's excitations (:data:`RUNUP_EXCITATIONS`, :data:`LATERAL_FORCES`).
+VISIBILITY = ("mesh", "run-up")
+#: Excitations of a run-up that are FMU inputs, by column name (a unit change of the input). The
+#: speed reference acts through the motor's slip law as ``c_motor`` times the drive torque: the
+#: same column scaled, so it is not repeated.
+RUNUP_EXCITATIONS = {"drive torque": ("drive_torque",), "load torque": ("load_torque",)}
+#: Forces on the gear bodies (no model input needed: a force F on a body of mass m is the column
+#: F/m on its velocity state), by column name: ((velocity state, mass parameter, direction
+#: factor), ...). Run-out and unbalance rotate at shaft order, so they push each gear both ways;
+#: the process force acts across the line of action on the pinion, the gear taking the reaction,
+#: along (cos alpha, -sin alpha) (GearTwin.Gearbox21Measured, ``excitation_off_line_force``).
+LATERAL_FORCES = {"pinion x": (("vx5", "m5", "1"),), "pinion y": (("vy5", "m5", "1"),),
+                  "gear x": (("vx10", "m10", "1"),), "gear y": (("vy10", "m10", "1"),),
+                  "process force": (("vx5", "m5", "cos"), ("vy5", "m5", "-sin"),
+                                    ("vx10", "m10", "-cos"), ("vy10", "m10", "sin"))}
 
 
 def _variables(fmu_path) -> frozenset[str]:
@@ -158,6 +181,8 @@ class ModelModes:
     classes: tuple = ()           # (m,) ModeClass of each mode (twin.calibration.mode_classes)
     sensor_shapes: np.ndarray | None = None   # (k, m) complex residue of each mode at each channel (mesh)
     channels: tuple[str, ...] = ()
+    visible_by: Mapping[str, np.ndarray] = field(default_factory=dict)   # excitation -> (m,) bool
+    visibility: str = "mesh"      # the rule that made ``visible`` (VISIBILITY)
 
     def sensor_shape(self, i: int, channels: Sequence[str]) -> np.ndarray:
         """Mode i's residues at ``channels`` (those it was linearised with; 0 for others), (len,)."""
@@ -168,45 +193,91 @@ class ModelModes:
         return out
 
 
+def check_visibility(visibility: str) -> str:
+    """``visibility`` if it is a known rule (:data:`VISIBILITY`), else a ValueError naming it."""
+    if visibility not in VISIBILITY:
+        raise ValueError(f"unknown visibility {visibility!r}: use one of {', '.join(VISIBILITY)}")
+    return visibility
+
+
 def model_modes(fmu_path, parameters: Mapping[str, float], *, speed_hz: float, load_nm: float,
-                channels: Sequence[str] = ("accel_pinion_casing",), fmax: float = 10_000.0) -> ModelModes:
+                channels: Sequence[str] = ("accel_pinion_casing",), fmax: float = 10_000.0,
+                visibility: str = "mesh") -> ModelModes:
     """Linearise at the operating point and find the visible modes (see the module docstring)."""
     from scipy.signal import find_peaks
 
+    from twin.calibration.mode_classes import classify, dof_table, mass_values
     from twin.linearize import frequency_response, linear_model, modal_model
     from twin.operating import operating_point
 
+    check_visibility(visibility)
     start, inputs = operating_point(speed_hz, load_nm)
+    names = _variables(fmu_path)
     excitations = {"mesh": [MESH_EXCITATION + "[*]"]}
+    excitations.update({k: list(v) for k, v in RUNUP_EXCITATIONS.items() if all(n in names for n in v)})
     # the broadband sources are excitation, not structure: linearised without them (a rough
     # flank's transmission error would otherwise add its slope to the mesh stiffness)
-    quiet = {n: 0.0 for n in BROADBAND_LEVELS if n in _variables(fmu_path)}
+    quiet = {n: 0.0 for n in BROADBAND_LEVELS if n in names}
     lm = linear_model(fmu_path, parameters={**parameters, **quiet, **start}, inputs=inputs, outputs=list(channels),
                       excitations=excitations, settle=0.02, window=2.5e-3, samples=4)
+    masses = {**mass_values(fmu_path, parameters), **parameters}
+    lm = _with_forces(lm, masses, float(parameters.get("alpha", _start(fmu_path, "alpha", 20 * math.pi / 180))))
     mm = modal_model(lm)
     keep = mm.frequency <= fmax
     freq, damp, shapes = mm.frequency[keep], mm.damping[keep], mm.shapes[:, keep]
-    gain = mm.gain[:, :, keep].max(axis=(0, 1))
-    visible = np.zeros(freq.size, dtype=bool)
+    gain = mm.gain[:, 0, keep].max(axis=0)      # the mesh column's (see the module docstring)
+    by = {e: np.zeros(freq.size, dtype=bool) for e in lm.excitations}
     if freq.size:
         grid = np.geomspace(max(1.0, 0.5 * freq.min()), min(fmax, 1.5 * freq.max()), 6000)
         # every mode enters the response, those above fmax too: a stiff sensor mount far above the
         # band carries the whole response to the output, and leaving it out would leave nothing
         h = frequency_response(mm, grid)
-        for k in range(h.shape[0]):
-            for e in range(h.shape[1]):
+        for e, name in enumerate(lm.excitations):
+            # the mode nearest a peak is the one that makes it through this column (its own gain)
+            g = mm.gain[:, e, keep].max(axis=0)
+            for k in range(h.shape[0]):
                 level = 20 * np.log10(np.maximum(np.abs(h[k, e]), 1e-300))
                 peaks, _ = find_peaks(level, prominence=3.0)
                 for p in peaks:
                     near = np.abs(np.log(freq / grid[p])) <= np.maximum(0.03, 2 * damp)
                     if near.any():
-                        i = np.flatnonzero(near)[np.argmax(gain[near])]
-                        visible[i] = True
+                        by[name][np.flatnonzero(near)[np.argmax(g[near])]] = True
+    visible = by["mesh"].copy() if visibility == "mesh" else np.any(list(by.values()), axis=0)
     top = gain[visible].max() if visible.any() else (gain.max() if gain.size else 1.0)
-    from twin.calibration.mode_classes import classify, dof_table, mass_values
-    table = dof_table(lm.state_names, {**mass_values(fmu_path, parameters), **parameters})
+    table = dof_table(lm.state_names, masses)
     return ModelModes(freq, damp, visible, shapes, 20 * np.log10(np.maximum(gain, 1e-300) / top),
-                      tuple(classify(shapes, table)), mm.residues[:, 0, keep], tuple(channels))
+                      tuple(classify(shapes, table)), mm.residues[:, 0, keep], tuple(channels), by, visibility)
+
+
+def _start(fmu_path, name: str, default: float) -> float:
+    """Start value of a parameter of the FMU (``default`` when it has none)."""
+    key = (str(fmu_path), Path(fmu_path).stat().st_mtime_ns, name)
+    if key not in _VARIABLES:
+        from twin.fmu import FMU
+        with FMU(fmu_path) as fmu:
+            v = fmu.variables.get(name)
+            _VARIABLES[key] = float(v.start) if v is not None and v.start is not None else default
+    return _VARIABLES[key]
+
+
+def _with_forces(lm, masses: Mapping[str, float], alpha: float):
+    """``lm`` with a B column per force of :data:`LATERAL_FORCES` whose velocity states it has
+    (1 N on each body: 1/m on its velocity state, times the direction factor)."""
+    from dataclasses import replace
+    factor = {"1": 1.0, "cos": math.cos(alpha), "-cos": -math.cos(alpha), "sin": math.sin(alpha),
+              "-sin": -math.sin(alpha)}
+    cols, names = [], []
+    for name, terms in LATERAL_FORCES.items():
+        if not all(state in lm.state_names for state, _, _ in terms):
+            continue
+        col = np.zeros(len(lm.state_names))
+        for state, mass, f in terms:
+            col[lm.state_names.index(state)] += factor[f] / float(masses.get(mass, 1.0))
+        cols.append(col)
+        names.append(name)
+    if not cols:
+        return lm
+    return replace(lm, B=np.column_stack([lm.B, *cols]), excitations=lm.excitations + tuple(names))
 
 
 def match_measured(model: ModelModes, measured: np.ndarray, rel_sd: np.ndarray | None = None, *,
@@ -268,6 +339,8 @@ class Sensitivity:
     pairing: Pairing | None = None        # of all the measured modes (unpaired: -1), at the nominal set
     pairing_rule: str = "frequency"       # how the modes were paired (twin.calibration.pairing.PAIRINGS)
     refused: tuple[dict, ...] = ()        # measured modes left unpaired for their shape (pairing.shape_refusals)
+    visibility: str = "mesh"              # which excitations made a model mode visible (VISIBILITY)
+    visible_by: Mapping[str, tuple[float, ...]] = field(default_factory=dict)   # excitation -> visible modes [Hz]
 
     def bounds(self) -> dict[str, list[float]]:
         by = {c.name: c for c in self.candidates}
@@ -307,6 +380,10 @@ class Sensitivity:
                         f"{REFUSE_COHERENCE:g}): " + ", ".join(
                             f"{r['measured_hz']:.1f} Hz (model {r['model_hz']:.1f} Hz, {r['shape_mismatch']:.2f})"
                             for r in self.refused))
+        if self.visible_by:
+            rows.append(f"visible model modes at nominal [Hz], by excitation (visibility: {self.visibility}; "
+                        + ("any column counts" if self.visibility == "run-up" else "the mesh column counts") + "):")
+            rows += [f"  {e:<13s} " + ", ".join(f"{f:.0f}" for f in fs) for e, fs in self.visible_by.items()]
         rows += [f"note: {n}" for n in self.notes]
         return "\n".join(rows)
 
@@ -326,7 +403,8 @@ class Sensitivity:
                                for j, c in enumerate(self.candidates)],
                 "chosen": list(self.chosen), "condition": self.condition,
                 "unmatched_measured_hz": list(self.unmatched_hz), "notes": list(self.notes),
-                "pairing_rule": self.pairing_rule,
+                "pairing_rule": self.pairing_rule, "visibility": self.visibility,
+                "visible_by_excitation": {e: list(fs) for e, fs in self.visible_by.items()},
                 "pairing": [{"measured_hz": float(fm), "model_hz": float(f),
                              "model_gain_db": None if self.gain_db is None else float(self.gain_db[i]),
                              "reach_ln_f": None if self.reach is None else [float(v) for v in self.reach[i]],
@@ -340,17 +418,18 @@ def mode_sensitivity(fmu_path, values: Mapping[str, float], measured_hz, *, spee
                      rel_sd=None, channels: Sequence[str] = ("accel_pinion_casing",),
                      candidates: Sequence[Candidate] | None = None, step: float = 0.02,
                      executor=None, shapes: MeasuredShapes | None = None,
-                     pairing: str = "frequency") -> Sensitivity:
+                     pairing: str = "frequency", visibility: str = "mesh") -> Sensitivity:
     """Sensitivities of the measured modes' model counterparts and the identifiable subset.
 
     ``pairing``: ``"frequency"`` (default) or ``"shape"`` (see the module docstring); ``shapes``:
-    the measured modes' shapes at the channels (``twin modes``), used by the shape pairing."""
+    the measured modes' shapes at the channels (``twin modes``), used by the shape pairing;
+    ``visibility``: which excitations make a model mode visible (:data:`VISIBILITY`)."""
     check_pairing(pairing)
     measured = np.asarray(measured_hz, float)
     rel = np.sqrt((np.full(measured.size, 0.0) if rel_sd is None else np.asarray(rel_sd, float)) ** 2
                   + MODEL_FORM ** 2)
     cands = list(candidates) if candidates is not None else candidate_parameters(fmu_path, values)
-    kw = dict(speed_hz=speed_hz, load_nm=load_nm, channels=tuple(channels))
+    kw = dict(speed_hz=speed_hz, load_nm=load_nm, channels=tuple(channels), visibility=check_visibility(visibility))
     base = model_modes(fmu_path, values, **kw)
     notes = []
     if pairing == "frequency":      # paired before the runs: only the paired modes' sensitivities are needed
@@ -378,7 +457,8 @@ def mode_sensitivity(fmu_path, values: Mapping[str, float], measured_hz, *, spee
             S[:, j] = np.log(follow(base, mv, which) / base.frequency[which]) / math.log(1 + step)
         chosen, left_out, info, cond = select_identifiable(S, cands, rel[ok])
         return Sensitivity(base.frequency[which], measured[ok], rel[ok], tuple(cands), S, chosen, left_out, info,
-                           cond, tuple(float(f) for f in measured[~ok]), tuple(notes), gain_db=base.gain_db[which])
+                           cond, tuple(float(f) for f in measured[~ok]), tuple(notes), gain_db=base.gain_db[which],
+                           visibility=visibility, visible_by=_visible_by(base))
     # every candidate model mode's sensitivities, so that each has its own reach for the pairing
     cols = candidate_modes(base)
     S_all = np.zeros((base.frequency.size, len(cands)))
@@ -399,7 +479,13 @@ def mode_sensitivity(fmu_path, values: Mapping[str, float], measured_hz, *, spee
     return Sensitivity(base.frequency[which], measured[ok], rel[ok], tuple(cands), S, chosen, left_out, info, cond,
                        tuple(float(f) for f in measured[~ok]), tuple(notes), reach[which], mismatch,
                        base.gain_db[which], Pairing(base, match), "shape",
-                       tuple(shape_refusals(base, measured, match, rel, shapes=shapes, reach=reach)))
+                       tuple(shape_refusals(base, measured, match, rel, shapes=shapes, reach=reach)),
+                       visibility, _visible_by(base))
+
+
+def _visible_by(model: ModelModes) -> dict[str, tuple[float, ...]]:
+    """Excitation -> the frequencies [Hz] of the model modes its column makes visible."""
+    return {e: tuple(float(f) for f in model.frequency[v]) for e, v in model.visible_by.items()}
 
 
 def _modes_task(task):

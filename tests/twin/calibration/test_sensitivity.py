@@ -79,3 +79,22 @@ def test_the_shape_pairing_gives_each_paired_mode_its_reach(gearbox_fmu):
     assert np.allclose(sens.modes_hz, freqs) and "pairing (measured -> model mode" in sens.table()
     assert np.all(sens.reach > 0) and [p["model_hz"] for p in sens.to_dict()["pairing"]] == sens.modes_hz.tolist()
     assert sens.pairing_rule == "shape" and sens.pairing.index.tolist() == np.flatnonzero(mm.visible)[:6].tolist()
+
+
+def test_a_lateral_force_shows_a_mode_the_mesh_does_not(gearbox_fmu):
+    # the pinion's horizontal mode moves across the line of action: the mesh hardly drives it, a
+    # run-out force on the pinion does
+    kw = dict(speed_hz=20.0, load_nm=20.0)
+    mesh = model_modes(gearbox_fmu, {}, **kw)
+    runup = model_modes(gearbox_fmu, {}, **kw, visibility="run-up")
+    assert set(runup.visible_by) >= {"mesh", "drive torque", "load torque", "pinion x", "pinion y", "gear x",
+                                     "gear y", "process force"}
+    assert np.array_equal(mesh.visible, mesh.visible_by["mesh"])
+    assert np.array_equal(runup.visible, np.any(list(runup.visible_by.values()), axis=0))
+    horizontal = [i for i, c in enumerate(runup.classes) if c.name == "pinion lateral x" and c.shares[c.name] > 0.5]
+    assert horizontal
+    i = horizontal[0]
+    assert not mesh.visible[i] and runup.visible_by["pinion x"][i] and runup.visible[i]
+    np.testing.assert_allclose(runup.gain_db[mesh.visible] - mesh.gain_db[mesh.visible], 0.0, atol=1e-6)
+    with pytest.raises(ValueError, match="visibility 'all'"):
+        model_modes(gearbox_fmu, {}, **kw, visibility="all")
