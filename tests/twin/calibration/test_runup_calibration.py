@@ -158,6 +158,9 @@ def test_cli_sensitivity_from_a_runup(gearbox_fmu, rig_file, tmp_path, capsys):
     assert "chosen (*)" in out and "not identifiable" in out
     data = json.loads((tmp_path / "s.json").read_text())
     assert data["chosen"] and len(data["measured_hz"]) >= 4
+    assert data["visibility"] == "mesh" and "load torque" in data["visible_by_excitation"]
+    assert set(data["modes_hz"]) <= set(data["visible_by_excitation"]["mesh"])
+    assert "by excitation (visibility: mesh" in out
     assert main(["sensitivity", str(sc), "--json", str(tmp_path / "missing" / "s.json")]) == 2
     assert main(["sensitivity", str(sc), "--pairing", "by-shape"]) == 2
     assert "argument --pairing: invalid choice: 'by-shape'" in capsys.readouterr().err
