@@ -19,6 +19,8 @@ Scenario block (every key but ``parameters`` optional)::
       band: [10, 5000]            # Hz, spectrum objective
       refine: true                # polish the pick by least squares on the modes (default)
       pairing: frequency          # measured to model modes: frequency (default) or shape (opt-in)
+      visibility: mesh            # model modes a sensor shows: under the mesh (default) or any
+                                  #   excitation of a run-up (run-up, opt-in)
       evaluation_timeout: 600     # s; an evaluation still running then is stopped, scored infeasible
       speed: 20                   # Hz and N.m: the operating point of typed modes without a measurement
       load: 20                    #   file (default: the scenario's constant operating speed and load)
@@ -29,7 +31,8 @@ physics (:mod:`twin.calibration.sensitivity`). The default objectives are the pa
 (correlation, modes) otherwise. ``pairing: frequency`` (default) pairs each measured mode with the
 nearest visible model mode within 15 %; ``pairing: shape`` pairs by frequency, shape at the
 sensors and each model mode's reach (:mod:`twin.calibration.pairing`), an opt-in that scored
-worse on the rigs.
+worse on the rigs. ``visibility`` (:data:`twin.calibration.sensitivity.VISIBILITY`) says which
+excitations make a model mode visible, i.e. a pairing candidate.
 
 Without a measurement file (``measurements=None``) the block must type ``natural_frequencies``
 and have only the ``modes`` objective (the default then): a published table of modes calibrates
