@@ -15,8 +15,9 @@
    direction and across the line of action (shaft-order run-out and unbalance, the process force).
    A model mode counts as *visible* when it makes a peak of an excitation-to-sensor response, the
    way a measured mode shows in a run-up: with ``visibility="mesh"`` (default) of the mesh
-   column's, with ``visibility="run-up"`` of any column's (:data:`VISIBILITY`). Every column's
-   visible modes are kept (``ModelModes.visible_by``) whichever rule is used. A mode's level
+   column's, with ``visibility="run-up"`` of any column's (:data:`VISIBILITY`). At the nominal set
+   every column's visible modes are kept (``ModelModes.visible_by``, reported) whichever rule is
+   used; with the default rule the fit's linearisations take the mesh column alone. A mode's level
    (``gain_db``) is always the mesh column's: the columns' units differ (m, N.m, N), and the mesh
    is what excites the modes most in a geared run-up, so levels stay comparable between rules.
 3. **Pairing and sensitivities** ``S[i, j] = d ln f_i / d ln p_j`` by one-sided differences (2 %),
@@ -202,8 +203,12 @@ def check_visibility(visibility: str) -> str:
 
 def model_modes(fmu_path, parameters: Mapping[str, float], *, speed_hz: float, load_nm: float,
                 channels: Sequence[str] = ("accel_pinion_casing",), fmax: float = 10_000.0,
-                visibility: str = "mesh") -> ModelModes:
-    """Linearise at the operating point and find the visible modes (see the module docstring)."""
+                visibility: str = "mesh", every_excitation: bool = False) -> ModelModes:
+    """Linearise at the operating point and find the visible modes (see the module docstring).
+
+    The run-up's other excitation columns are linearised only when they decide visibility
+    (``visibility="run-up"``) or are asked for (``every_excitation``, for the report of
+    ``visible_by``): with the default rule the fit's many linearisations need the mesh column alone."""
     from scipy.signal import find_peaks
 
     from twin.calibration.mode_classes import classify, dof_table, mass_values
@@ -214,14 +219,17 @@ def model_modes(fmu_path, parameters: Mapping[str, float], *, speed_hz: float, l
     start, inputs = operating_point(speed_hz, load_nm)
     names = _variables(fmu_path)
     excitations = {"mesh": [MESH_EXCITATION + "[*]"]}
-    excitations.update({k: list(v) for k, v in RUNUP_EXCITATIONS.items() if all(n in names for n in v)})
+    every_excitation = every_excitation or visibility == "run-up"
+    if every_excitation:
+        excitations.update({k: list(v) for k, v in RUNUP_EXCITATIONS.items() if all(n in names for n in v)})
     # the broadband sources are excitation, not structure: linearised without them (a rough
     # flank's transmission error would otherwise add its slope to the mesh stiffness)
     quiet = {n: 0.0 for n in BROADBAND_LEVELS if n in names}
     lm = linear_model(fmu_path, parameters={**parameters, **quiet, **start}, inputs=inputs, outputs=list(channels),
                       excitations=excitations, settle=0.02, window=2.5e-3, samples=4)
     masses = {**mass_values(fmu_path, parameters), **parameters}
-    lm = _with_forces(lm, masses, float(parameters.get("alpha", _start(fmu_path, "alpha", 20 * math.pi / 180))))
+    if every_excitation:
+        lm = _with_forces(lm, masses, float(parameters.get("alpha", _start(fmu_path, "alpha", 20 * math.pi / 180))))
     mm = modal_model(lm)
     keep = mm.frequency <= fmax
     freq, damp, shapes = mm.frequency[keep], mm.damping[keep], mm.shapes[:, keep]
@@ -430,7 +438,7 @@ def mode_sensitivity(fmu_path, values: Mapping[str, float], measured_hz, *, spee
                   + MODEL_FORM ** 2)
     cands = list(candidates) if candidates is not None else candidate_parameters(fmu_path, values)
     kw = dict(speed_hz=speed_hz, load_nm=load_nm, channels=tuple(channels), visibility=check_visibility(visibility))
-    base = model_modes(fmu_path, values, **kw)
+    base = model_modes(fmu_path, values, **kw, every_excitation=True)      # each column's visible modes reported
     notes = []
     if pairing == "frequency":      # paired before the runs: only the paired modes' sensitivities are needed
         match = match_measured(base, measured, rel)
