@@ -21,8 +21,6 @@ The mesh-harmonic and level statistics are those of ``bench/transfer_diagnostics
 from __future__ import annotations
 
 import argparse
-import dataclasses
-import json
 import sys
 from pathlib import Path
 
@@ -32,15 +30,7 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 sys.path.insert(0, str(REPO / "bench"))
 
-CHANNEL = "accel_pinion_casing"
-
-
-def _labelled(path: Path) -> list:
-    from twin.measurements import load_measurements
-    truth = json.loads(Path(str(path) + ".truth.json").read_text())["records"]
-    recs = load_measurements(path, channels=[CHANNEL]).records
-    return [dataclasses.replace(r, label=int(truth[r.name]["label"])) for r in recs
-            if truth.get(r.name, {}).get("label") is not None]
+from pipeline_rigs import CHANNEL, labelled   # the rig files and their truth labels, as scored there
 
 
 def statistics(records, pre) -> dict:
@@ -76,7 +66,7 @@ def main() -> None:
     if any(len(n) != 2 for n in named):
         raise SystemExit("archives are given as NAME=ARCHIVE.h5")
     pre = preprocessing_for(archive_facts(named[0][1]))
-    rig = statistics(_labelled(args.rig), pre)
+    rig = statistics(labelled(args.rig), pre)
     rows = [(name, statistics(load_measurements(path, channels=[CHANNEL]).records, pre)) for name, path in named]
     fmt = lambda v, f="+.2f": " ".join(format(x, f) for x in v)      # noqa: E731
     print(f"rig {args.rig.name}; window {pre.window} at {pre.sample_rate:g} Hz, level removed: {pre.remove_level}\n")
