@@ -101,14 +101,21 @@ LATERAL_FORCES = {"pinion x": (("vx5", "m5", "1"),), "pinion y": (("vy5", "m5", 
                                     ("vx10", "m10", "-cos"), ("vy10", "m10", "sin"))}
 
 
-def _variables(fmu_path) -> frozenset[str]:
-    """Variable names of an FMU (read once per file and content)."""
+def _starts(fmu_path) -> dict[str, float | None]:
+    """Every variable of an FMU by name, with its numeric start value or None (read once per file
+    and content)."""
     from twin.fmu import FMU
     key = (str(fmu_path), Path(fmu_path).stat().st_mtime_ns)
     if key not in _VARIABLES:
         with FMU(fmu_path) as fmu:
-            _VARIABLES[key] = frozenset(fmu.variables)
+            _VARIABLES[key] = {n: (float(v.start) if isinstance(v.start, (int, float)) else None)
+                               for n, v in fmu.variables.items()}
     return _VARIABLES[key]
+
+
+def _variables(fmu_path) -> frozenset[str]:
+    """Variable names of an FMU."""
+    return frozenset(_starts(fmu_path))
 
 
 _VARIABLES: dict = {}
@@ -259,13 +266,8 @@ def model_modes(fmu_path, parameters: Mapping[str, float], *, speed_hz: float, l
 
 def _start(fmu_path, name: str, default: float) -> float:
     """Start value of a parameter of the FMU (``default`` when it has none)."""
-    key = (str(fmu_path), Path(fmu_path).stat().st_mtime_ns, name)
-    if key not in _VARIABLES:
-        from twin.fmu import FMU
-        with FMU(fmu_path) as fmu:
-            v = fmu.variables.get(name)
-            _VARIABLES[key] = float(v.start) if v is not None and v.start is not None else default
-    return _VARIABLES[key]
+    v = _starts(fmu_path).get(name)
+    return default if v is None else v
 
 
 def _with_forces(lm, masses: Mapping[str, float], alpha: float):
