@@ -161,6 +161,10 @@ SCHEMA: dict[str, Any] = {
                 "tooth_scatter": {**_NONNEG, "description": "pitting: log-sd of the per-tooth pitting strength "
                                                            "factors (seeded by 'seed', as are the pit cells; default 0.58, "
                                                            "the Weibull life scatter of gear teeth; 0 = teeth alike)"},
+                "pit_cluster_length": {**_NONNEG, "maximum": 0.1,
+                                       "description": "pitting: correlation length [m] of the pit cells' strengths "
+                                                      "across the flank (default 0.8e-3, the size of a progressive "
+                                                      "pit; 0 = cells fail independently)"},
             },
         },
         "archive": {

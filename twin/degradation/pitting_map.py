@@ -20,7 +20,10 @@ has failed; real flanks fail in discrete pits, unequally from tooth to tooth.  E
 flank is divided into pit-sized cells, :data:`PIT_SIZE` along the flank and across the face,
 and each cell carries a seeded uniform quantile u; the cell has pitted once the law's failure
 probability at its centre reaches u.  A cell's pit, once formed, stays as the density grows, and
-the expected pitted fraction is the law's D.  Teeth also differ in load and strength: tooth j
+the expected pitted fraction is the law's D.  Pits do not fail independently of their
+neighbours: growing pits join into craters, so the quantiles are a Gaussian field of correlation
+length :data:`PIT_CLUSTER_LENGTH` mapped to uniform marginals (:meth:`ToothScatter.cell_quantiles`;
+the expected pitted fraction is unchanged, the pits cluster).  Teeth also differ in load and strength: tooth j
 has a strength factor lambda_j (seeded, lognormal, median 1, log-sd ``scatter``) and, under the
 Weibull law of :class:`~twin.degradation.pitting.FatiguePitting` at constant load, its cells
 fail with probability ``D_j = 1 - (1 - D)^lambda_j``.
@@ -84,6 +87,12 @@ _MAX_DENSITY = 0.98
 #: 1010-F14, as summarised in Gear Solutions, "Gear wear and failure modes"; ISO 10825-1:2022
 #: uses the same progression).  Not fitted to any rig.
 PIT_SIZE = 0.5e-3
+#: Correlation length of the pit cells' strengths across the flank [m] (the standard deviation of
+#: the Gaussian kernel that correlates them): pits that grow join their neighbours into irregular
+#: craters, and progressive pits are those beyond 0.032 in (0.8 mm) across (same sources as
+#: :data:`PIT_SIZE`), so a cell's neighbours within about a progressive pit's size fail together.
+#: Fixed from that morphology before the twin was compared with any rig; not fitted.
+PIT_CLUSTER_LENGTH = 0.8e-3
 #: Depth of a pit below the flank over its Hertz half-width: the law's z0 / b (Eq. 13), the depth
 #: of the shear stress whose cracks break the pit out.
 PIT_DEPTH_OVER_B = 0.786
@@ -91,25 +100,51 @@ PIT_DEPTH_OVER_B = 0.786
 
 @dataclass(frozen=True)
 class ToothScatter:
-    """Per-tooth pitting strength factors lambda_j (z1,), median 1, and the seed of the pit cells."""
+    """Per-tooth pitting strength factors lambda_j (z1,), median 1, the seed of the pit cells and
+    the correlation length of their strengths [m] (0: independent cells; module docstring)."""
 
     factors: np.ndarray
     seed: int = 0
+    cluster_length: float = 0.0
 
     @classmethod
-    def draw(cls, teeth: int, scatter: float, seed: int) -> "ToothScatter":
+    def draw(cls, teeth: int, scatter: float, seed: int, cluster_length: float = 0.0) -> "ToothScatter":
         """lambda_j = exp(scatter * n_j), n_j standard normal from ``seed``; scatter 0: all ones."""
         if not (isinstance(scatter, (int, float)) and math.isfinite(scatter) and scatter >= 0):
             raise ParameterError(f"tooth scatter must be a finite number >= 0, got {scatter!r}")
         if not (isinstance(teeth, (int, np.integer)) and teeth >= 1):
             raise ParameterError(f"teeth must be an integer >= 1, got {teeth!r}")
+        if not (isinstance(cluster_length, (int, float)) and math.isfinite(cluster_length)
+                and 0 <= cluster_length <= 0.1):
+            raise ParameterError(f"pit cluster length must be a finite number in [0, 0.1] m, got {cluster_length!r}")
         rng = np.random.default_rng(seed)
-        return cls(np.exp(float(scatter) * rng.standard_normal(int(teeth))), int(seed))
+        return cls(np.exp(float(scatter) * rng.standard_normal(int(teeth))), int(seed), float(cluster_length))
 
     def cell_quantiles(self, n_profile: int, n_face: int) -> np.ndarray:
-        """Seeded uniform strength quantiles of the pit cells, shape (z1, n_profile, n_face)."""
+        """Seeded uniform strength quantiles of the pit cells, shape (z1, n_profile, n_face).
+
+        Independent cells for ``cluster_length`` 0; otherwise a Gaussian field of that correlation
+        length over each flank (white noise smoothed by a Gaussian kernel of standard deviation
+        ``cluster_length`` on a grid padded by 4 kernel widths, so every cell sees the whole kernel),
+        scaled to unit variance and mapped through the normal CDF: each cell's quantile stays
+        uniform on [0, 1], so the expected pitted fraction is the law's; only neighbours now fail
+        together."""
         rng = np.random.default_rng([self.seed, 1])
-        return rng.random((self.factors.size, n_profile, n_face))
+        shape = (self.factors.size, n_profile, n_face)
+        if self.cluster_length == 0.0:
+            return rng.random(shape)
+        from scipy.ndimage import gaussian_filter
+        from scipy.special import ndtr
+        sigma = self.cluster_length / PIT_SIZE                      # kernel sd in cells
+        pad = int(math.ceil(4.0 * sigma))
+        noise = rng.standard_normal((shape[0], n_profile + 2 * pad, n_face + 2 * pad))
+        field = gaussian_filter(noise, sigma=(0.0, sigma, sigma), mode="constant", truncate=4.0)
+        field = field[:, pad:pad + n_profile, pad:pad + n_face]
+        # the variance of a filtered unit white noise is the sum of the squared kernel weights
+        delta = np.zeros((1, 2 * pad + 1, 2 * pad + 1))
+        delta[0, pad, pad] = 1.0
+        weights = gaussian_filter(delta, sigma=(0.0, sigma, sigma), mode="constant", truncate=4.0)
+        return ndtr(field / math.sqrt(float(np.sum(weights ** 2))))
 
 
 def gear_density(geometry: GearPair, density: np.ndarray, weibull_slope: float) -> np.ndarray:

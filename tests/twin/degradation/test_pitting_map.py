@@ -141,3 +141,38 @@ def test_bad_input_is_named(pitted):
         pitting_parameters(G, pitted, F, HEALTHY_K_PAIR, scatter=ToothScatter.draw(18, 0.2, 0))
     with pytest.raises(ParameterError, match="scatter"):
         ToothScatter.draw(19, -0.1, 0)
+
+
+def test_clustered_cells_keep_the_law_and_fail_together():
+    independent = ToothScatter.draw(19, 0.0, 11)
+    clustered = ToothScatter.draw(19, 0.0, 11, 0.8e-3)
+    # a length of 0 is the independent cells exactly
+    np.testing.assert_array_equal(independent.cell_quantiles(9, 40),
+                                  ToothScatter(independent.factors, 11, 0.0).cell_quantiles(9, 40))
+    u = clustered.cell_quantiles(9, 40)
+    assert u.shape == (19, 9, 40) and np.all((u > 0) & (u < 1))
+    # uniform marginals: the expected pitted fraction at any density is the law's (many flanks:
+    # clustered cells sample the law more coarsely than independent ones)
+    many = ToothScatter(np.ones(400), 11, 0.8e-3).cell_quantiles(9, 40)
+    for d in (0.05, 0.2, 0.5):
+        assert abs(np.mean(many < d) - d) < 0.02
+    # neighbours across the face are correlated, far cells are not
+    z = u - 0.5
+    near = np.mean(z[:, :, :-1] * z[:, :, 1:]) / np.var(z)
+    far = np.mean(z[:, :, :-20] * z[:, :, 20:]) / np.var(z)
+    assert near > 0.5 and abs(far) < 0.1
+    np.testing.assert_array_equal(u, ToothScatter.draw(19, 0.0, 11, 0.8e-3).cell_quantiles(9, 40))
+
+
+def test_clustered_pits_make_the_teeth_differ_more(pitted):
+    spread = []
+    for length in (0.0, 0.8e-3):
+        m = pitting_parameters(G, pitted, F, HEALTHY_K_PAIR, scatter=ToothScatter.draw(19, 0.58, 2, length))
+        spread.append(np.sqrt(np.mean(m.tooth_deviation ** 2)))
+    assert spread[1] > 1.5 * spread[0]
+
+
+def test_a_bad_cluster_length_is_named():
+    for bad in (-1e-3, float("nan"), 1.0):
+        with pytest.raises(ParameterError, match="cluster length"):
+            ToothScatter.draw(19, 0.5, 0, bad)
