@@ -148,7 +148,7 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
     from twin import _interrupt
     from twin._atomic import partial_path
     from twin.degradation import GearPair, MeshLoad, TransmittedLoad, contact_k_pair, mesh_parameters
-    from twin.degradation.pitting_map import PIT_CLUSTER_LENGTH, ToothScatter, pitting_parameters
+    from twin.degradation.pitting_map import ToothScatter, pitting_parameters
     from twin.plausibility import check_block, check_parameters
 
     spec = scenario.degradation
@@ -188,7 +188,7 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
                                   f"pitting needs the per-tooth field tooth_pit_field[1..{geometry.z1 * n_nodes}]"
                                   " (GearTwin.Gearbox21 and the models built on it); this FMU has none")])
         scatter = ToothScatter.draw(geometry.z1, float(spec.get("tooth_scatter", DEFAULT_TOOTH_SCATTER)),
-                                    scenario.seed, float(spec.get("pit_cluster_length", PIT_CLUSTER_LENGTH))
+                                    scenario.seed, float(spec.get("pit_cluster_length", 0.0))
                                     ) if model_name == "pitting" else None
         source = next((p for p in (partial, path) if p is not None and p.exists()), None) if resume else None
         if source is not None:     # the partial output, else a complete one to extend (a later stop)

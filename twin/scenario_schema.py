@@ -163,8 +163,8 @@ SCHEMA: dict[str, Any] = {
                                                            "the Weibull life scatter of gear teeth; 0 = teeth alike)"},
                 "pit_cluster_length": {**_NONNEG, "maximum": 0.1,
                                        "description": "pitting: correlation length [m] of the pit cells' strengths "
-                                                      "across the flank (default 0.8e-3, the size of a progressive "
-                                                      "pit; 0 = cells fail independently)"},
+                                                      "across the flank (default 0: cells fail independently; "
+                                                      "0.8e-3 is the size of a progressive pit, an opt-in)"},
             },
         },
         "archive": {

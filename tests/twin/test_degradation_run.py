@@ -131,3 +131,18 @@ def test_bad_coefficients_are_a_scenario_error(gearbox_fmu):
     from twin.errors import ScenarioError
     with pytest.raises(ScenarioError, match="coefficients"):
         run_degradation(_lubricated(coefficients={"wear_rate": 1.0}), None, fmu_path=gearbox_fmu, progress=False)
+
+
+def test_clustered_pits_are_an_opt_in(gearbox_fmu):
+    from twin.errors import ScenarioError
+    fields = []
+    for length in (0.0, 0.8e-3):
+        run = run_degradation(_lubricated(stop=0.03, pit_cluster_length=length), None, fmu_path=gearbox_fmu,
+                              progress=False)
+        last = run.stages[-1]
+        fields.append(np.array([last.parameters[f"tooth_pit_field[{k}]"] for k in range(1, 19 * 11 + 1)]))
+    # the same law and cycles, the pits placed differently (clustered)
+    assert np.any(fields[0] != fields[1])
+    from twin.errors import ParameterError
+    with pytest.raises((ScenarioError, ParameterError), match="cluster length"):
+        run_degradation(_lubricated(pit_cluster_length=-1.0), None, fmu_path=gearbox_fmu, progress=False)

@@ -21,9 +21,10 @@ flank is divided into pit-sized cells, :data:`PIT_SIZE` along the flank and acro
 and each cell carries a seeded uniform quantile u; the cell has pitted once the law's failure
 probability at its centre reaches u.  A cell's pit, once formed, stays as the density grows, and
 the expected pitted fraction is the law's D.  Pits do not fail independently of their
-neighbours: growing pits join into craters, so the quantiles are a Gaussian field of correlation
-length :data:`PIT_CLUSTER_LENGTH` mapped to uniform marginals (:meth:`ToothScatter.cell_quantiles`;
-the expected pitted fraction is unchanged, the pits cluster).  Teeth also differ in load and strength: tooth j
+neighbours: growing pits join into craters.  With a cluster length (opt-in,
+:data:`PIT_CLUSTER_LENGTH`) the quantiles are a Gaussian field of that correlation length mapped
+to uniform marginals (:meth:`ToothScatter.cell_quantiles`; the expected pitted fraction is
+unchanged, the pits cluster); by default they are independent.  Teeth also differ in load and strength: tooth j
 has a strength factor lambda_j (seeded, lognormal, median 1, log-sd ``scatter``) and, under the
 Weibull law of :class:`~twin.degradation.pitting.FatiguePitting` at constant load, its cells
 fail with probability ``D_j = 1 - (1 - D)^lambda_j``.
@@ -91,7 +92,8 @@ PIT_SIZE = 0.5e-3
 #: the Gaussian kernel that correlates them): pits that grow join their neighbours into irregular
 #: craters, and progressive pits are those beyond 0.032 in (0.8 mm) across (same sources as
 #: :data:`PIT_SIZE`), so a cell's neighbours within about a progressive pit's size fail together.
-#: Fixed from that morphology before the twin was compared with any rig; not fitted.
+#: Fixed from that morphology before the twin was compared with any rig; not fitted.  An opt-in
+#: (``degradation.pit_cluster_length``); the default is independent cells (docs/experiments.md).
 PIT_CLUSTER_LENGTH = 0.8e-3
 #: Depth of a pit below the flank over its Hertz half-width: the law's z0 / b (Eq. 13), the depth
 #: of the shear stress whose cracks break the pit out.
