@@ -78,6 +78,12 @@ def shafts_fmu(fmu_dir) -> Path:
 
 
 @pytest.fixture(scope="session")
+def overhangs_fmu(fmu_dir) -> Path:
+    """The shafts model with the parts carried on the overhung shaft ends (GearTwin.Gearbox21Overhangs)."""
+    return build_shared("GearTwin.Gearbox21Overhangs", fmu_dir)
+
+
+@pytest.fixture(scope="session")
 def walls_fmu(fmu_dir) -> Path:
     """The shafts model with flexible casing walls under the housings (GearTwin.Gearbox21Walls)."""
     return build_shared("GearTwin.Gearbox21Walls", fmu_dir)

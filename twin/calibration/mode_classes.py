@@ -19,6 +19,8 @@ whose energy is mostly rotation stays ``torsion`` and carries the pinion's share
 | ``gear lateral x`` / ``y`` | ``vx10`` / ``vy10``: the gear on its shaft | ``m10`` |
 | ``input pedestals x`` / ``y`` | ``vx4``, ``vx6`` / ``vy4``, ``vy6`` | ``m4``, ``m6`` |
 | ``output pedestals x`` / ``y`` | ``vx9``, ``vx11`` / ``vy9``, ``vy11`` | ``m9``, ``m11`` |
+| ``input shaft ends x`` / ``y`` | ``vx_end4``, ``vx_end6`` / ``vy_end4``, ``vy_end6``: parts on the input shaft outside its bearings (GearTwin.Gearbox21Overhangs) | ``m_end4``, ``m_end6`` |
+| ``output shaft ends x`` / ``y`` | ``vx_end9``, ``vx_end11`` / ``vy_end9``, ``vy_end11`` | ``m_end9``, ``m_end11`` |
 | ``casing`` | ``vx_casing``, ``vy_casing`` / ``w_casing`` (GearTwin.Gearbox21Casing); ``casing.qd[k]`` (the wall modes of GearTwin.Gearbox21Walls and Gearbox21TiltingWalls, mass-normalised) | ``m_casing`` / ``I_casing``; 1 (modal states carry sqrt of the modal mass) |
 | ``sensor path`` | a sensor's panel or mount modes (massless: only when nothing else moves) | |
 
@@ -48,6 +50,10 @@ DOF_RULES: tuple[tuple[str, str, str | None], ...] = (
     (r"^vy(4|6)$", "input pedestals y", r"m\1"),
     (r"^vx(9|11)$", "output pedestals x", r"m\1"),
     (r"^vy(9|11)$", "output pedestals y", r"m\1"),
+    (r"^vx_end(4|6)$", "input shaft ends x", r"m_end\1"),
+    (r"^vy_end(4|6)$", "input shaft ends y", r"m_end\1"),
+    (r"^vx_end(9|11)$", "output shaft ends x", r"m_end\1"),
+    (r"^vy_end(9|11)$", "output shaft ends y", r"m_end\1"),
     (r"^v(x|y)_casing$", "casing", "m_casing"),
     (r"^w_casing$", "casing", "I_casing"),
     (r"^casing\.qd\[(\d+)\]$", "casing", None),
@@ -55,7 +61,8 @@ DOF_RULES: tuple[tuple[str, str, str | None], ...] = (
 )
 #: The classes, in the order reports list them.
 CLASSES = ("torsion", "pinion lateral x", "pinion lateral y", "gear lateral x", "gear lateral y",
-           "input pedestals x", "input pedestals y", "output pedestals x", "output pedestals y", "casing",
+           "input pedestals x", "input pedestals y", "output pedestals x", "output pedestals y",
+           "input shaft ends x", "input shaft ends y", "output shaft ends x", "output shaft ends y", "casing",
            "sensor path")
 #: A mode counts as the sensor path's own when the structure carries less than this share of the
 #: velocity (unweighted) of the mode: the path's modes do not act back, so the structure is still.
@@ -168,6 +175,6 @@ def mass_values(fmu_path, parameters: Mapping[str, float]) -> dict[str, float]:
     return out
 
 
-#: Names of mass and inertia parameters: ``I5``, ``m10``, ``m_casing``, ``I_casing``.
-_MASS = r"^(I|m)(\d+|_casing)$"
+#: Names of mass and inertia parameters: ``I5``, ``m10``, ``m_casing``, ``I_casing``, ``m_end4``.
+_MASS = r"^(I|m)(\d+|_casing|_end\d+)$"
 _STARTS: dict = {}
