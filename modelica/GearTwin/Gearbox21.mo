@@ -225,17 +225,22 @@ model Gearbox21 "21-DOF lumped model of the UNSW spur-gear test rig (Feng et al.
   Real support_input_vy(unit = "m/s") = 0 "Time derivative of support_input_y";
   Real support_output_vx(unit = "m/s") = 0 "Time derivative of support_output_x";
   Real support_output_vy(unit = "m/s") = 0 "Time derivative of support_output_y";
-  // Forces of parts carried on the shafts outside the bearings (overhung couplings, slip rings and
-  // encoders: GearTwin.Gearbox21Overhangs binds them; zero here, as in the paper, whose model keeps
-  // only their rotation), acting on the pedestal of the nearest bearing.
-  Real overhang_force_x4(unit = "N") = 0 "Horizontal force of the input shaft's motor-side end on pedestal 4";
-  Real overhang_force_y4(unit = "N") = 0 "Vertical force of the input shaft's motor-side end on pedestal 4";
-  Real overhang_force_x6(unit = "N") = 0 "Horizontal force of the input shaft's free end on pedestal 6";
-  Real overhang_force_y6(unit = "N") = 0 "Vertical force of the input shaft's free end on pedestal 6";
-  Real overhang_force_x9(unit = "N") = 0 "Horizontal force of the output shaft's free end on pedestal 9";
-  Real overhang_force_y9(unit = "N") = 0 "Vertical force of the output shaft's free end on pedestal 9";
-  Real overhang_force_x11(unit = "N") = 0 "Horizontal force of the output shaft's brake-side end on pedestal 11";
-  Real overhang_force_y11(unit = "N") = 0 "Vertical force of the output shaft's brake-side end on pedestal 11";
+  // Forces of a shaft modelled as a beam with the parts it carries outside its bearings
+  // (overhung couplings, slip rings and encoders: GearTwin.Gearbox21Overhangs binds them; zero
+  // here, as in the paper, whose model keeps only their rotation), on the gear bodies and on the
+  // pedestals.
+  Real shaft_force_x4(unit = "N") = 0 "Horizontal force of the input shaft on pedestal 4, beyond kx45";
+  Real shaft_force_y4(unit = "N") = 0 "Vertical force of the input shaft on pedestal 4, beyond ky45";
+  Real shaft_force_x6(unit = "N") = 0 "Horizontal force of the input shaft on pedestal 6, beyond kx56";
+  Real shaft_force_y6(unit = "N") = 0 "Vertical force of the input shaft on pedestal 6, beyond ky56";
+  Real shaft_force_x9(unit = "N") = 0 "Horizontal force of the output shaft on pedestal 9, beyond kx910";
+  Real shaft_force_y9(unit = "N") = 0 "Vertical force of the output shaft on pedestal 9, beyond ky910";
+  Real shaft_force_x11(unit = "N") = 0 "Horizontal force of the output shaft on pedestal 11, beyond kx1011";
+  Real shaft_force_y11(unit = "N") = 0 "Vertical force of the output shaft on pedestal 11, beyond ky1011";
+  Real shaft_force_x5(unit = "N") = 0 "Horizontal force of its shaft on the pinion, beyond the shaft springs";
+  Real shaft_force_x10(unit = "N") = 0 "Horizontal force of its shaft on the gear, beyond the shaft springs";
+  Real shaft_force_y5(unit = "N") = 0 "Vertical force of its shaft on the pinion, beyond the shaft springs";
+  Real shaft_force_y10(unit = "N") = 0 "Vertical force of its shaft on the gear, beyond the shaft springs";
 equation
   // Tooth-pair bookkeeping without events: the mesh phase is wrapped with atan2; the angle of
   // the last entered tooth counts the completed mesh cycles k, which name the teeth in contact.
@@ -303,18 +308,18 @@ equation
   der(y10) = vy10;
   der(x11) = vx11;
   der(y11) = vy11;
-  m4 * der(vx4) = -kx4 * (x4 - support_input_x) - cx4 * (vx4 - support_input_vx) + kx45 * (x5 - x4) + cx45 * (vx5 - vx4) + overhang_force_x4;
-  m4 * der(vy4) = -ky4 * (y4 - support_input_y) - cy4 * (vy4 - support_input_vy) + ky45 * (y5 - y4) + cy45 * (vy5 - vy4) + overhang_force_y4;
-  m5 * der(vx5) = -kx45 * (x5 - x4) - cx45 * (vx5 - vx4) - kx56 * (x5 - x6) - cx56 * (vx5 - vx6) - mesh_force * sin(alpha) + (effect_off_line_force + excitation_off_line_force) * cos(alpha);
-  m5 * der(vy5) = -ky45 * (y5 - y4) - cy45 * (vy5 - vy4) - ky56 * (y5 - y6) - cy56 * (vy5 - vy6) - mesh_force * cos(alpha) - (effect_off_line_force + excitation_off_line_force) * sin(alpha);
-  m6 * der(vx6) = -kx6 * (x6 - support_input_x) - cx6 * (vx6 - support_input_vx) + kx56 * (x5 - x6) + cx56 * (vx5 - vx6) + overhang_force_x6;
-  m6 * der(vy6) = -ky6 * (y6 - support_input_y) - cy6 * (vy6 - support_input_vy) + ky56 * (y5 - y6) + cy56 * (vy5 - vy6) + overhang_force_y6;
-  m9 * der(vx9) = -kx9 * (x9 - support_output_x) - cx9 * (vx9 - support_output_vx) + kx910 * (x10 - x9) + cx910 * (vx10 - vx9) + overhang_force_x9;
-  m9 * der(vy9) = -ky9 * (y9 - support_output_y) - cy9 * (vy9 - support_output_vy) + ky910 * (y10 - y9) + cy910 * (vy10 - vy9) + overhang_force_y9;
-  m10 * der(vx10) = -kx910 * (x10 - x9) - cx910 * (vx10 - vx9) - kx1011 * (x10 - x11) - cx1011 * (vx10 - vx11) + mesh_force * sin(alpha) - (effect_off_line_force + excitation_off_line_force) * cos(alpha);
-  m10 * der(vy10) = -ky910 * (y10 - y9) - cy910 * (vy10 - vy9) - ky1011 * (y10 - y11) - cy1011 * (vy10 - vy11) + mesh_force * cos(alpha) + (effect_off_line_force + excitation_off_line_force) * sin(alpha);
-  m11 * der(vx11) = -kx11 * (x11 - support_output_x) - cx11 * (vx11 - support_output_vx) + kx1011 * (x10 - x11) + cx1011 * (vx10 - vx11) + overhang_force_x11;
-  m11 * der(vy11) = -ky11 * (y11 - support_output_y) - cy11 * (vy11 - support_output_vy) + ky1011 * (y10 - y11) + cy1011 * (vy10 - vy11) + overhang_force_y11;
+  m4 * der(vx4) = -kx4 * (x4 - support_input_x) - cx4 * (vx4 - support_input_vx) + kx45 * (x5 - x4) + cx45 * (vx5 - vx4) + shaft_force_x4;
+  m4 * der(vy4) = -ky4 * (y4 - support_input_y) - cy4 * (vy4 - support_input_vy) + ky45 * (y5 - y4) + cy45 * (vy5 - vy4) + shaft_force_y4;
+  m5 * der(vx5) = -kx45 * (x5 - x4) - cx45 * (vx5 - vx4) - kx56 * (x5 - x6) - cx56 * (vx5 - vx6) - mesh_force * sin(alpha) + (effect_off_line_force + excitation_off_line_force) * cos(alpha) + shaft_force_x5;
+  m5 * der(vy5) = -ky45 * (y5 - y4) - cy45 * (vy5 - vy4) - ky56 * (y5 - y6) - cy56 * (vy5 - vy6) - mesh_force * cos(alpha) - (effect_off_line_force + excitation_off_line_force) * sin(alpha) + shaft_force_y5;
+  m6 * der(vx6) = -kx6 * (x6 - support_input_x) - cx6 * (vx6 - support_input_vx) + kx56 * (x5 - x6) + cx56 * (vx5 - vx6) + shaft_force_x6;
+  m6 * der(vy6) = -ky6 * (y6 - support_input_y) - cy6 * (vy6 - support_input_vy) + ky56 * (y5 - y6) + cy56 * (vy5 - vy6) + shaft_force_y6;
+  m9 * der(vx9) = -kx9 * (x9 - support_output_x) - cx9 * (vx9 - support_output_vx) + kx910 * (x10 - x9) + cx910 * (vx10 - vx9) + shaft_force_x9;
+  m9 * der(vy9) = -ky9 * (y9 - support_output_y) - cy9 * (vy9 - support_output_vy) + ky910 * (y10 - y9) + cy910 * (vy10 - vy9) + shaft_force_y9;
+  m10 * der(vx10) = -kx910 * (x10 - x9) - cx910 * (vx10 - vx9) - kx1011 * (x10 - x11) - cx1011 * (vx10 - vx11) + mesh_force * sin(alpha) - (effect_off_line_force + excitation_off_line_force) * cos(alpha) + shaft_force_x10;
+  m10 * der(vy10) = -ky910 * (y10 - y9) - cy910 * (vy10 - vy9) - ky1011 * (y10 - y11) - cy1011 * (vy10 - vy11) + mesh_force * cos(alpha) + (effect_off_line_force + excitation_off_line_force) * sin(alpha) + shaft_force_y10;
+  m11 * der(vx11) = -kx11 * (x11 - support_output_x) - cx11 * (vx11 - support_output_vx) + kx1011 * (x10 - x11) + cx1011 * (vx10 - vx11) + shaft_force_x11;
+  m11 * der(vy11) = -ky11 * (y11 - support_output_y) - cy11 * (vy11 - support_output_vy) + ky1011 * (y10 - y11) + cy1011 * (vy10 - vy11) + shaft_force_y11;
 
   // ---- Sensors ------------------------------------------------------------------------------
   casing_acceleration_pinion = cos(sensor_angle_pinion) * der(vy6) + sin(sensor_angle_pinion) * der(vx6);

@@ -20,25 +20,57 @@ def _get(path, parameters, names):
         return dict(zip(names, fmu.get(list(names))))
 
 
-def test_an_end_hangs_on_its_stub_and_both_bearings_levered(overhangs_fmu):
-    # a force F at the end of a stub c beyond a bearing of a span L deflects it by
-    # F c^2 (L + c) / (3 E I) on rigid bearings; the bearing beside it takes F (L + c) / L and the
-    # other F c / L, each moving the end by its own deflection times the same lever
-    E, rho, d, L, c = 2.1e11, 7850.0, 0.024, 0.16, 0.08
-    p = {"d_shaft_input": d, "span_input": L, "overhang6": c, "kx_bearing6": 1.0e8, "kx_bearing4": 3.0e8,
-         "end_mass6": 0.5}
-    v = _get(overhangs_fmu, p, ("k_end6_x", "m_end6", "k_end4_x"))
+def _beam_flexibility(EI, points, supports):
+    """Influence matrix [m/N] of a free beam on two rigid supports at ``points``: Euler-Bernoulli
+    finite elements (cubic Hermite, exact for point loads at nodes), independent of the model's
+    closed forms."""
+    nodes = np.unique(np.concatenate([np.linspace(lo, hi, 9) for lo, hi in
+                                      zip(sorted([*points, *supports])[:-1], sorted([*points, *supports])[1:])]))
+    n = nodes.size
+    K = np.zeros((2 * n, 2 * n))
+    for e in range(n - 1):
+        h = nodes[e + 1] - nodes[e]
+        k = EI / h ** 3 * np.array([[12, 6 * h, -12, 6 * h], [6 * h, 4 * h * h, -6 * h, 2 * h * h],
+                                    [-12, -6 * h, 12, -6 * h], [6 * h, 2 * h * h, -6 * h, 4 * h * h]])
+        K[2 * e:2 * e + 4, 2 * e:2 * e + 4] += k
+    fixed = [2 * int(np.argmin(abs(nodes - s))) for s in supports]
+    free = [i for i in range(2 * n) if i not in fixed]
+    at = [2 * int(np.argmin(abs(nodes - s))) for s in points]
+    F = np.zeros((len(points), len(points)))
+    for j, pj in enumerate(at):
+        f = np.zeros(2 * n)
+        f[pj] = 1.0
+        u = np.zeros(2 * n)
+        u[free] = np.linalg.solve(K[np.ix_(free, free)], f[free])
+        F[:, j] = u[at]
+    return F
+
+
+def test_each_shaft_is_a_beam_through_its_gear_and_ends_on_two_bearings(overhangs_fmu):
+    E, rho, d, L, a, b, pos = 2.1e11, 7850.0, 0.024, 0.16, 0.05, 0.08, 0.4
+    k4, k6 = 1.0e8, 3.0e8
+    p = {"d_shaft_input": d, "span_input": L, "overhang4": a, "overhang6": b, "pinion_position": pos,
+         "kx_bearing4": k4, "kx_bearing6": k6, "end_mass6": 0.5}
+    names = [f"K_input_x_{ij}" for ij in ("e1e1", "gg", "e2e2", "e1g", "e1e2", "ge2")]
+    v = _get(overhangs_fmu, p, (*names, "m_end6", "kx45", "kx56"))
     EI = E * math.pi * d ** 4 / 64
-    compliance = c * c * (L + c) / (3 * EI) + ((L + c) / L) ** 2 / 1.0e8 + (c / L) ** 2 / 3.0e8
-    assert v["k_end6_x"] == pytest.approx(1 / compliance, rel=1e-9)
+    s = np.array([-a, pos * L, L + b])
+    F = _beam_flexibility(EI, list(s), [0.0, L])
+    # the bearings: a point at s moves with the shaft centres at the bearings by (L - s)/L and s/L
+    T = np.stack([(L - s) / L, s / L])
+    F += np.outer(T[0], T[0]) / k4 + np.outer(T[1], T[1]) / k6
+    K = np.linalg.inv(F)
+    got = np.array([[v["K_input_x_e1e1"], v["K_input_x_e1g"], v["K_input_x_e1e2"]],
+                    [v["K_input_x_e1g"], v["K_input_x_gg"], v["K_input_x_ge2"]],
+                    [v["K_input_x_e1e2"], v["K_input_x_ge2"], v["K_input_x_e2e2"]]])
+    np.testing.assert_allclose(got, K, rtol=1e-6)
+    # a load on the span lifts the overhangs: the gear and an end pull each other the same way
+    assert v["K_input_x_e1g"] > 0 and v["K_input_x_ge2"] > 0
+    # Gearbox21Shafts' two springs per gear are replaced by the beam
+    assert v["kx45"] == 0 and v["kx56"] == 0
     # the stub's own mass moves with the end by the cantilever's Rayleigh share 33/140
-    assert v["m_end6"] == pytest.approx(0.5 + 33 / 140 * rho * math.pi * d * d / 4 * c, rel=1e-9)
-    # the mode classes weigh the ends with these masses
+    assert v["m_end6"] == pytest.approx(0.5 + 33 / 140 * rho * math.pi * d * d / 4 * b, rel=1e-9)
     assert mass_values(overhangs_fmu, p)["m_end6"] == pytest.approx(v["m_end6"], rel=1e-9)
-    # the end beside bearing 4 is levered the other way round (bearing 4 beside it)
-    c4 = 0.06
-    compliance4 = c4 * c4 * (L + c4) / (3 * EI) + ((L + c4) / L) ** 2 / 3.0e8 + (c4 / L) ** 2 / 1.0e8
-    assert v["k_end4_x"] == pytest.approx(1 / compliance4, rel=1e-9)
 
 
 def test_the_ends_add_their_own_modes_below_a_few_khz(overhangs_fmu, shafts_fmu):
@@ -50,24 +82,35 @@ def test_the_ends_add_their_own_modes_below_a_few_khz(overhangs_fmu, shafts_fmu)
         k = max(range(len(mm.classes)), key=lambda i: mm.classes[i].shares.get(cls, 0.0))
         # a 0.35-0.6 kg part on a 25 mm stub of 60-90 mm: a few hundred Hz to about 1 kHz
         assert 250.0 < mm.frequency[k] < 1500.0 and mm.classes[k].shares[cls] > 0.3
-    # the mesh reaches some of them through the pedestals (visible at the casing sensors)
-    visible_end = [c.name for c, vis in zip(mm.classes, mm.visible) if vis and c.name in ENDS]
-    assert visible_end
+    # the mesh reaches them through the shafts: an end-dominated mode within 30 dB of the most
+    # visible mode at the casing sensors
+    assert max(g for c, g in zip(mm.classes, mm.gain_db) if c.name in ENDS) > -30.0
 
 
-def test_light_short_ends_leave_the_shafts_model(overhangs_fmu, shafts_fmu):
-    # parts of a gram on 5 mm stubs: their modes move far above 5 kHz and the rest of the gearbox is
-    # Gearbox21Shafts again; a wrong sign of the reaction on the pedestals would show here
+def test_light_short_ends_leave_the_shafts_gear_modes(overhangs_fmu, shafts_fmu):
+    # parts of a gram on 5 mm stubs: their modes move far above 5 kHz, and the gears' lateral and the
+    # torsional modes are Gearbox21Shafts' again (the same beam seen at the gear); a wrong sign of
+    # a reaction on the pedestals would show here
     tiny = {f"end_mass{n}": 1e-3 for n in (4, 6, 9, 11)}
     tiny.update({f"overhang{n}": 5e-3 for n in (4, 6, 9, 11)})
     tiny.update(k_coupling_radial_input=1.0, k_coupling_radial_output=1.0)
     base = model_modes(shafts_fmu, {}, fmax=5000.0, **KW)
     mm = model_modes(overhangs_fmu, tiny, fmax=5000.0, **KW)
     assert not any(c.name in ENDS for c in mm.classes)
-    f0 = np.sort(base.frequency)
-    f1 = np.sort(mm.frequency)
-    assert f1.shape == f0.shape
-    np.testing.assert_allclose(f1, f0, rtol=2e-3)
+    for cls in ("pinion lateral x", "pinion lateral y", "gear lateral x", "gear lateral y"):
+        f0 = _dominant(base, cls)
+        f1 = _dominant(mm, cls)
+        assert f1 == pytest.approx(f0, rel=5e-3), cls
+    # but a shaft may now turn about its gear as a rigid beam (no tilting inertia here): the two
+    # pedestals of a shaft moving against each other feel only their own supports, where the two
+    # springs of Gearbox21Shafts also stretched the shaft (827 Hz there)
+    k = max(range(len(mm.classes)), key=lambda i: mm.classes[i].shares.get("input pedestals x", 0.0))
+    assert mm.classes[k].shares["input pedestals x"] > 0.9
+    assert mm.frequency[k] == pytest.approx(math.sqrt(3.0e7 / 2.0) / (2 * math.pi), rel=1e-2)
+
+
+def _dominant(mm, cls):
+    return float(mm.frequency[max(range(len(mm.classes)), key=lambda i: mm.classes[i].shares.get(cls, 0.0))])
 
 
 def test_the_ends_are_calibratable_within_physical_bounds(overhangs_fmu):
