@@ -16,7 +16,8 @@ For each rig and seed: one gearbox with its base parameters scattered +-12 %
    rig modes have an extracted mode within 2 %, and the errors of those pairs.
 2. ``twin calibrate`` (parameters auto, modes from the run-up, steady record for the spectrum,
    model ``--model``, default ``GearTwin.Gearbox21Shafts``; ``GearTwin.Gearbox21Walls`` adds flexible
-   casing walls, ``GearTwin.Gearbox21TiltingWalls`` walls that also tilt the housings;
+   casing walls, ``GearTwin.Gearbox21TiltingWalls`` walls that also tilt the housings,
+   ``GearTwin.Gearbox21Overhangs`` each shaft a beam through its gear and its overhung ends;
    ``--pairing shape`` pairs the modes by frequency, shape and reach instead of frequency alone,
    and refuses a well-measured shape unlike the model mode's; ``--visibility run-up`` makes a model
    mode visible when any of a run-up's excitations shows it, not only the mesh). The rig's first six observable
@@ -254,7 +255,8 @@ def main() -> None:
     ap.add_argument("--seeds", nargs="+", type=int, default=[6, 7, 8, 9, 10])
     ap.add_argument("--model", default="GearTwin.Gearbox21Shafts",
                     help="the twin's model (GearTwin.Gearbox21Walls: flexible casing walls; GearTwin.Gearbox21TiltingWalls: "
-                         "walls that also tilt the housings; GearTwin.Gearbox21Measured: "
+                         "walls that also tilt the housings; GearTwin.Gearbox21Overhangs: each shaft a beam through its "
+                         "gear and overhung ends; GearTwin.Gearbox21Measured: "
                          "pedestals on rigid ground)")
     ap.add_argument("--pairing", choices=("frequency", "shape"), default="frequency",
                     help="how twin calibrate pairs measured with model modes (calibration.pairing)")
