@@ -22,6 +22,7 @@ let a calibration identify.
 from __future__ import annotations
 
 import argparse
+import importlib
 import json
 import sys
 import time
@@ -31,6 +32,7 @@ import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
+sys.path.insert(0, str(REPO / "bench"))
 
 KW = dict(speed_hz=20.0, load_nm=20.0, channels=("accel_pinion_casing", "accel_gear_casing"), fmax=6000.0)
 #: Motor and brake inertias: they set modes far below the rig's first six, and the rig's have no
@@ -38,25 +40,16 @@ KW = dict(speed_hz=20.0, load_nm=20.0, channels=("accel_pinion_casing", "accel_g
 LEFT_OUT = ("I1", "I13")
 
 
-def _rig(name: str):
-    if name == "beam":
-        from rigs.beam import Rig
-    elif name == "pedestal":
-        from rigs.pedestal import Rig
-    else:
-        raise SystemExit(f"unknown rig {name!r}: beam or pedestal")
-    return Rig
-
-
 def one_gearbox(rig_name: str, seed: int, fmu: Path, budget: int) -> dict:
     import cma
     from scipy.optimize import linear_sum_assignment
 
+    from calibration_rigs import observable_modes
+
     from twin.calibration.sensitivity import candidate_parameters, model_modes
 
-    box = _rig(rig_name)().scattered(seed, 0.12)
-    target = np.array([m.frequency for m in box.modes(speed=20.0, load=20.0)
-                       if m.observability >= 0.02 and 10.0 < m.frequency < 5000.0][:6])
+    box = importlib.import_module(f"rigs.{rig_name}").Rig().scattered(seed, 0.12)
+    target = observable_modes(box)[:6]
     cands = [c for c in candidate_parameters(fmu) if c.name not in LEFT_OUT]
     lo, hi = np.log([c.lower for c in cands]), np.log([c.upper for c in cands])
     nominal = np.log([c.nominal for c in cands])

@@ -176,14 +176,14 @@ model Gearbox21Overhangs "GearTwin.Gearbox21Shafts with each shaft a beam throug
   Real force_y5(unit = "N") "Force of its shaft's beam on body 5, vertical";
   Real force_y10(unit = "N") "Force of its shaft's beam on body 10, vertical";
 equation
-  der(y_end11) = vy_end11;
-  der(y_end9) = vy_end9;
-  der(x_end11) = vx_end11;
-  der(x_end9) = vx_end9;
-  der(y_end6) = vy_end6;
+  der(x_end4) = vx_end4;
   der(y_end4) = vy_end4;
   der(x_end6) = vx_end6;
-  der(x_end4) = vx_end4;
+  der(y_end6) = vy_end6;
+  der(x_end9) = vx_end9;
+  der(y_end9) = vy_end9;
+  der(x_end11) = vx_end11;
+  der(y_end11) = vy_end11;
   r_input_x_e1 = x_end4 - (span_input + overhang4) / span_input * x4 - (-overhang4 / span_input) * x6;
   r_input_x_g = x5 - (1 - pinion_position) * x4 - pinion_position * x6;
   r_input_x_e2 = x_end6 - (-overhang6 / span_input) * x4 - (span_input + overhang6) / span_input * x6;
