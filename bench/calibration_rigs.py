@@ -2,7 +2,7 @@
 
     python bench/calibration_rigs.py [--rigs pedestal beam] [--seeds 6 7 8 9 10] [--workers 2]
                                      [--model GearTwin.Gearbox21Shafts] [--pairing frequency]
-                                     [--visibility mesh]
+                                     [--visibility mesh] [--fit follow]
                                      [--out bench_out/calibration_rigs]
 
 For each rig and seed: one gearbox with its base parameters scattered +-12 %
@@ -56,14 +56,15 @@ CHANNEL = "accel_pinion_casing"
 
 
 def _scenario(path: Path, fs: float, workers: int, model: str, pairing: str = "frequency",
-              visibility: str = "mesh") -> Path:
+              visibility: str = "mesh", fit: str = "follow") -> Path:
     path.write_text(json.dumps({
         "version": 1, "name": "rig-calibration", "fmu": model, "stop_time": 2.0,
         "output": {"sample_rate": fs, "variables": [CHANNEL]},
         "operating": {"speed": SPEED, "load": LOAD}, "seed": 0,
         "executor": {"type": "local", "workers": workers},
         "calibration": {"parameters": "auto", "modes_from": "runup", "record": "steady",
-                        "pop_size": 12, "n_gen": 6, "pairing": pairing, "visibility": visibility}}, indent=2))
+                        "pop_size": 12, "n_gen": 6, "pairing": pairing, "visibility": visibility,
+                        "fit": fit}}, indent=2))
     return path
 
 
@@ -179,7 +180,7 @@ def _nearest(values, f):
 
 
 def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str, pairing: str = "frequency",
-                visibility: str = "mesh") -> dict:
+                visibility: str = "mesh", fit: str = "follow") -> dict:
     from spectral_distance import spectral_distance_report
 
     from fmu_build import build_fmu
@@ -211,7 +212,7 @@ def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str, p
     rec_err = [abs(f - _nearest(extracted, f)) / f for f in observable]
 
     scenario = load_scenario(_scenario(out / f"{rig_name}_{seed}.yaml", float(load_measurements(h5)[0].sample_rate),
-                                       workers, model, pairing, visibility))
+                                       workers, model, pairing, visibility, fit))
     t0 = time.perf_counter()
     report = run_calibration(scenario, h5, out / f"{rig_name}_{seed}_cal", progress=False)
     t_cal = time.perf_counter() - t0
@@ -269,6 +270,9 @@ def main() -> None:
     ap.add_argument("--visibility", choices=("mesh", "run-up"), default="mesh",
                     help="which excitations make a model mode visible (calibration.visibility); the score looks "
                          "at the calibrated twin's visible modes under the same rule")
+    ap.add_argument("--fit", choices=("follow", "search"), default="follow",
+                    help="how twin calibrate fits the modes (calibration.fit): following the nominal pairing, or "
+                         "a search pairing afresh at every candidate set")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--out", type=Path, default=REPO / "bench_out" / "calibration_rigs")
     ap.add_argument("--explain", action="store_true",
@@ -289,7 +293,9 @@ def main() -> None:
     for rig in args.rigs:
         for seed in args.seeds:
             t = time.perf_counter()
-            r = one_gearbox(rig, seed, args.out, args.workers, args.model, args.pairing, args.visibility)
+            r = one_gearbox(rig, seed, args.out, args.workers, args.model, args.pairing, args.visibility,
+                            args.fit)
+            r["fit"] = args.fit
             r["load_after"] = os.getloadavg()
             r["first6_explained"] = explain_modes(rig, seed, r, args.out, args.visibility)
             rows.append(r)

@@ -72,6 +72,10 @@ CALIBRATION_SCHEMA: dict[str, Any] = {
                     "description": "how measured modes are paired with model modes: frequency (the nearest visible "
                                    "model mode within 15 %, default) or shape (frequency, shape at the sensors and "
                                    "reach)"},
+        "fit": {"enum": ["follow", "search"],
+                "description": "how the modes are fitted: follow (the modes paired at the nominal set, followed "
+                               "through a Levenberg-Marquardt descent, default) or search (CMA-ES, the modes "
+                               "paired afresh at every candidate set, then that descent)"},
         "visibility": {"enum": ["mesh", "run-up"],
                        "description": "which excitations make a model mode visible (a pairing candidate): the "
                                       "mesh's alone (default) or any of a run-up's (mesh, drive and load torque, "

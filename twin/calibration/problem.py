@@ -54,6 +54,7 @@ class CalibrationTarget:
     mode_pairing: object | None = None      # Pairing at the nominal set (shape pairing), or None
     pairing: str = "frequency"              # how measured and model modes are paired (frequency or shape)
     visibility: str = "mesh"                # which excitations make a model mode visible (mesh or run-up)
+    fit: str = "follow"                     # how the modes are fitted (twin.calibration.mode_search.FITS)
 
     @property
     def needs_simulation(self) -> bool:
@@ -369,12 +370,21 @@ def _calibrate(fmu_path, space, target, ex, *, algorithm, pop_size, n_gen, seed,
             nom = np.array([float((nominal or {}).get(n, m)) for n, m in zip(space.names, mid)])
             # from the nominal set, where the modes were matched, following them step by step: a
             # population member far from it may hold two modes in swapped places
-            chosen = space.to_dict(fit_modes(Path(fmu_path), space.names, space.lower, space.upper, nom, nom,
-                                             target.natural_frequencies, target.rel_sd, fixed=dict(fixed or {}),
-                                             speed_hz=target.drive_hz, load_nm=target.load,
-                                             channels=target.mode_channels or (target.channel,),
-                                             shapes=target.mode_shapes, pairing=target.pairing,
-                                             start_pairing=target.mode_pairing, visibility=target.visibility))
+            kw = dict(fixed=dict(fixed or {}), speed_hz=target.drive_hz, load_nm=target.load,
+                      channels=target.mode_channels or (target.channel,), shapes=target.mode_shapes,
+                      pairing=target.pairing, visibility=target.visibility)
+            x0, start_pairing = nom, target.mode_pairing
+            from twin.calibration.mode_search import check_fit
+            if check_fit(target.fit) == "search":
+                # paired afresh at every candidate set; the descent then starts from a pairing made there
+                from twin.calibration.mode_search import search_modes
+                x0, _ = search_modes(Path(fmu_path), space.names, space.lower, space.upper, nom,
+                                     target.natural_frequencies, target.rel_sd, executor=ex, seed=seed,
+                                     progress=verbose, **kw)
+                start_pairing = None
+            chosen = space.to_dict(fit_modes(Path(fmu_path), space.names, space.lower, space.upper, nom, x0,
+                                             target.natural_frequencies, target.rel_sd,
+                                             start_pairing=start_pairing, **kw))
         else:
             chosen = space.to_dict(refine_modes(Path(fmu_path), space, target, start, fixed=fixed))
     return CalibrationResult(space.names, X, F, chosen, space.to_dict(X[knee]),

@@ -21,6 +21,8 @@ Scenario block (every key but ``parameters`` optional)::
       pairing: frequency          # measured to model modes: frequency (default) or shape (opt-in)
       visibility: mesh            # model modes a sensor shows: under the mesh (default) or any
                                   #   excitation of a run-up (run-up, opt-in)
+      fit: follow                 # the modes fit: follow the nominal pairing (default) or search
+                                  #   (CMA-ES, modes paired afresh at every set; opt-in)
       evaluation_timeout: 600     # s; an evaluation still running then is stopped, scored infeasible
       speed: 20                   # Hz and N.m: the operating point of typed modes without a measurement
       load: 20                    #   file (default: the scenario's constant operating speed and load)
@@ -32,7 +34,8 @@ physics (:mod:`twin.calibration.sensitivity`). The default objectives are the pa
 nearest visible model mode within 15 %; ``pairing: shape`` pairs by frequency, shape at the
 sensors and each model mode's reach (:mod:`twin.calibration.pairing`), an opt-in that scored
 worse on the rigs. ``visibility`` (:data:`twin.calibration.sensitivity.VISIBILITY`) says which
-excitations make a model mode visible, i.e. a pairing candidate.
+excitations make a model mode visible, i.e. a pairing candidate. ``fit``
+(:mod:`twin.calibration.mode_search`) says how the modes are fitted with ``refine``.
 
 Without a measurement file (``measurements=None``) the block must type ``natural_frequencies``
 and have only the ``modes`` objective (the default then): a published table of modes calibrates
@@ -231,6 +234,7 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
     spec = _block(scenario, modes_from, pairing, foundation_from)
     pairing = spec.get("pairing", "frequency")
     visibility = spec.get("visibility", "mesh")
+    fit = spec.get("fit", "follow")
     if measurements is None:       # refused before anything is written
         objectives = modes_only_objectives(spec, source)
         speed_hz, load_nm = typed_operating_point(scenario, spec)
@@ -265,7 +269,7 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
     target = CalibrationTarget(signal, sample_rate, speed_hz, load_nm, freqs, channel=channel, fmin=band[0],
                                fmax=band[1], objectives=objectives, mode_rel_sd=rel_sd, mode_channels=mode_channels,
                                mode_shapes=shapes if len(mode_channels) > 1 and pairing == "shape" else None,
-                               pairing=pairing, visibility=visibility)
+                               pairing=pairing, visibility=visibility, fit=fit)
     fixed = dict(scenario.parameters)
     if not auto:       # unknown or non-physical names and bounds: refused before the first evaluation
         check_calibration_parameters(fmu, ParameterSpace.from_bounds(spec["parameters"]),

@@ -88,6 +88,8 @@ def test_bad_calibration_block_lists_problems(gearbox_fmu, rig, tmp_path):
         _scenario(gearbox_fmu, pairing="nearest")
     with pytest.raises(ScenarioError, match=r"calibration\.visibility: 'all' is not one of \['mesh', 'run-up'\]"):
         _scenario(gearbox_fmu, visibility="all")
+    with pytest.raises(ScenarioError, match=r"calibration\.fit: 'global' is not one of \['follow', 'search'\]"):
+        _scenario(gearbox_fmu, fit="global")
     with pytest.raises(ScenarioError, match=r"calibration\.pairing: 'nearest' is not one of"):
         run_calibration(_scenario(gearbox_fmu), rig, tmp_path / "o3", progress=False, pairing="nearest")
     bare = scenario_from_dict({"version": 1, "name": "c", "fmu": str(gearbox_fmu), "stop_time": 1.0})
