@@ -76,6 +76,8 @@ CALIBRATION_SCHEMA: dict[str, Any] = {
                 "description": "how the modes are fitted: follow (the modes paired at the nominal set, followed "
                                "through a Levenberg-Marquardt descent, default) or search (CMA-ES, the modes "
                                "paired afresh at every candidate set, then that descent)"},
+        "search_budget": {"type": "integer", "minimum": 8,
+                          "description": "linearisations of the modes search (fit: search; default 160)"},
         "visibility": {"enum": ["mesh", "run-up"],
                        "description": "which excitations make a model mode visible (a pairing candidate): the "
                                       "mesh's alone (default) or any of a run-up's (mesh, drive and load torque, "

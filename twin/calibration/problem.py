@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from twin.calibration.mode_search import SEARCH_BUDGET
 from twin.errors import ParameterError
 
 log = logging.getLogger(__name__)
@@ -55,6 +56,7 @@ class CalibrationTarget:
     pairing: str = "frequency"              # how measured and model modes are paired (frequency or shape)
     visibility: str = "mesh"                # which excitations make a model mode visible (mesh or run-up)
     fit: str = "follow"                     # how the modes are fitted (twin.calibration.mode_search.FITS)
+    search_budget: int = SEARCH_BUDGET      # linearisations of the search (fit: search)
 
     @property
     def needs_simulation(self) -> bool:
@@ -380,7 +382,7 @@ def _calibrate(fmu_path, space, target, ex, *, algorithm, pop_size, n_gen, seed,
                 from twin.calibration.mode_search import search_modes
                 x0, _ = search_modes(Path(fmu_path), space.names, space.lower, space.upper, nom,
                                      target.natural_frequencies, target.rel_sd, executor=ex, seed=seed,
-                                     progress=verbose, **kw)
+                                     budget=target.search_budget, progress=verbose, **kw)
                 start_pairing = None
             chosen = space.to_dict(fit_modes(Path(fmu_path), space.names, space.lower, space.upper, nom, x0,
                                              target.natural_frequencies, target.rel_sd,

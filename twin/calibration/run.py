@@ -23,6 +23,7 @@ Scenario block (every key but ``parameters`` optional)::
                                   #   excitation of a run-up (run-up, opt-in)
       fit: follow                 # the modes fit: follow the nominal pairing (default) or search
                                   #   (CMA-ES, modes paired afresh at every set; opt-in)
+      search_budget: 160          # linearisations of that search
       evaluation_timeout: 600     # s; an evaluation still running then is stopped, scored infeasible
       speed: 20                   # Hz and N.m: the operating point of typed modes without a measurement
       load: 20                    #   file (default: the scenario's constant operating speed and load)
@@ -217,6 +218,7 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
     from twin._atomic import check_output_dir
     from twin.calibration.levels import fit_levels, has_levels, panel_participations
     from twin.calibration.modal_fit import mode_errors, on_bounds
+    from twin.calibration.mode_search import SEARCH_BUDGET
     from twin.calibration.objectives import match_modes
     from twin.calibration.output import write_calibrated_scenario
     from twin.calibration.problem import (CalibrationTarget, EvalTask, ParameterSpace, calibrate,
@@ -269,7 +271,8 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
     target = CalibrationTarget(signal, sample_rate, speed_hz, load_nm, freqs, channel=channel, fmin=band[0],
                                fmax=band[1], objectives=objectives, mode_rel_sd=rel_sd, mode_channels=mode_channels,
                                mode_shapes=shapes if len(mode_channels) > 1 and pairing == "shape" else None,
-                               pairing=pairing, visibility=visibility, fit=fit)
+                               pairing=pairing, visibility=visibility, fit=fit,
+                               search_budget=int(spec.get("search_budget", SEARCH_BUDGET)))
     fixed = dict(scenario.parameters)
     if not auto:       # unknown or non-physical names and bounds: refused before the first evaluation
         check_calibration_parameters(fmu, ParameterSpace.from_bounds(spec["parameters"]),

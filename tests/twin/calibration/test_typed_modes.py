@@ -34,9 +34,10 @@ def truth_modes(gearbox_fmu):
     return np.array([f for f, v in zip(mm.frequency, mm.visible) if v and 200 < f < 3000])
 
 
-def test_typed_modes_alone_calibrate_the_twin_to_a_perturbed_variant(gearbox_fmu, truth_modes, tmp_path):
+@pytest.mark.parametrize("fit", [{}, {"fit": "search", "search_budget": 24}], ids=["follow", "search"])
+def test_typed_modes_alone_calibrate_the_twin_to_a_perturbed_variant(gearbox_fmu, truth_modes, tmp_path, fit):
     sc = _scenario(gearbox_fmu, {"speed": 20, "load": 20}, parameters="auto", pop_size=2, n_gen=1,
-                   natural_frequencies=[float(f) for f in truth_modes])
+                   natural_frequencies=[float(f) for f in truth_modes], **fit)
     out = tmp_path / "out"
     report = run_calibration(sc, None, out, progress=False)
     assert report.objectives == ("modes",)
