@@ -20,7 +20,8 @@ For each rig and seed: one gearbox with its base parameters scattered +-12 %
    ``GearTwin.Gearbox21Overhangs`` each shaft a beam through its gear and its overhung ends;
    ``--pairing shape`` pairs the modes by frequency, shape and reach instead of frequency alone,
    and refuses a well-measured shape unlike the model mode's; ``--visibility run-up`` makes a model
-   mode visible when any of a run-up's excitations shows it, not only the mesh). The rig's first six observable
+   mode visible when any of a run-up's excitations shows it, not only the mesh; ``--fit search``
+   fits the modes by CMA-ES pairing them afresh at every candidate set, then the descent). The rig's first six observable
    modes against the nearest mode the calibrated twin shows at its sensor (acceptance: all within 3 %), counted apart by what met them: a mode of
    the twin's gearbox, or a sensor-path slot (a panel mode of the sensor path set at a measured mode,
    which matches by construction); the parameters left on a bound, and the wall time of modes +
