@@ -98,7 +98,7 @@ def explain_modes(rig_name: str, seed: int, row: dict, out: Path, visibility: st
     """Per mode of the rig's first six observable ones: its label, whether ``twin modes`` saw it
     (an extracted mode within 2 %), the calibrated twin's nearest visible mode and that mode's class
     (largest kinetic-energy share, :mod:`twin.calibration.mode_classes`)."""
-    from twin.calibration.sensitivity import model_modes
+    from twin.calibration.model_modes import model_modes
     from twin.scenario import load_scenario
 
     rigmod = importlib.import_module(f"rigs.{rig_name}")
@@ -186,7 +186,7 @@ def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str, p
 
     from fmu_build import build_fmu
     from twin.calibration.run import run_calibration
-    from twin.calibration.sensitivity import model_modes
+    from twin.calibration.model_modes import model_modes
     from twin.measurements import load_measurements
     from twin.modes import MIN_CONFIDENCE, survey_file
     from twin.operating import simulate_operating_point

@@ -46,7 +46,8 @@ def one_gearbox(rig_name: str, seed: int, fmu: Path, budget: int) -> dict:
 
     from calibration_rigs import observable_modes
 
-    from twin.calibration.sensitivity import candidate_parameters, model_modes
+    from twin.calibration.model_modes import model_modes
+    from twin.calibration.sensitivity import candidate_parameters
 
     box = importlib.import_module(f"rigs.{rig_name}").Rig().scattered(seed, 0.12)
     target = observable_modes(box)[:6]

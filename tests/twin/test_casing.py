@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from twin.calibration.sensitivity import model_modes
+from twin.calibration.model_modes import model_modes
 from twin.fmu import FMU
 from twin.linearize import state_jacobian
 from twin.operating import operating_point

@@ -124,7 +124,7 @@ def test_level_fit_recovers_gain_and_roughness(measured_fmu):
 
 
 def test_modes_no_gearbox_mode_reaches_go_to_the_casing_path(measured_fmu, gearbox_fmu):
-    from twin.calibration.run import casing_path
+    from twin.calibration.sensor_path import casing_path
     freqs = np.array([640.0, 1700.0, 3300.0, 4100.0, 4500.0])
     damping = np.array([0.02, 0.015, np.nan, 0.5, 0.03])
     confidence = np.array([0.9, 0.8, 0.7, 0.6, 0.3])

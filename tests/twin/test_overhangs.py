@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from twin.calibration.mode_classes import mass_values
-from twin.calibration.sensitivity import candidate_parameters, model_modes
+from twin.calibration.model_modes import model_modes
+from twin.calibration.sensitivity import candidate_parameters
 from twin.fmu import FMU
 
 KW = dict(speed_hz=20.0, load_nm=20.0, channels=("accel_pinion_casing", "accel_gear_casing"))

@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from twin.calibration.mode_classes import mass_values
-from twin.calibration.sensitivity import candidate_parameters, model_modes
+from twin.calibration.model_modes import model_modes
+from twin.calibration.sensitivity import candidate_parameters
 from twin.fmu import FMU
 
 SPRINGS = ("kx45", "ky45", "kx56", "ky56", "kx910", "ky910", "kx1011", "ky1011")

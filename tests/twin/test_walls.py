@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from twin.calibration.mode_classes import mass_values
-from twin.calibration.sensitivity import candidate_parameters, model_modes
+from twin.calibration.model_modes import model_modes
+from twin.calibration.sensitivity import candidate_parameters
 from twin.fmu import FMU
 from twin.linearize import state_jacobian
 from twin.operating import operating_point

@@ -29,7 +29,8 @@ from collections.abc import Mapping
 import numpy as np
 
 from twin.calibration.pairing import MeasuredShapes, Pairing, shape_mismatch
-from twin.calibration.sensitivity import MATCH_REACH, ModelModes, follow_index, match_measured, model_modes
+from twin.calibration.model_modes import ModelModes, model_modes
+from twin.calibration.sensitivity import MATCH_REACH, follow_index, match_measured
 
 
 def mode_errors(model: ModelModes, measured: np.ndarray, rel_sd: np.ndarray, shapes: MeasuredShapes | None = None,

@@ -52,7 +52,7 @@ def check_fit(fit: str) -> str:
 def _cost_task(task) -> float:
     """Objective of one candidate set (top level, so that worker processes can run it)."""
     from twin.calibration.modal_fit import mode_errors
-    from twin.calibration.sensitivity import model_modes
+    from twin.calibration.model_modes import model_modes
 
     fmu_path, values, prior, measured, rel_sd, shapes, pairing, kw = task
     z, _ = mode_errors(model_modes(fmu_path, values, **kw), measured, rel_sd, shapes, pairing=pairing)

@@ -38,7 +38,7 @@ shape at the casing sensors must look like the measured one.
   estimate. Below that coherence a neighbouring mode or the noise may have bent the shape, and
   the mismatch only costs. A refused measured mode goes to another model mode of its shape
   within reach, or stays unpaired (and may become a sensor-path panel mode,
-  :func:`twin.calibration.run.casing_path`); :func:`shape_refusals` lists them.
+  :func:`twin.calibration.sensor_path.casing_path`); :func:`shape_refusals` lists them.
 * **Assignment.** One-to-one with least total cost (Hungarian algorithm); a measured mode is left
   unpaired at cost :data:`UNPAIRED`, more than any feasible pairing.
 """

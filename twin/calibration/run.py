@@ -34,7 +34,7 @@ physics (:mod:`twin.calibration.sensitivity`). The default objectives are the pa
 (correlation, modes) otherwise. ``pairing: frequency`` (default) pairs each measured mode with the
 nearest visible model mode within 15 %; ``pairing: shape`` pairs by frequency, shape at the
 sensors and each model mode's reach (:mod:`twin.calibration.pairing`), an opt-in that scored
-worse on the rigs. ``visibility`` (:data:`twin.calibration.sensitivity.VISIBILITY`) says which
+worse on the rigs. ``visibility`` (:data:`twin.calibration.model_modes.VISIBILITY`) says which
 excitations make a model mode visible, i.e. a pairing candidate. ``fit``
 (:mod:`twin.calibration.mode_search`) says how the modes are fitted with ``refine``.
 
@@ -224,7 +224,9 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
     from twin.calibration.problem import (CalibrationTarget, EvalTask, ParameterSpace, calibrate,
                                           check_calibration_parameters, evaluate_candidate, write_parameter_set)
     from twin.calibration.report import psd_overlay, write_html, write_pareto
-    from twin.calibration.sensitivity import model_modes, mode_sensitivity
+    from twin.calibration.sensor_path import casing_path
+    from twin.calibration.model_modes import model_modes
+    from twin.calibration.sensitivity import mode_sensitivity
     from twin.calibration.typed_modes import modes_only_objectives, typed_operating_point
     from twin.executor import make_executor
     from twin.measurements import load_measurements
@@ -407,49 +409,6 @@ def _steady_record(spec: dict, mset, scenario, channel: str, duration: float, so
     return rec
 
 
-#: Casing panel modes a sensor path of GearTwin.Gearbox21Measured can hold.
-PANEL_SLOTS = 3
-
-
-def casing_path(fmu, channel: str, unmatched_hz, freqs, damping, confidence, *, shared: int = 1
-                ) -> dict[str, float]:
-    """Parameters that put the measured modes no gearbox mode can reach into the sensor's casing path.
-
-    A measured mode with no visible mode of the gearbox model within 15 % (with the shape
-    pairing: none within reach whose shape is not refused) is something the gearbox model does
-    not have; at a casing accelerometer the casing wall between the bearings
-    and the sensor is what it most likely is (the rig's counterpart of the paper's foundation
-    modes, which were measured apart and removed). The most confident of them, at most
-    PANEL_SLOTS, become the path's panel modes: frequency and damping as measured, the sensor on
-    the modal mass (participation 1; 1/``shared`` when the modes were read at several sensors,
-    whose paths all get them, since a run-up does not say which sensor's casing they belong to).
-    A mode outside the range the model declares for a panel (a 13 Hz hump is no casing panel) is
-    left out rather than written as a parameter the FMU refuses. Empty when the model has no such
-    path.
-    """
-    from twin.calibration.levels import SENSOR_OF_CHANNEL
-    from twin.fmu import FMU
-
-    sensor = SENSOR_OF_CHANNEL.get(channel)
-    if sensor is None or len(unmatched_hz) == 0:
-        return {}
-    with FMU(fmu) as f:
-        if f"{sensor}.panel_frequency[1]" not in f.variables:
-            return {}
-        sv = {v.name: v for v in f.model_description.modelVariables}[f"{sensor}.panel_frequency[1]"]
-    lo = float(sv.min) if getattr(sv, "min", None) is not None else 0.0
-    hi = float(sv.max) if getattr(sv, "max", None) is not None else np.inf
-    picks = [i for i in np.argsort(-np.asarray(confidence))
-             if np.any(np.isclose(freqs[i], unmatched_hz)) and lo <= freqs[i] <= hi]
-    out = {}
-    for slot, i in enumerate(sorted(picks[:PANEL_SLOTS], key=lambda i: freqs[i]), start=1):
-        zeta = float(damping[i]) if np.isfinite(damping[i]) else 0.02
-        out[f"{sensor}.panel_frequency[{slot}]"] = float(freqs[i])
-        out[f"{sensor}.panel_damping[{slot}]"] = float(np.clip(zeta, 0.005, 0.1))
-        out[f"{sensor}.panel_participation[{slot}]"] = 1.0 / shared
-    return out
-
-
 def _outputs(fmu) -> set[str]:
     from twin.fmu import FMU
     with FMU(fmu) as f:
@@ -474,7 +433,8 @@ def scenario_sensitivity(scenario, measurements: str | Path | None = None, *, mo
     """
     import tempfile
 
-    from twin.calibration.sensitivity import model_modes, mode_sensitivity
+    from twin.calibration.model_modes import model_modes
+    from twin.calibration.sensitivity import mode_sensitivity
     from twin.measurements import load_measurements
 
     spec = dict(scenario.raw.get("calibration") or {})

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from twin.calibration.mode_classes import classify, dof_table
-from twin.calibration.sensitivity import model_modes
+from twin.calibration.model_modes import model_modes
 
 NAMES = ("theta5", "omega5", "y10", "vy10", "x10", "vx10", "casing.q[1]", "casing.qd[1]",
          "sensor_pinion.panel_deflection[1]", "sensor_pinion.panel_rate[1]")

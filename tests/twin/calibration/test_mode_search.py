@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from twin.calibration.mode_search import FAILED_COST, _evaluate, check_fit, search_modes
-from twin.calibration.sensitivity import model_modes
+from twin.calibration.model_modes import model_modes
 
 KW = dict(speed_hz=20.0, load_nm=20.0)
 

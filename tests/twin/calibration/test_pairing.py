@@ -10,7 +10,8 @@ import pytest
 from twin.calibration.modal_fit import mode_errors
 from twin.calibration.pairing import (MATCH_REACH, PAIRINGS, REFUSE_COHERENCE, REFUSE_MISMATCH, MeasuredShapes,
                                       Pairing, mac, mode_reach, pair_modes, refused, shape_mismatch, shape_refusals)
-from twin.calibration.sensitivity import Candidate, ModelModes, Sensitivity, match_measured
+from twin.calibration.model_modes import ModelModes
+from twin.calibration.sensitivity import Candidate, Sensitivity, match_measured
 from twin.scenario_schema import CALIBRATION_SCHEMA
 from twin.signals.shapes import ChannelShape
 

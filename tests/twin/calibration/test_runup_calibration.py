@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from twin.calibration.run import run_calibration
-from twin.calibration.sensitivity import model_modes
+from twin.calibration.model_modes import model_modes
 from twin.cli import main
 from twin.errors import ScenarioError
 from twin.measurements import Record, write_measurements

@@ -4,8 +4,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from twin.calibration.sensitivity import (Candidate, candidate_parameters, match_measured, model_modes,
-                                          mode_sensitivity, select_identifiable)
+from twin.calibration.model_modes import model_modes
+from twin.calibration.sensitivity import (Candidate, candidate_parameters, match_measured, mode_sensitivity,
+                                          select_identifiable)
 
 
 def _cands(n):

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from twin.calibration.run import run_calibration
-from twin.calibration.sensitivity import model_modes
+from twin.calibration.model_modes import model_modes
 from twin.cli import main
 from twin.errors import ScenarioError
 from twin.scenario import load_scenario, read_parameter_file, scenario_from_dict
