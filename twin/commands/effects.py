@@ -33,7 +33,8 @@ def add_subcommands(sub) -> None:
 
     p = sub.add_parser("effects", help="list the effect catalogue")
     p.add_argument("--write-candidates", action="store_true",
-                   help="regenerate GearTwin.Variants.Gearbox21Candidates from the catalogue")
+                   help="regenerate the candidate models (GearTwin.Variants.<Base>Candidates, one per base "
+                        "model) from the catalogue")
     p.add_argument("--modelica-dir", type=Path, default=None)
     p.set_defaults(handler=_cmd_effects)
 

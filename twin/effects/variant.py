@@ -32,7 +32,15 @@ from twin.effects.catalogue import CATALOGUE, effect
 BASE_MODEL = "GearTwin.Gearbox21"
 #: The base gearbox as its sensors measure it (broadband excitation, transfer paths).
 MEASURED_MODEL = "GearTwin.Gearbox21Measured"
-BASE_MODELS = (BASE_MODEL, MEASURED_MODEL)
+#: The models with the casing in the loop, each with a parameter only it (and what extends it)
+#: has, most derived first: every one extends GearTwin.Gearbox21 without binding its effect
+#: hooks, so the catalogue's effects wire into them as into the base.
+CASING_MODELS = (("end_mass4", "GearTwin.Gearbox21Overhangs"),
+                 ("housing_height", "GearTwin.Gearbox21TiltingWalls"),
+                 ("wall_thickness", "GearTwin.Gearbox21Walls"),
+                 ("d_shaft_input", "GearTwin.Gearbox21Shafts"),
+                 ("m_casing", "GearTwin.Gearbox21Casing"))
+BASE_MODELS = (BASE_MODEL, MEASURED_MODEL, *(m for _, m in reversed(CASING_MODELS)))
 VARIANTS_PACKAGE = "GearTwin.Variants"
 CANDIDATES_MODEL = f"{VARIANTS_PACKAGE}.Gearbox21Candidates"
 
@@ -44,22 +52,20 @@ def candidates_model(base: str = BASE_MODEL) -> str:
 
 
 def base_of(parameter_names) -> str:
-    """The base model an FMU extends, read from its parameters (a sensor model means
-    :data:`MEASURED_MODEL`). Raises :class:`twin.errors.ParameterError` for a model with a casing
-    (``GearTwin.Gearbox21Casing`` and the models that extend it), which has no candidate model."""
+    """The base model an FMU extends, read from its parameters: a model of :data:`CASING_MODELS`
+    by its own parameter, else :data:`MEASURED_MODEL` when it has a sensor model, else
+    :data:`BASE_MODEL`."""
     names = set(parameter_names)
-    if "m_casing" in names:
-        from twin.errors import ParameterError
-        raise ParameterError("the effect catalogue has no candidate model for GearTwin.Gearbox21Casing or "
-                             "the models that extend it (a casing on mounts); diagnose a twin calibrated as "
-                             f"{MEASURED_MODEL} or {BASE_MODEL}")
+    for marker, model in CASING_MODELS:
+        if marker in names:
+            return model
     return MEASURED_MODEL if any(n.startswith("sensor_pinion.") for n in names) else BASE_MODEL
 
 
 def _check_base(base: str) -> None:
     if base not in BASE_MODELS:
         from twin.errors import ParameterError
-        raise ParameterError(f"effects extend {' or '.join(BASE_MODELS)}, not {base!r}")
+        raise ParameterError(f"effects extend {', '.join(BASE_MODELS)}, not {base!r}")
 _REPO_MODELICA = Path(__file__).resolve().parents[2] / "modelica"
 
 
