@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from twin.calibration.mode_search import SEARCH_BUDGET
+from twin.calibration.mode_search import SEARCH_BUDGET, check_fit, search_modes
 from twin.errors import ParameterError
 
 log = logging.getLogger(__name__)
@@ -376,10 +376,8 @@ def _calibrate(fmu_path, space, target, ex, *, algorithm, pop_size, n_gen, seed,
                       channels=target.mode_channels or (target.channel,), shapes=target.mode_shapes,
                       pairing=target.pairing, visibility=target.visibility)
             x0, start_pairing = nom, target.mode_pairing
-            from twin.calibration.mode_search import check_fit
             if check_fit(target.fit) == "search":
                 # paired afresh at every candidate set; the descent then starts from a pairing made there
-                from twin.calibration.mode_search import search_modes
                 x0, _ = search_modes(Path(fmu_path), space.names, space.lower, space.upper, nom,
                                      target.natural_frequencies, target.rel_sd, executor=ex, seed=seed,
                                      budget=target.search_budget, progress=verbose, **kw)

@@ -224,9 +224,9 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
     from twin.calibration.problem import (CalibrationTarget, EvalTask, ParameterSpace, calibrate,
                                           check_calibration_parameters, evaluate_candidate, write_parameter_set)
     from twin.calibration.report import psd_overlay, write_html, write_pareto
-    from twin.calibration.sensor_path import casing_path
     from twin.calibration.model_modes import model_modes
     from twin.calibration.sensitivity import mode_sensitivity
+    from twin.calibration.sensor_path import casing_path
     from twin.calibration.typed_modes import modes_only_objectives, typed_operating_point
     from twin.executor import make_executor
     from twin.measurements import load_measurements
