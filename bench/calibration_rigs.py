@@ -2,12 +2,14 @@
 
     python bench/calibration_rigs.py [--rigs pedestal beam] [--seeds 6 7 8 9 10] [--workers 2]
                                      [--model GearTwin.Gearbox21Shafts] [--pairing frequency]
-                                     [--visibility mesh] [--fit follow]
+                                     [--visibility mesh] [--fit follow] [--hammer]
                                      [--out bench_out/calibration_rigs]
 
 For each rig and seed: one gearbox with its base parameters scattered +-12 %
 (``Rig().scattered(seed, 0.12)``); a 2 s steady record at 20 Hz / 20 N.m and a 6 s run-up from 2 to
-20 Hz, written in the measurement format (truth apart). Then, as a user would:
+20 Hz, written in the measurement format (truth apart); with ``--hammer`` also a hammer test per
+struck point (:data:`HAMMER`: the two bearing supports, vertical) at slow roll (0.5 Hz, 20 N.m, 8 s,
+4 blows/s), read together with the run-up for the modes. Then, as a user would:
 
 1. ``twin modes`` on the run-up (every casing channel): the modes with confidence >= 0.3 against
    the rig's own modes (``box.modes()``, its linearisation). *Observable* rig modes: observability
@@ -54,16 +56,21 @@ OBSERVABLE = 0.02
 BAND = (10.0, 5000.0)
 SPEED, LOAD = 20.0, 20.0
 CHANNEL = "accel_pinion_casing"
+#: Where each rig is struck in the hammer tests (``Rig.impact(location=...)``): the pinion's and the
+#: gear's bearing support, vertical; at slow roll, where the running excitation is weak.
+HAMMER = {"pedestal": ("pinion_pedestal", "gear_pedestal"), "beam": ("pinion_housing", "gear_housing")}
+HAMMER_SPEED, HAMMER_DURATION, HAMMER_RATE = 0.5, 8.0, 4.0
 
 
 def _scenario(path: Path, fs: float, workers: int, model: str, pairing: str = "frequency",
-              visibility: str = "mesh", fit: str = "follow") -> Path:
+              visibility: str = "mesh", fit: str = "follow", modes_from=("runup",)) -> Path:
     path.write_text(json.dumps({
         "version": 1, "name": "rig-calibration", "fmu": model, "stop_time": 2.0,
         "output": {"sample_rate": fs, "variables": [CHANNEL]},
         "operating": {"speed": SPEED, "load": LOAD}, "seed": 0,
         "executor": {"type": "local", "workers": workers},
-        "calibration": {"parameters": "auto", "modes_from": "runup", "record": "steady",
+        "calibration": {"parameters": "auto", "modes_from": modes_from[0] if len(modes_from) == 1 else list(modes_from),
+                        "record": "steady",
                         "pop_size": 12, "n_gen": 6, "pairing": pairing, "visibility": visibility,
                         "fit": fit}}, indent=2))
     return path
@@ -181,7 +188,7 @@ def _nearest(values, f):
 
 
 def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str, pairing: str = "frequency",
-                visibility: str = "mesh", fit: str = "follow") -> dict:
+                visibility: str = "mesh", fit: str = "follow", hammer: bool = False) -> dict:
     from spectral_distance import spectral_distance_report
 
     from fmu_build import build_fmu
@@ -195,25 +202,28 @@ def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str, p
     rigmod = importlib.import_module(f"rigs.{rig_name}")
     box = rigmod.Rig().scattered(seed=seed, scatter=0.12)
     t = time.perf_counter()
-    h5 = out / f"{rig_name}_{seed}.h5"
+    h5 = out / f"{rig_name}_{seed}{'_hammer' * hammer}.h5"
+    modes_from = ("runup",) + tuple(f"hammer_{loc}" for loc in HAMMER[rig_name] if hammer)
     if not h5.exists():          # the records depend on the rig version and the seeds only
         steady = box.steady(speed=SPEED, load=LOAD, duration=2.0, seed=seed, name="steady")
         runup = box.runup(speeds=(2.0, SPEED), load=LOAD, duration=6.0, seed=seed, name="runup")
-        rigmod.write(h5, [steady, runup])
+        struck = [box.impact(speed=HAMMER_SPEED, load=LOAD, duration=HAMMER_DURATION, impacts_per_second=HAMMER_RATE,
+                             location=loc, seed=seed, name=f"hammer_{loc}") for loc in HAMMER[rig_name] if hammer]
+        rigmod.write(h5, [steady, runup, *struck])
     rig_wall = time.perf_counter() - t
     truth = box.modes(speed=SPEED, load=LOAD)
     all_modes = np.array([m.frequency for m in truth])
     observable = observable_modes(box)
 
     t0 = time.perf_counter()
-    survey = survey_file(h5, "runup")
+    survey = survey_file(h5, list(modes_from))
     t_modes = time.perf_counter() - t0
     extracted = survey.frequencies(MIN_CONFIDENCE)
     ext_err = [abs(f - _nearest(all_modes, f)) / _nearest(all_modes, f) for f in extracted]
     rec_err = [abs(f - _nearest(extracted, f)) / f for f in observable]
 
     scenario = load_scenario(_scenario(out / f"{rig_name}_{seed}.yaml", float(load_measurements(h5)[0].sample_rate),
-                                       workers, model, pairing, visibility, fit))
+                                       workers, model, pairing, visibility, fit, modes_from))
     t0 = time.perf_counter()
     report = run_calibration(scenario, h5, out / f"{rig_name}_{seed}_cal", progress=False)
     t_cal = time.perf_counter() - t0
@@ -252,7 +262,7 @@ def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str, p
             "first6_errors_pc": [100 * e for e in six_err], "first6_pass": bool(max(six_err) <= 0.03),
             "first6_errors_mesh_visible_pc": [100 * e for e in mesh_err], "visibility": visibility,
             "on_bounds": list(report.warnings), "chosen": list(report.result.chosen),
-            "notes": list(report.notes), "modes_s": t_modes, "calibrate_s": t_cal,
+            "notes": list(report.notes), "modes_s": t_modes, "calibrate_s": t_cal, "modes_from": list(modes_from),
             "spectrum": spectrum,
             "table2": {"measured": report.measured_modes.tolist(), "after": report.after_modes.tolist()}}
 
@@ -274,6 +284,8 @@ def main() -> None:
     ap.add_argument("--fit", choices=("follow", "search"), default="follow",
                     help="how twin calibrate fits the modes (calibration.fit): following the nominal pairing, or "
                          "a search pairing afresh at every candidate set")
+    ap.add_argument("--hammer", action="store_true",
+                    help="also a slow-roll hammer test per struck point (HAMMER), read with the run-up for the modes")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--out", type=Path, default=REPO / "bench_out" / "calibration_rigs")
     ap.add_argument("--explain", action="store_true",
@@ -295,7 +307,7 @@ def main() -> None:
         for seed in args.seeds:
             t = time.perf_counter()
             r = one_gearbox(rig, seed, args.out, args.workers, args.model, args.pairing, args.visibility,
-                            args.fit)
+                            args.fit, args.hammer)
             r["fit"] = args.fit
             r["load_after"] = os.getloadavg()
             r["first6_explained"] = explain_modes(rig, seed, r, args.out, args.visibility)

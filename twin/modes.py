@@ -192,14 +192,44 @@ def merge_surveys(surveys) -> ModalSurvey:
                    channels=tuple(c for s in surveys for c in s.channels))
 
 
-def survey_file(path, record: str | None = None, **kwargs) -> ModalSurvey:
-    """Survey of record ``record`` (default: the first) of a measurement file."""
+def survey_records(mset, names, **kwargs) -> ModalSurvey:
+    """One survey of the structure from several records of ``mset`` (for example a run-up and a
+    hammer test per struck point): each record surveyed (:func:`survey_record`), then merged like
+    several sensors (a mode seen in any record is a mode of the structure, kept with the estimate of
+    the record that saw it most clearly, modes within 1 % merged). Each mode's evidence names the
+    records that saw it (``records``). ``names``: one record name or a sequence of them; a name
+    ``mset`` lacks raises :class:`MeasurementError` naming it."""
+    names = [names] if isinstance(names, str) else list(names)
+    if not names:
+        raise MeasurementError(mset.source or "<memory>", "", "no record named to read modes from")
+    missing = [n for n in names if n not in mset.names]
+    if missing:
+        raise MeasurementError(mset.source or "<memory>", missing[0],
+                               f"no such record (the file has {', '.join(mset.names)})")
+    if len(names) == 1:
+        return survey_record(mset[names[0]], **kwargs)
+    surveys = []
+    for n in names:
+        s = survey_record(mset[n], **kwargs)
+        surveys.append(replace(s, modes=tuple(replace(m, evidence={**m.evidence, "records": [n]}) for m in s.modes)))
+    merged = merge_surveys(surveys)
+    # which records saw each merged mode: every record with a mode within the merge's reach
+    modes = []
+    for m in merged.modes:
+        seen = [n for n, s in zip(names, surveys)
+                if any(abs(o.frequency - m.frequency) <= max(0.01 * m.frequency, 2 * s.resolution) for o in s.modes)]
+        modes.append(replace(m, evidence={**m.evidence, "records": seen}))
+    method = "+".join(dict.fromkeys(s.method for s in surveys))
+    return replace(merged, modes=tuple(modes), method=method, channels=tuple(dict.fromkeys(merged.channels)))
+
+
+def survey_file(path, record=None, **kwargs) -> ModalSurvey:
+    """Survey of record ``record`` (default: the first) of a measurement file; several record
+    names (a sequence) are surveyed together (:func:`survey_records`)."""
     from twin.measurements import load_measurements
 
     mset = load_measurements(path)
-    if record is not None and record not in mset.names:
-        raise MeasurementError(str(path), record, f"no such record (the file has {', '.join(mset.names)})")
-    return survey_record(mset[record] if record is not None else mset[0], **kwargs)
+    return survey_records(mset, mset.names[0] if record is None else record, **kwargs)
 
 
 def write_survey_json(survey: ModalSurvey, path, **extra) -> Path:

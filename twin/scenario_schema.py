@@ -51,7 +51,10 @@ CALIBRATION_SCHEMA: dict[str, Any] = {
             {"const": "auto", "description": "the parameters the measured modes identify, with bounds from physics"},
             {"type": "object", "minProperties": 1,
              "additionalProperties": {"type": "array", "items": {"type": "number"}, "minItems": 2, "maxItems": 2}}]},
-        "modes_from": {"type": "string", "description": "record (run-up or hammer test) the measured modes are read from"},
+        "modes_from": {"oneOf": [{"type": "string"},
+                                 {"type": "array", "items": {"type": "string"}, "minItems": 1, "uniqueItems": True}],
+                       "description": "record (run-up or hammer test) the measured modes are read from, or several "
+                                      "read together (a run-up and a hammer test per struck point)"},
         "min_confidence": {"type": "number", "minimum": 0, "maximum": 1},
         "objectives": {"type": "array", "minItems": 1, "uniqueItems": True,
                        "items": {"enum": ["waveform", "correlation", "frequencies", "modes"]}},

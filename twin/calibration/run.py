@@ -4,7 +4,8 @@ Scenario block (every key but ``parameters`` optional)::
 
     calibration:
       parameters: auto            # or {kt12: [1000, 2500], I1: [3.0e-3, 6.0e-3]}: bounds in SI units
-      modes_from: runup           # record whose run-up (or hammer test) gives the measured modes
+      modes_from: runup           # record whose run-up (or hammer test) gives the measured modes;
+                                  # or a list read together: [runup, hammer_pinion, hammer_gear]
       min_confidence: 0.3         # modes of that record used for calibration
       natural_frequencies: [22, 87, 218, 430]   # or typed by hand [Hz]
       foundation_modes: [13, 41]  # removed from the measured modes (paper: hammer test), in Hz
@@ -128,22 +129,24 @@ def measured_modes(spec: dict, mset, source: str, out_dir: Path, *, with_damping
     channels they were read from (empty when typed) and their shapes at those channels
     (:class:`twin.calibration.pairing.MeasuredShapes`, None when typed or read from one channel)."""
     from twin.calibration.pairing import MeasuredShapes
-    from twin.modes import MIN_CONFIDENCE, survey_record, write_survey_json
+    from twin.modes import MIN_CONFIDENCE, survey_records, write_survey_json
     from twin.signals import remove_foundation_modes
 
     if isinstance(spec.get("foundation_modes"), str):      # refused before any survey is run or written
         _hammer_record(spec["foundation_modes"], mset, source)
     if spec.get("modes_from"):
-        name = spec["modes_from"]
-        if name not in mset.names:
-            raise ScenarioError([(source, "calibration.modes_from",
-                                  f"no record {name!r} in the measurements (they have {', '.join(mset.names)})")])
-        survey = survey_record(mset[name])
-        write_survey_json(survey, out_dir / "modes.json", record=name)
+        names = modes_records(spec)
+        for name in names:
+            if name not in mset.names:
+                raise ScenarioError([(source, "calibration.modes_from",
+                                      f"no record {name!r} in the measurements (they have {', '.join(mset.names)})")])
+        survey = survey_records(mset, names)
+        label = f"record {names[0]!r}" if len(names) == 1 else "records " + ", ".join(map(repr, names))
+        write_survey_json(survey, out_dir / "modes.json", record=names[0] if len(names) == 1 else names)
         threshold = float(spec.get("min_confidence", MIN_CONFIDENCE))
         used = [m for m in survey.modes if m.confidence >= threshold]
         if not used:
-            raise ScenarioError([(source, "calibration.modes_from", f"record {name!r} shows no mode with "
+            raise ScenarioError([(source, "calibration.modes_from", f"{label} show{'s' * (len(names) == 1)} no mode with "
                                   f"confidence >= {threshold:g} (see {out_dir / 'modes.json'})")])
         freqs = np.array([m.frequency for m in used])
         rel = np.array([m.evidence.get("frequency_sd_hz", 0.0) / m.frequency for m in used])
@@ -151,7 +154,7 @@ def measured_modes(spec: dict, mset, source: str, out_dir: Path, *, with_damping
         confidence = np.array([m.confidence for m in used])
         channels = tuple(survey.channels)
         shapes = MeasuredShapes.from_evidence([m.evidence for m in used])
-        what = (f"{freqs.size} modes read from record {name!r} ({survey.method}, confidence >= {threshold:g}; "
+        what = (f"{freqs.size} modes read from {label} ({survey.method}, confidence >= {threshold:g}; "
                 f"{len(survey.lines)} fixed lines and {len(survey.orders)} orders set aside)")
     elif spec.get("natural_frequencies"):
         freqs = np.asarray(spec["natural_frequencies"], float)
@@ -178,6 +181,12 @@ def measured_modes(spec: dict, mset, source: str, out_dir: Path, *, with_damping
     if with_damping:
         return freqs, rel, what, damping, confidence, channels, shapes
     return freqs, rel, what
+
+
+def modes_records(spec: dict) -> list[str]:
+    """The record names of a calibration block's ``modes_from`` (one name or a list), as a list."""
+    names = spec.get("modes_from") or []
+    return [names] if isinstance(names, str) else list(names)
 
 
 def _hammer_record(name: str, mset, source: str):
@@ -209,7 +218,7 @@ def foundation_modes_of(name: str, spec: dict, mset, source: str, out_dir: Path)
 
 def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Path, *, executor=None,
                     progress: bool = True, seed: int | None = None, resume: bool = False,
-                    modes_from: str | None = None, pairing: str | None = None,
+                    modes_from: str | list[str] | None = None, pairing: str | None = None,
                     foundation_from: str | None = None) -> CalibrationReport:
     """Calibrate the scenario's FMU to a measurement file, or with ``measurements=None`` to the
     block's typed natural frequencies alone (see the module docstring); ``modes_from``,
@@ -387,7 +396,7 @@ def _steady_record(spec: dict, mset, scenario, channel: str, duration: float, so
     from twin.measurements.resample import resample_record
 
     # the first record that neither gives the modes nor is the foundation's hammer test
-    not_steady = {spec.get("modes_from"), spec.get("foundation_modes") if isinstance(spec.get("foundation_modes"), str)
+    not_steady = {*modes_records(spec), spec.get("foundation_modes") if isinstance(spec.get("foundation_modes"), str)
                   else None}
     steady_name = spec.get("record") or next((n for n in mset.names if n not in not_steady), mset.names[0])
     if steady_name not in mset.names:
@@ -420,7 +429,7 @@ def _start(target) -> dict:
     return operating_point(target.drive_hz, target.load)[0]
 
 
-def scenario_sensitivity(scenario, measurements: str | Path | None = None, *, modes_from: str | None = None,
+def scenario_sensitivity(scenario, measurements: str | Path | None = None, *, modes_from: str | list[str] | None = None,
                          n_modes: int = 8, executor=None, pairing: str | None = None):
     """The sensitivity study ``parameters: auto`` runs (:class:`twin.calibration.sensitivity.Sensitivity`).
 
@@ -457,7 +466,7 @@ def scenario_sensitivity(scenario, measurements: str | Path | None = None, *, mo
             freqs, rel, _, _, _, seen_by, shapes = measured_modes(spec, mset, str(scenario.source), Path(tmp),
                                                                   with_damping=True)
         channels = tuple(c for c in seen_by if c in _outputs(fmu)) or (channel,)
-        steady = [r for r in mset if r.name != spec.get("modes_from") and r.nominal_speed and r.load is not None]
+        steady = [r for r in mset if r.name not in modes_records(spec) and r.nominal_speed and r.load is not None]
         if steady:
             speed_hz, load_nm = float(steady[0].nominal_speed), float(steady[0].load)
     elif spec.get("natural_frequencies"):

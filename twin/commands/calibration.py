@@ -18,9 +18,10 @@ def add_subcommands(sub) -> None:
     p.add_argument("--workers", type=positive_int, help="local worker processes for the evaluations")
     p.add_argument("--seed", type=int, help="override the scenario's seed")
     p.add_argument("--resume", action="store_true", help="continue from <out>/checkpoint.json")
-    p.add_argument("--modes-from", metavar="RECORD",
-                   help="read the measured modes from this run-up or hammer record (see twin modes); without a "
-                        "calibration block the parameters are chosen automatically")
+    p.add_argument("--modes-from", metavar="RECORD[,RECORD...]", type=_record_list,
+                   help="read the measured modes from this run-up or hammer record, or from several together "
+                        "(comma-separated: a run-up and a hammer test per struck point; see twin modes); without "
+                        "a calibration block the parameters are chosen automatically")
     p.add_argument("--foundation-from", metavar="RECORD",
                    help="hammer-test record of the foundation (casing root): its modes are left out of the "
                         "measured ones, as the paper does")
@@ -84,13 +85,22 @@ def _add_sensitivity_parser(sub) -> None:
                                            "calibrates), with bounds from physics")
     p.add_argument("scenario", metavar="SCENARIO", help="scenario .yaml (model and parameters)")
     p.add_argument("--measurements", help="measurement HDF5 with the record the modes are read from")
-    p.add_argument("--modes-from", metavar="RECORD", help="run-up or hammer record of the measured modes")
+    p.add_argument("--modes-from", metavar="RECORD[,RECORD...]", type=_record_list,
+                   help="run-up or hammer record(s) of the measured modes, comma-separated")
     p.add_argument("--modes", type=int, default=8,
                    help="without measurements: the model's first N visible modes (default: 8)")
     p.add_argument("--workers", type=positive_int, help="local worker processes (default: one)")
     p.add_argument("--json", type=Path, help="write the sensitivities and the choice here")
     _add_pairing_option(p)
     p.set_defaults(handler=_cmd_sensitivity)
+
+
+def _record_list(text: str):
+    """``--modes-from``: one record name, or several comma-separated (a list)."""
+    names = [n.strip() for n in text.split(",")]
+    if not all(names):
+        raise argparse.ArgumentTypeError(f"empty record name in {text!r}")
+    return names[0] if len(names) == 1 else names
 
 
 def _add_pairing_option(p) -> None:
@@ -118,11 +128,12 @@ def _cmd_modes(args: argparse.Namespace) -> int:
     for path in (args.json, args.plot):           # refuse a bad output path before the analysis
         if path is not None:
             check_parent(path)
-    survey = modes.survey_file(Path(args.measurements), args.record, channels=args.channel, fmin=args.fmin,
+    record = args.record[0] if args.record and len(args.record) == 1 else args.record
+    survey = modes.survey_file(Path(args.measurements), record, channels=args.channel, fmin=args.fmin,
                                fmax=args.fmax, resolution=args.resolution, fdd=args.fdd)
     print(modes.survey_table(survey, args.min_confidence))
     if args.json:
-        modes.write_survey_json(survey, args.json, file=str(args.measurements), record=args.record,
+        modes.write_survey_json(survey, args.json, file=str(args.measurements), record=record,
                                 min_confidence=args.min_confidence)
         print(f"modes -> {args.json}")
     if args.plot:
@@ -135,7 +146,9 @@ def _add_modes_parser(sub) -> None:
     p = sub.add_parser("modes", help="natural frequencies of a run-up or hammer record (orders and fixed lines "
                                      "set apart)")
     p.add_argument("measurements", metavar="MEAS", help="measurement HDF5 (or CSV + sidecar)")
-    p.add_argument("--record", help="record name (default: the first)")
+    p.add_argument("--record", action="append",
+                   help="record name (default: the first); repeatable: --record runup --record hammer_a surveys "
+                        "the records together, a mode seen in any of them being a mode of the structure")
     p.add_argument("--channel", action="append", help="vibration channel (repeatable; default: every one)")
     p.add_argument("--fmin", type=float, help="lowest frequency [Hz] (default: 4 bins)")
     p.add_argument("--fmax", type=float, help="highest frequency [Hz] (default: min(0.4 fs, 10 kHz))")

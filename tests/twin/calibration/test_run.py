@@ -1,6 +1,7 @@
 """twin calibrate end to end on a tiny budget: outputs, Table 2, bad blocks refused."""
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -140,3 +141,48 @@ def test_foundation_from_overrides_the_block(gearbox_fmu):
 
     assert _block(_scenario(gearbox_fmu), None, None, "impact")["foundation_modes"] == "impact"
     assert _block(_scenario(gearbox_fmu), None)["foundation_modes"] == [13.0]
+
+
+def test_modes_read_from_several_records_together(tmp_path):
+    """A mode seen in any of the records is a mode of the structure (two hammer tests struck where
+    each shows modes the other does not), each mode naming the records that saw it."""
+    from twin.calibration.run import measured_modes
+    from twin.measurements import MeasurementSet
+
+    a = _hammer("hammer_a", modes=((87.0, 0.02), (218.0, 0.015)))
+    b = _hammer("hammer_b", modes=((218.0, 0.015), (512.0, 0.02)))
+    steady = Record("steady", {"accel_pinion_casing": np.zeros(1000)}, {"accel_pinion_casing": "m/s2"}, 1e4)
+    mset = MeasurementSet((steady, a, b))
+    for d in ("one", "both"):
+        (tmp_path / d).mkdir()
+    one, _, _ = measured_modes({"modes_from": "hammer_a"}, mset, "s.yaml", tmp_path / "one")
+    both, _, what = measured_modes({"modes_from": ["hammer_a", "hammer_b"]}, mset, "s.yaml", tmp_path / "both")
+    assert one.size == 2 and both.size == 3
+    assert np.allclose(np.sort(both), [87.0, 218.0, 512.0], rtol=0.02)
+    assert "records 'hammer_a', 'hammer_b'" in what
+    saved = json.loads((tmp_path / "both" / "modes.json").read_text())
+    assert saved["record"] == ["hammer_a", "hammer_b"]
+    seen = {round(m["frequency_hz"] / 10): m["evidence"]["records"] for m in saved["modes"] if m["confidence"] >= 0.3}
+    assert seen[round(218.0 / 10)] == ["hammer_a", "hammer_b"] and seen[round(512.0 / 10)] == ["hammer_b"]
+    with pytest.raises(ScenarioError, match="no record 'hammer_c'"):
+        measured_modes({"modes_from": ["hammer_a", "hammer_c"]}, mset, "s.yaml", tmp_path / "bad")
+    assert not (tmp_path / "bad").exists()
+
+
+def test_modes_from_on_the_command_line_takes_several_records(capsys):
+    from twin.cli import main
+    from twin.commands.calibration import _record_list
+
+    assert _record_list("runup") == "runup"
+    assert _record_list("runup, hammer_a") == ["runup", "hammer_a"]
+    assert main(["calibrate", "s.yaml", "--modes-from", "runup,"]) == 2
+    assert "empty record name in 'runup,'" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("bad", [[], ["runup", "runup"], [3]])
+def test_a_bad_list_of_modes_records_is_refused_by_the_schema(gearbox_fmu, bad):
+    from twin.calibration.run import _block
+
+    assert _block(_scenario(gearbox_fmu, modes_from=["runup", "hammer_a"]), None)["modes_from"] == ["runup", "hammer_a"]
+    with pytest.raises(ScenarioError, match="calibration.modes_from"):
+        _block(_scenario(gearbox_fmu, modes_from=bad), None)
