@@ -208,10 +208,7 @@ def survey_records(mset, names, **kwargs) -> ModalSurvey:
                                f"no such record (the file has {', '.join(mset.names)})")
     if len(names) == 1:
         return survey_record(mset[names[0]], **kwargs)
-    surveys = []
-    for n in names:
-        s = survey_record(mset[n], **kwargs)
-        surveys.append(replace(s, modes=tuple(replace(m, evidence={**m.evidence, "records": [n]}) for m in s.modes)))
+    surveys = [survey_record(mset[n], **kwargs) for n in names]
     merged = merge_surveys(surveys)
     # which records saw each merged mode: every record with a mode within the merge's reach
     modes = []
