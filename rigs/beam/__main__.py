@@ -1,4 +1,4 @@
-"""Command line of the beam rig: python -m rigs.beam steady|runup|stages|modes ..."""
+"""Command line of the beam rig: python -m rigs.beam steady|runup|stages|impact|modes ..."""
 from __future__ import annotations
 
 import argparse
@@ -6,6 +6,7 @@ import json
 import sys
 
 from .effects import DEFAULTS, EffectError
+from .hammer import LOCATIONS, HammerError
 from .io import WriteError, write
 from .rig import Rig, RigError
 from .simulate import DamageError
@@ -52,6 +53,13 @@ def main(argv=None) -> int:
     sg.add_argument("--duration", type=float, default=1.0)
     sg.add_argument("--at-centre", action="store_true", help="damage at stage centres")
     sg.add_argument("--out", required=True)
+    im = sub.add_parser("impact", parents=[common], help="one hammer-test record (force channel hammer)")
+    im.add_argument("--speed", type=float, default=20.0, help="pinion speed [Hz] (0.5: slow roll)")
+    im.add_argument("--load", type=float, default=20.0, help="brake torque [N m]")
+    im.add_argument("--duration", type=float, default=4.0)
+    im.add_argument("--rate", type=float, default=4.0, help="mean blows per second")
+    im.add_argument("--location", choices=LOCATIONS, default="pinion_housing")
+    im.add_argument("--out", required=True, help="output .h5 (truth beside it as .h5.truth.json)")
     md = sub.add_parser("modes", parents=[common], help="modes of the linearised rig")
     md.add_argument("--load", type=float, default=20.0)
     md.add_argument("--fmax", type=float, default=5000.0)
@@ -72,13 +80,16 @@ def main(argv=None) -> int:
         elif args.cmd == "runup":
             recs = [rig.runup((args.v0, args.v1), args.load, args.duration, args.effect, _damage(args),
                               args.seed)]
+        elif args.cmd == "impact":
+            recs = [rig.impact(args.speed, args.load, args.duration, args.rate, args.location,
+                               args.seed)]
         else:
             fn = rig.pitting_stages if args.kind == "pitting" else rig.wear_stages
             recs = fn(args.per_stage, args.duration, args.seed, args.at_centre)
         path = write(args.out, recs)
         print(f"wrote {len(recs)} record(s) to {path} and {path}.truth.json")
         return 0
-    except (RigError, EffectError, DamageError, WriteError) as exc:
+    except (RigError, EffectError, DamageError, HammerError, WriteError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
 

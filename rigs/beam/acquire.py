@@ -1,5 +1,6 @@
 """Acquisition chain: accelerometer mount, IEPE coupling, anti-alias decimation, noise, gain
-error, 16-bit quantisation at an auto-selected range; encoder by edge time-stamping."""
+error, 16-bit quantisation at an auto-selected range; encoder by edge time-stamping; the
+impact hammer's load cell through the same converter."""
 from __future__ import annotations
 
 import numpy as np
@@ -24,20 +25,47 @@ def accelerometer(x, fs_in, fs_out, sensors, rng, gain, bracket=None):
         y = signal.lfilter(*_base_excited(bracket[0], bracket[1], fs_in), y)
     sos = signal.butter(2, sensors.highpass, btype="highpass", fs=fs_in, output="sos")
     y = signal.sosfilt(sos, y)
+    y = decimate(y, fs_in, fs_out)
+    y = y * gain + rng.normal(0.0, sensors.noise, y.size)
+    return quantise(y, sensors.ranges, sensors.bits)
+
+
+def quantise(y, ranges, bits):
+    """Quantisation at the smallest range that holds the record with 25 % headroom.
+    Returns (samples, range_used)."""
+    peak = np.max(np.abs(y)) * 1.25
+    rng_used = next((r for r in ranges if r >= peak), ranges[-1])
+    lsb = 2 * rng_used / 2**bits
+    yq = np.clip(np.round(y / lsb), -(2 ** (bits - 1)), 2 ** (bits - 1) - 1) * lsb
+    return yq, rng_used
+
+
+def decimate(y, fs_in, fs_out):
+    """The converter's delta-sigma style linear-phase decimation filter, flat to 0.45 fs_out,
+    delay removed; the same for every analogue channel."""
     factor = int(round(fs_in / fs_out))
     if factor > 1:
-        # delta-sigma style linear-phase decimation filter, flat to 0.45 fs_out
         n_taps, beta = signal.kaiserord(100.0, (0.55 - 0.45) * fs_out / (fs_in / 2))
         taps = signal.firwin(n_taps | 1, 0.5 * fs_out, window=("kaiser", beta), fs=fs_in)
         d = (taps.size - 1) // 2
-        y = signal.fftconvolve(np.concatenate([y, np.full(d, y[-1])]), taps, mode="full")[d:d + x.size]
+        y = signal.fftconvolve(np.concatenate([y, np.full(d, y[-1])]), taps, mode="full")[d:d + y.size]
         y = y[::factor]
-    y = y * gain + rng.normal(0.0, sensors.noise, y.size)
-    peak = np.max(np.abs(y)) * 1.25
-    rng_used = next((r for r in sensors.ranges if r >= peak), sensors.ranges[-1])
-    lsb = 2 * rng_used / 2**sensors.bits
-    yq = np.clip(np.round(y / lsb), -(2 ** (sensors.bits - 1)), 2 ** (sensors.bits - 1) - 1) * lsb
-    return yq, rng_used
+    return y
+
+
+def load_cell(force, fs_in, fs_out, hammer, rng):
+    """Hammer force [N] at fs_in -> the load cell's samples at fs_out.
+
+    Quartz load cell (its resonance far above the band, DC-coupled over a record: the
+    discharge time constant of a hammer is thousands of seconds), the same decimation filter
+    as the accelerometers, a sensitivity error drawn per record, noise, 16-bit quantisation
+    at the smallest range that holds the record. Returns (samples, gain, range_used [N]).
+    """
+    gain = 1.0 + float(rng.normal(0.0, hammer.gain_error))
+    y = decimate(force, fs_in, fs_out) * gain
+    y = y + rng.normal(0.0, hammer.noise, y.size)
+    yq, rng_used = quantise(y, hammer.ranges, hammer.bits)
+    return yq, gain, rng_used
 
 
 def encoder(angle, fs_in, fs_out, n_out, lines, line_error):

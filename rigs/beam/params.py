@@ -181,6 +181,20 @@ class Sensors:
 
 
 @dataclass(frozen=True)
+class Hammer:
+    """The instrumented impact hammer of a hammer test (a test instrument, not the gearbox):
+    a hard plastic tip on cast iron and steel, a quartz load cell on the IEPE input."""
+    contact_time: tuple = (0.15e-3, 0.30e-3)   # s, range of a blow's contact time
+    peak: tuple = (100.0, 300.0)                # N, range of a blow's peak force
+    interval_shape: float = 5.0       # gamma shape of the interval between blows (a hand's rhythm)
+    min_interval: float = 0.05        # s, no two blows closer (the hammer must come back up)
+    noise: float = 0.03               # N r.m.s. load-cell and conditioning noise over the band
+    gain_error: float = 0.015         # s.d. of the load cell's sensitivity error (per record)
+    ranges: tuple = (50.0, 100.0, 200.0, 500.0, 1000.0, 2000.0)  # +- N
+    bits: int = 16
+
+
+@dataclass(frozen=True)
 class Numerics:
     mode_cutoff: float = 16000.0      # Hz, modes kept in the time integration
     settle: float = 0.3               # s simulated and dropped before a record
@@ -202,6 +216,7 @@ class Params:
     broadband: Broadband = field(default_factory=Broadband)
     sensors: Sensors = field(default_factory=Sensors)
     numerics: Numerics = field(default_factory=Numerics)
+    hammer: Hammer = field(default_factory=Hammer)
 
 
 # Base parameters a gearbox-to-gearbox scatter acts on: (group, field).

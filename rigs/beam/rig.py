@@ -7,6 +7,7 @@ import numpy as np
 
 from . import acquire
 from .effects import resolve
+from .hammer import check_location, check_rate, draw_blows
 from .params import VERSION, Params, scatter_params
 from .simulate import Damage, modal_for, resolve_damage, simulate
 from .structure import NDOF_NODE
@@ -120,6 +121,42 @@ class Rig:
         return self._record("runup", tuple(speeds), duration, load, duration, effect, damage, seed,
                             lubricated, name, 0.0, 0.015, None)
 
+    def impact(self, speed: float = 20.0, load: float = 20.0, duration: float = 4.0,
+               impacts_per_second: float = 4.0, location: str = "pinion_housing", seed: int = 0,
+               name=None) -> RigRecord:
+        """An operational hammer test: blows at random instants while the rig runs (oiled,
+        healthy), recorded as one more channel ``hammer`` [N] (the hammer's load cell, same
+        acquisition rate and anti-alias filter as the accelerometers).
+
+        Each blow is a haversine pulse of 0.15-0.3 ms contact and 100-300 N peak (params.Hammer),
+        about ``impacts_per_second`` of them (gamma-distributed intervals). Struck from above,
+        i.e. along -z, the vertical of this rig (y joins the shaft centres):
+
+        - ``pinion_housing``: housing of bearing A, the pinion shaft's front-wall bearing on the
+          coupling side of the pinion; DOF vector ``bearing_housing[0, 1]`` (casing modes),
+        - ``gear_housing``: housing of bearing C, the gear shaft's bearing in the same wall;
+          ``bearing_housing[2, 1]``,
+        - ``pinion_shaft_end``: free (encoder) end node of the pinion shaft (its last node),
+          vertical DOF ``encoder - 4 + 1``,
+        - ``gear_shaft_end``: free (encoder) end node of the gear shaft (its first node),
+          vertical DOF ``gear_encoder - 4 + 1``.
+
+        The truth carries the location, its DOF and the blows (start of contact [s from the
+        first sample], contact times, peaks) with the load cell's gain and range. Slow roll
+        (0.5 Hz) keeps the running excitation weak against the blows.
+        """
+        location = check_location(location)
+        rate = check_rate(impacts_per_second)
+        _check_point(speed, load)
+        if not 0.05 <= duration <= 60.0:
+            raise RigError(f"duration {duration} s outside [0.05, 60]")
+        blows = draw_blows(location, rate, float(duration), self.params.hammer,
+                           np.random.default_rng([self.box_seed, int(seed), 31]))
+        if name is None:
+            name = f"impact_{speed:g}Hz_{load:g}Nm_{location}_seed{seed}"
+        return self._record("impact", (speed, speed), 0.0, load, duration, None, None, seed,
+                            True, name, 0.0, 0.015, None, hammer=(blows, rate))
+
     def pitting_stages(self, per_stage: int = 4, duration: float = 1.0, seed: int = 0,
                        at_centre: bool = False) -> list:
         """Records of the six pitting stages at 20 Hz / 20 N m (lubricated), scattered per record."""
@@ -147,7 +184,7 @@ class Rig:
         return out
 
     def _record(self, kind, speeds, ramp, load, duration, effect, damage, seed, lubricated, name,
-                speed_scatter, load_scatter, label):
+                speed_scatter, load_scatter, label, hammer=None):
         for sp in speeds:
             _check_point(sp, load)
         if not 0.05 <= duration <= 60.0:
@@ -166,7 +203,7 @@ class Rig:
         err_total = (1 + err) / speed_factor - 1
         sim = simulate(self, speed_from=speeds[0], speed_to=speeds[1], ramp=ramp, duration=duration,
                        load=load_true, lubricated=bool(lubricated), effect=eff, damage=dmg, rng=rng,
-                       sensor_err=err_total)
+                       sensor_err=err_total, hammer=None if hammer is None else hammer[0])
         out, fs_in = sim["out"], sim["fs"]
         s = p.sensors
         n_out = int(round(duration * s.sample_rate))
@@ -214,6 +251,16 @@ class Rig:
         attrs = {"record_kind": kind, "speed_from": float(speeds[0]), "speed_to": float(speeds[1]),
                  "rig": "beam"}
         units = {"accel_pinion_casing": "m/s2", "accel_gear_casing": "m/s2", "encoder": "rad"}
+        if hammer is not None:
+            blows, rate = hammer
+            f, gain, r = acquire.load_cell(sim["hammer"], fs_in, s.sample_rate, p.hammer,
+                                           np.random.default_rng([self.box_seed, int(seed), 32]))
+            chans["hammer"] = f[:n_out]
+            units["hammer"] = "N"
+            attrs["impact_location"] = blows.location
+            truth["hammer"] = {**blows.truth(sim["model"]), "impacts_per_second": rate,
+                               "sensor_gain": gain, "sensor_range": r,
+                               "sensor_noise_rms": p.hammer.noise}
         return RigRecord(name, chans, units, s.sample_rate, float(speeds[1]), float(load), "encoder",
                          attrs, truth)
 

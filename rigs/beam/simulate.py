@@ -102,8 +102,12 @@ def _outer_race_impacts(rng, t, angle, bearing_geo, static_load, eff, fs):
 
 
 def simulate(rig, *, speed_from, speed_to, ramp, duration, load, lubricated, effect: Effect | None,
-             damage: Damage, rng: np.random.Generator, sensor_err: float):
-    """Integrate one record; returns dict of internal-rate signals and facts for the truth."""
+             damage: Damage, rng: np.random.Generator, sensor_err: float, hammer=None):
+    """Integrate one record; returns dict of internal-rate signals and facts for the truth.
+
+    hammer: the blows of a hammer test (hammer.Blows) or None; with blows, the hammer force
+    is one more external force series and "hammer" the force at the output instants [N].
+    """
     p = rig.params
     fs = p.sensors.internal_rate
     h = 1.0 / fs
@@ -169,6 +173,10 @@ def simulate(rig, *, speed_from, speed_to, ramp, duration, load, lubricated, eff
         d = model.bearing_loads[hb] / loads[hb]
         series[:, 2 * hb] += imp * d[0]
         series[:, 2 * hb + 1] += imp * d[1]
+    if hammer is not None:
+        # output o is the state at (o + 1) h of the run: record time o h is t_all - h
+        series = np.ascontiguousarray(np.column_stack([series, hammer.force(t_all - h)]))
+        G_ser = np.ascontiguousarray(np.column_stack([G_ser, Phi.T @ hammer.vector(model)]))
     fl = _band_noise(rng, n_tot, fs, p.brake.fluctuation_band, p.brake.fluctuation, 1)[:, 0]
     # loop parameters
     par = np.zeros(len(integrate.NAMES))
@@ -216,5 +224,8 @@ def simulate(rig, *, speed_from, speed_to, ramp, duration, load, lubricated, eff
     out = integrate.run(n_steps, n_settle, par, Ph, G0, G1, 2 * mm.zeta * w, w**2, gvec, B, G_ser,
                         series, fl, rows, tab.gap_p, tab.gap_g, tab.comp_p, tab.width_p,
                         tab.hertz_a, tab.du, q0, v0, -n_settle * h)
-    return {"out": out, "fs": fs, "modal": mm, "model": model, "mesh_stiffness": kbar,
-            "tables": tab}
+    res = {"out": out, "fs": fs, "modal": mm, "model": model, "mesh_stiffness": kbar,
+           "tables": tab}
+    if hammer is not None:
+        res["hammer"] = series[n_settle + 1:n_settle + 1 + n_steps, -1].copy()
+    return res

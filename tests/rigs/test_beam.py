@@ -212,3 +212,116 @@ def test_scattered_gearboxes_differ(rig):
     fb = [m.frequency for m in b.modes()][:6]
     assert a.params != b.params and not np.allclose(fa, fb)
     assert rig.scattered(1).params == a.params
+
+
+# ---- the impact (hammer) test record
+
+@pytest.fixture(scope="module")
+def impact(rig):
+    """Slow roll (0.5 Hz) at 20 N m, hammer on the pinion-side bearing housing."""
+    return rig.impact(0.5, 20.0, 2.0, impacts_per_second=4.0, location="pinion_housing", seed=1)
+
+
+def _h1(r, ch, nperseg=8192):
+    f, Pxy = signal.csd(r.channels["hammer"], r.channels[ch], FS, nperseg=nperseg)
+    _, Pxx = signal.welch(r.channels["hammer"], FS, nperseg=nperseg)
+    _, Pyy = signal.welch(r.channels[ch], FS, nperseg=nperseg)
+    return f, Pxy / Pxx, np.abs(Pxy) ** 2 / (Pxx * Pyy)
+
+
+def test_impact_force_channel_is_written_and_loads(impact, tmp_path):
+    from twin.measurements import load_measurements
+    assert set(impact.channels) == {"accel_pinion_casing", "accel_gear_casing", "encoder", "hammer"}
+    assert impact.units["hammer"] == "N" and impact.attributes["record_kind"] == "impact"
+    assert len({x.size for x in impact.channels.values()}) == 1
+    path = write(tmp_path / "impact.h5", [impact])
+    rec = load_measurements(path)[0]
+    assert "hammer" in rec.channel_names and rec.units["hammer"] == "N"
+    assert np.array_equal(rec["hammer"], impact.channels["hammer"])
+    t = json.loads((tmp_path / "impact.h5.truth.json").read_text())["records"][rec.name]["hammer"]
+    assert t["location"] == "pinion_housing" and t["hits"] == len(t["hit_times"])
+    hits = np.array(t["hit_times"])
+    assert np.all(np.diff(hits) > 0) and 0 <= hits[0] and hits[-1] < 2.0
+    # each blow is in the channel at its time with its peak (load-cell gain, 50 kHz sampling)
+    x = rec["hammer"]
+    for t0, w, peak in zip(hits, t["contact_times"], t["peak_forces"]):
+        i0, i1 = int(t0 * FS), int(np.ceil((t0 + w) * FS)) + 1
+        assert x[i0:i1].max() == pytest.approx(peak * t["sensor_gain"], rel=0.1)
+    assert np.abs(np.delete(x, np.concatenate([np.arange(int(a * FS) - 20, int(a * FS) + 40)
+                                               for a in hits]))).max() < 1.0
+
+
+def test_impact_hit_count_near_rate_times_duration(impact):
+    from rigs.beam.hammer import draw_blows
+    from rigs.beam.params import Hammer
+    hits = impact.truth["hammer"]["hits"]
+    assert abs(hits - 8) <= 3
+    peaks, _ = signal.find_peaks(impact.channels["hammer"], height=50.0, distance=int(0.02 * FS))
+    assert peaks.size == hits
+    for rate in (1.0, 4.0, 10.0):
+        n = [draw_blows("gear_housing", rate, 60.0, Hammer(), np.random.default_rng(s)).starts.size
+             for s in range(5)]
+        assert np.mean(n) == pytest.approx(60.0 * rate, rel=0.08), (rate, n)
+
+
+def test_impact_refuses_bad_requests_by_name(rig):
+    with pytest.raises(ValueError, match="nowhere"):
+        rig.impact(location="nowhere")
+    for bad in (0.0, -2.0, float("nan")):
+        with pytest.raises(ValueError, match=f"impacts_per_second {bad}"):
+            rig.impact(0.5, 20.0, 1.0, impacts_per_second=bad)
+        with pytest.raises(ValueError, match=f"speed {bad}"):
+            rig.impact(bad, 20.0, 1.0)
+
+
+def test_impact_leaves_the_other_records_unchanged(rig):
+    """The steady record of a seed is the one computed before the hammer test was added."""
+    r = rig.steady(20.0, 20.0, 0.2, seed=4)
+    assert set(r.channels) == {"accel_pinion_casing", "accel_gear_casing", "encoder"}
+    rms = {k: float(np.sqrt(np.mean(v ** 2))) for k, v in r.channels.items()}
+    assert rms["accel_pinion_casing"] == pytest.approx(9.916372364709064, rel=1e-6)
+    assert rms["accel_gear_casing"] == pytest.approx(3.0570079308314297, rel=1e-6)
+    assert rms["encoder"] == pytest.approx(14.724357219023611, rel=1e-9)
+    assert r.channels["encoder"][-1] == pytest.approx(25.42309125772332, rel=1e-9)
+
+
+def test_impact_frf_peaks_at_an_observable_mode(rig, impact):
+    """At slow roll the hammer-to-casing FRF (H1) peaks at one of the rig's own modes that the
+    sensors see, with good coherence."""
+    f, H, coh = _h1(impact, "accel_pinion_casing")
+    band = (f > 100.0) & (f < 5000.0)
+    i = np.flatnonzero(band)[np.argmax(np.abs(H[band]))]
+    modes = rig.modes(0.5, impact.truth["load"]["true"])
+    near = [m for m in modes if abs(f[i] / m.frequency - 1) < 0.03 and m.observability >= 0.1]
+    assert near, (f[i], [(m.frequency, m.observability) for m in modes])
+    assert coh[i] > 0.5
+
+
+def test_impact_frf_matches_the_modal_model(rig, impact):
+    """Sign, size and timing of the blow: the measured H1 agrees with the accelerance of the
+    linearised rig from the struck DOF to the sensor (times the gain ratio)."""
+    from rigs.beam.hammer import Blows
+    from rigs.beam.simulate import modal_for
+    ch = "accel_pinion_casing"
+    f, H, coh = _h1(impact, ch)
+    model, mm, _ = modal_for(rig.params, impact.truth["load"]["true"], True)
+    v = Blows("pinion_housing", np.zeros(0), np.zeros(0), np.zeros(0)).vector(model)
+    band = (f > 300.0) & (f < 4000.0)
+    w, wr = 2 * np.pi * f[band, None], 2 * np.pi * mm.freq[None, 1:]
+    num = (model.sensors[0] @ mm.shapes[:, 1:]) * (v @ mm.shapes[:, 1:])
+    Hm = (-w ** 2 * num / (wr ** 2 - w ** 2 + 2j * mm.zeta[1:] * wr * w)).sum(axis=1)
+    Hm *= impact.truth["sensor_gain"][ch] / impact.truth["hammer"]["sensor_gain"]
+    ratio = H[band] / Hm
+    assert 0.85 < np.median(np.abs(ratio)) < 1.2
+    assert abs(np.degrees(np.median(np.angle(ratio)))) < 10.0
+
+
+def test_impact_command_line(tmp_path):
+    from rigs.beam.__main__ import main
+    from twin.measurements import load_measurements
+    out = tmp_path / "impact.h5"
+    assert main(["impact", "--seed", "2", "--speed", "0.5", "--duration", "0.3",
+                 "--location", "gear_shaft_end", "--out", str(out)]) == 0
+    rec = load_measurements(out)[0]
+    assert rec.units["hammer"] == "N" and rec.metadata["impact_location"] == "gear_shaft_end"
+    assert main(["impact", "--rate", "0", "--out", str(tmp_path / "x.h5")]) == 2
