@@ -47,11 +47,16 @@ def _scenario(path):
 
 def test_healthy_roles_pick_the_run_up_and_the_steady_record():
     recs = [_record("steady", 20.0, 20.0, 1.0, 1), _record("up", 2.0, 20.0, 2.0, 0)]
-    assert healthy_roles(recs) == ("up", "steady")
+    assert healthy_roles(recs) == (("up",), "steady")
+    # a hammer test (a force channel) joins the run-up for the modes, after it
+    hammer = Record("hammer", {CH: np.zeros(100), "hammer": np.zeros(100)}, {CH: "m/s2", "hammer": "N"}, FS)
+    assert healthy_roles([hammer, *recs]) == (("up", "hammer"), "steady")
     with pytest.raises(ScenarioError, match="run-up"):
         healthy_roles([_record("a", 20.0, 20.0, 1.0, 1), _record("b", 19.0, 20.0, 1.0, 2)])
     with pytest.raises(ScenarioError, match="steady record"):
         healthy_roles([_record("up", 2.0, 20.0, 2.0, 0)])
+    with pytest.raises(ScenarioError, match="'up', 'hammer' was given; add a steady record"):
+        healthy_roles([_record("up", 2.0, 20.0, 2.0, 0), hammer])
 
 
 def test_bad_names_and_settings_are_refused_before_anything_is_written(tmp_path):

@@ -138,10 +138,10 @@ def _key(*parts) -> str:
     return h.hexdigest()[:16]
 
 
-def healthy_roles(records) -> tuple[str, str]:
-    """(modes record, steady record) among the healthy records: the modes come from the record whose
-    shaft speed varies most (a run-up) or that has a force channel (a hammer test), the spectrum from
-    the one whose speed varies least.
+def healthy_roles(records) -> tuple[tuple[str, ...], str]:
+    """(modes records, steady record) among the healthy records: the modes come from every run-up
+    (shaft speed varying by a factor 1.5 or more) and every hammer test (a force channel), read
+    together (the run-up first), the spectrum from the record whose speed varies least.
 
     Raises
     ------
@@ -166,16 +166,17 @@ def healthy_roles(records) -> tuple[str, str]:
         means = np.array([p.mean() for p in parts if p.size])
         lo, hi = float(means.min()), float(means.max())
         spread[r.name] = hi / lo if lo > 0 else np.inf
-    modes = max(spread, key=spread.get)
-    if spread[modes] < 1.5:
+    # run-ups before hammer tests (a stable sort keeps the given order within each)
+    names = tuple(sorted((n for n in spread if spread[n] >= 1.5), key=lambda n: spread[n] == np.inf))
+    if not names:
         raise ScenarioError([("--healthy", "records", "no healthy record is a run-up (shaft speed varying by a "
                               f"factor 1.5 or more) or a hammer test: {', '.join(spread)}; the modes are read "
                               "from one")])
-    steady = min((n for n in spread if n != modes), key=spread.get, default=None)
+    steady = min((n for n in spread if n not in names), key=spread.get, default=None)
     if steady is None:
-        raise ScenarioError([("--healthy", "records", f"only the run-up '{modes}' was given; add a steady record of "
-                              "the healthy rig for the spectrum")])
-    return modes, steady
+        raise ScenarioError([("--healthy", "records", f"only the run-up or hammer test {', '.join(map(repr, names))} "
+                              "was given; add a steady record of the healthy rig for the spectrum")])
+    return names, steady
 
 
 def run_pipeline(plan: PipelinePlan, *, progress: bool = True, log=print) -> dict:
@@ -220,9 +221,10 @@ def run_pipeline(plan: PipelinePlan, *, progress: bool = True, log=print) -> dic
             log(f"[1/6] calibrate: kept {cal_file}")
         else:
             from twin.calibration.run import run_calibration
-            log(f"[1/6] calibrate: modes from '{modes_rec}', spectrum from '{steady_rec}'")
+            log(f"[1/6] calibrate: modes from {', '.join(map(repr, modes_rec))}, spectrum from '{steady_rec}'")
             t = time.perf_counter()
-            block = {**(scenario.raw.get("calibration") or CALIBRATION), "modes_from": modes_rec,
+            block = {**(scenario.raw.get("calibration") or CALIBRATION),
+                     "modes_from": modes_rec[0] if len(modes_rec) == 1 else list(modes_rec),
                      "record": steady_rec}
             model = MEASURED.get(scenario.fmu, scenario.fmu)
             cal_sc = scenario.with_overrides(fmu=model, raw={**scenario.raw, "fmu": model, "calibration": block},
@@ -230,7 +232,7 @@ def run_pipeline(plan: PipelinePlan, *, progress: bool = True, log=print) -> dic
             report = run_calibration(cal_sc, meas, cal_dir, progress=progress)
             for w in report.warnings:
                 log(f"warning: {w}")
-            man.record("calibrate", key, time.perf_counter() - t, modes=modes_rec, steady=steady_rec,
+            man.record("calibrate", key, time.perf_counter() - t, modes=list(modes_rec), steady=steady_rec,
                        table=report.table(), warnings=list(report.warnings))
         timings["calibrate"] = man.stages["calibrate"]["seconds"]
         twin_sc, twin_file, key_up = load_scenario(cal_file), cal_file, man.stages["calibrate"]["key"]
