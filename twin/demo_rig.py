@@ -5,6 +5,7 @@ The records come from files (``make demo`` writes them with ``python -m rigs.ped
 and ``steady``; ``twin`` never imports ``rigs``). The step does what a user does with a rig:
 
     twin modes rig.h5 --record runup --plot modes.png
+    twin modes rig.h5 --record runup --record hammer        # with a hammer test: the two together
     twin calibrate scenario.yaml --measurements rig.h5 --modes-from runup --out calibration_rig/
     twin compare calibration_rig/calibrated.yaml --measurements rig.h5 --record steady
 """
@@ -15,17 +16,22 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
 
-def merge_records(steady_file: Path, runup_file: Path, out: Path) -> Path:
-    """One measurement file holding the first record of each file, named ``steady`` and ``runup``."""
+
+def merge_records(steady_file: Path, runup_file: Path, out: Path, hammer_file: Path | None = None) -> Path:
+    """One measurement file holding the first record of each file, named ``steady``, ``runup`` and
+    (when given) ``hammer``."""
     from twin.measurements import load_measurements, write_measurements
 
-    steady = replace(load_measurements(steady_file)[0], name="steady")
-    runup = replace(load_measurements(runup_file)[0], name="runup")
-    return write_measurements([steady, runup], out)
+    records = [replace(load_measurements(steady_file)[0], name="steady"),
+               replace(load_measurements(runup_file)[0], name="runup")]
+    if hammer_file is not None:
+        records.append(replace(load_measurements(hammer_file)[0], name="hammer"))
+    return write_measurements(records, out)
 
 
-def rig_calibration_demo(out_dir: Path, steady_file: Path, runup_file: Path) -> dict:
+def rig_calibration_demo(out_dir: Path, steady_file: Path, runup_file: Path, hammer_file: Path | None = None) -> dict:
     """Step 6 (see the module docstring); returns the paths and headline numbers."""
     from twin.calibration.run import run_calibration
     from twin.compare import compare
@@ -38,7 +44,8 @@ def rig_calibration_demo(out_dir: Path, steady_file: Path, runup_file: Path) -> 
     t = time.perf_counter()
     d = out_dir / "rig"
     d.mkdir(exist_ok=True)
-    h5 = merge_records(Path(steady_file), Path(runup_file), d / "pedestal.h5")
+    h5 = merge_records(Path(steady_file), Path(runup_file), d / "pedestal.h5",
+                       Path(hammer_file) if hammer_file is not None else None)
     mset = load_measurements(h5)
     survey = survey_record(mset["runup"])
     png = plot_modal_survey(survey, d / "modes.png", title="Run-up of the pedestal rig: modes (red), fixed lines "
@@ -48,6 +55,15 @@ def rig_calibration_demo(out_dir: Path, steady_file: Path, runup_file: Path) -> 
     table = survey_table(survey)
     _lines(table.split("\nspeed-locked")[0])
     _lines(f"{len(survey.orders)} speed-locked orders set aside")
+    if "hammer" in mset.names:
+        from twin.modes import MIN_CONFIDENCE, survey_records
+        both = survey_records(mset, ["runup", "hammer"])
+        alone, together = survey.frequencies(MIN_CONFIDENCE), both.frequencies(MIN_CONFIDENCE)
+        added = [f for f in together if not alone.size or np.min(np.abs(alone - f)) > 0.01 * f]
+        _lines(f"twin modes --record runup --record hammer (blows at the pinion pedestal, the gears rolling at "
+               f"{mset['hammer'].nominal_speed or 0:g} Hz): {together.size} modes, "
+               f"{len(added)} the run-up alone did not show ({', '.join(f'{f:.0f}' for f in added) or 'none'} Hz); "
+               f"{both.notes[-1] if both.notes else ''}")
     scenario_file = d / "scenario.yaml"
     scenario_file.write_text(json.dumps({
         "version": 1, "name": "pedestal-rig", "fmu": "GearTwin.Gearbox21Measured", "stop_time": 2.0,
