@@ -264,6 +264,8 @@ def survey_table(survey: ModalSurvey, min_confidence: float = MIN_CONFIDENCE) ->
             bits.append(f"line on top at {ev['line_on_top_hz']} Hz")
         if ev.get("shape"):
             bits.append(shape_text(ev["shape"]))
+        if ev.get("records"):
+            bits.append(f"seen in {', '.join(ev['records'])}")
         damping = f"{m.damping:7.4f}" if np.isfinite(m.damping) else "    n/a"
         rows.append(f"{mark}{m.frequency:10.2f}  {damping}  {m.confidence:10.2f}  {'; '.join(b for b in bits if b)}")
     if not survey.modes:

@@ -112,6 +112,7 @@ def test_cli_surveys_several_records_together(runup, tmp_path, capsys):
     assert not np.any(only_low > fn[3] * 1.02) and np.any(np.abs(both - fn[4]) < 0.02 * fn[4])
     by_f = {m["frequency_hz"]: m["evidence"]["records"] for m in data["modes"]}
     assert any(r == ["full"] for f, r in by_f.items() if f > cut) and any(r == ["low", "full"] for r in by_f.values())
+    assert "seen in full" in capsys.readouterr().out
     assert main(["modes", str(h5), "--record", "full", "--record", "steady"]) == 2
     assert "record 'steady': no such record" in capsys.readouterr().err
 
