@@ -59,6 +59,8 @@ CHANNEL = "accel_pinion_casing"
 #: Where each rig is struck in the hammer tests (``Rig.impact(location=...)``): the pinion's and the
 #: gear's bearing support, vertical; at slow roll, where the running excitation is weak.
 HAMMER = {"pedestal": ("pinion_pedestal", "gear_pedestal"), "beam": ("pinion_housing", "gear_housing")}
+#: ``--hammer-at shaft-ends``: the blows on each shaft's free end instead (rigs/beam only)
+HAMMER_SHAFT_ENDS = {"beam": ("pinion_shaft_end", "gear_shaft_end")}
 HAMMER_SPEED, HAMMER_DURATION, HAMMER_RATE = 0.5, 8.0, 4.0
 
 
@@ -188,7 +190,8 @@ def _nearest(values, f):
 
 
 def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str, pairing: str = "frequency",
-                visibility: str = "mesh", fit: str = "follow", hammer: bool = False) -> dict:
+                visibility: str = "mesh", fit: str = "follow", hammer: bool = False,
+                hammer_at: str = "supports") -> dict:
     from spectral_distance import spectral_distance_report
 
     from fmu_build import build_fmu
@@ -202,13 +205,14 @@ def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str, p
     rigmod = importlib.import_module(f"rigs.{rig_name}")
     box = rigmod.Rig().scattered(seed=seed, scatter=0.12)
     t = time.perf_counter()
-    h5 = out / f"{rig_name}_{seed}{'_hammer' * hammer}.h5"
-    modes_from = ("runup",) + tuple(f"hammer_{loc}" for loc in HAMMER[rig_name] if hammer)
+    struck_at = (HAMMER_SHAFT_ENDS if hammer_at == "shaft-ends" else HAMMER)[rig_name]
+    h5 = out / f"{rig_name}_{seed}{'_hammer' * hammer}{'_ends' * (hammer and hammer_at == 'shaft-ends')}.h5"
+    modes_from = ("runup",) + tuple(f"hammer_{loc}" for loc in struck_at if hammer)
     if not h5.exists():          # the records depend on the rig version and the seeds only
         steady = box.steady(speed=SPEED, load=LOAD, duration=2.0, seed=seed, name="steady")
         runup = box.runup(speeds=(2.0, SPEED), load=LOAD, duration=6.0, seed=seed, name="runup")
         struck = [box.impact(speed=HAMMER_SPEED, load=LOAD, duration=HAMMER_DURATION, impacts_per_second=HAMMER_RATE,
-                             location=loc, seed=seed, name=f"hammer_{loc}") for loc in HAMMER[rig_name] if hammer]
+                             location=loc, seed=seed, name=f"hammer_{loc}") for loc in struck_at if hammer]
         rigmod.write(h5, [steady, runup, *struck])
     rig_wall = time.perf_counter() - t
     truth = box.modes(speed=SPEED, load=LOAD)
@@ -286,11 +290,16 @@ def main() -> None:
                          "a search pairing afresh at every candidate set")
     ap.add_argument("--hammer", action="store_true",
                     help="also a slow-roll hammer test per struck point (HAMMER), read with the run-up for the modes")
+    ap.add_argument("--hammer-at", choices=("supports", "shaft-ends"), default="supports",
+                    help="where --hammer strikes: the bearing supports (HAMMER) or, on rigs/beam only, each shaft's "
+                         "free end (HAMMER_SHAFT_ENDS)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--out", type=Path, default=REPO / "bench_out" / "calibration_rigs")
     ap.add_argument("--explain", action="store_true",
                     help="only the per-mode analysis of the results already in --out (no new scoring)")
     args = ap.parse_args()
+    if args.hammer_at == "shaft-ends" and set(args.rigs) - set(HAMMER_SHAFT_ENDS):
+        ap.error(f"--hammer-at shaft-ends: only {', '.join(HAMMER_SHAFT_ENDS)} has shaft-end hammer locations")
     args.out.mkdir(parents=True, exist_ok=True)
     if args.explain:
         done = json.loads((args.out / "results.json").read_text())
@@ -307,7 +316,7 @@ def main() -> None:
         for seed in args.seeds:
             t = time.perf_counter()
             r = one_gearbox(rig, seed, args.out, args.workers, args.model, args.pairing, args.visibility,
-                            args.fit, args.hammer)
+                            args.fit, args.hammer, args.hammer_at)
             r["fit"] = args.fit
             r["load_after"] = os.getloadavg()
             r["first6_explained"] = explain_modes(rig, seed, r, args.out, args.visibility)
