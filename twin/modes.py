@@ -162,6 +162,12 @@ def with_shapes(survey: ModalSurvey, xs, names, fs: float) -> ModalSurvey:
                                        for m, s in zip(survey.modes, shapes)))
 
 
+def _same_mode(f_seen: float, f: float, resolution: float) -> bool:
+    """Whether a mode at ``f_seen`` [Hz] is the one at ``f`` [Hz] read by a survey of ``resolution``
+    [Hz]: within 1 % or two bins."""
+    return abs(f_seen - f) <= max(0.01 * f, 2 * resolution)
+
+
 def merge_surveys(surveys) -> ModalSurvey:
     """One survey from several sensors' surveys of the same record (modes within 1 % merged)."""
     if len(surveys) == 1:
@@ -170,8 +176,7 @@ def merge_surveys(surveys) -> ModalSurvey:
     for s in surveys:
         for m in s.modes:
             m = replace(m, evidence={**m.evidence, "channels": list(s.channels)})
-            same = [i for i, o in enumerate(modes)
-                    if abs(o.frequency - m.frequency) <= max(0.01 * m.frequency, 2 * s.resolution)]
+            same = [i for i, o in enumerate(modes) if _same_mode(o.frequency, m.frequency, s.resolution)]
             if not same:
                 modes.append(m)
                 continue
@@ -213,8 +218,8 @@ def survey_records(mset, names, **kwargs) -> ModalSurvey:
     # which records saw each merged mode: every record with a mode within the merge's reach
     modes = []
     for m in merged.modes:
-        seen = [n for n, s in zip(names, surveys)
-                if any(abs(o.frequency - m.frequency) <= max(0.01 * m.frequency, 2 * s.resolution) for o in s.modes)]
+        seen = [n for n, s in zip(names, surveys) if any(_same_mode(o.frequency, m.frequency, s.resolution)
+                                                          for o in s.modes)]
         modes.append(replace(m, evidence={**m.evidence, "records": seen}))
     method = "+".join(dict.fromkeys(s.method for s in surveys))
     return replace(merged, modes=tuple(modes), method=method, channels=tuple(dict.fromkeys(merged.channels)))
