@@ -56,8 +56,10 @@ def rig_calibration_demo(out_dir: Path, steady_file: Path, runup_file: Path, ham
     _lines(table.split("\nspeed-locked")[0])
     _lines(f"{len(survey.orders)} speed-locked orders set aside")
     if "hammer" in mset.names:
-        from twin.modes import MIN_CONFIDENCE, survey_records
-        both = survey_records(mset, ["runup", "hammer"])
+        # what `twin modes --record runup --record hammer` shows: the run-up's survey (above)
+        # merged with the hammer test's, the run-up not surveyed again
+        from twin.modes import MIN_CONFIDENCE, merge_surveys
+        both = merge_surveys([survey, survey_record(mset["hammer"])])
         alone, together = survey.frequencies(MIN_CONFIDENCE), both.frequencies(MIN_CONFIDENCE)
         added = [f for f in together if not alone.size or np.min(np.abs(alone - f)) > 0.01 * f]
         _lines(f"twin modes --record runup --record hammer (blows at the pinion pedestal, the gears rolling at "
