@@ -6,7 +6,7 @@ import json
 import sys
 
 from .effects import DEFAULTS, EffectError
-from .hammer import LOCATIONS, HammerError
+from .hammer import DIRECTIONS, LOCATIONS, HammerError
 from .io import WriteError, write
 from .rig import Rig, RigError
 from .simulate import DamageError
@@ -59,6 +59,8 @@ def main(argv=None) -> int:
     im.add_argument("--duration", type=float, default=4.0)
     im.add_argument("--rate", type=float, default=4.0, help="mean blows per second")
     im.add_argument("--location", choices=LOCATIONS, default="pinion_housing")
+    im.add_argument("--direction", choices=tuple(DIRECTIONS), default="vertical",
+                    help="struck from above (-z) or from the side (-y)")
     im.add_argument("--out", required=True, help="output .h5 (truth beside it as .h5.truth.json)")
     md = sub.add_parser("modes", parents=[common], help="modes of the linearised rig")
     md.add_argument("--load", type=float, default=20.0)
@@ -82,7 +84,7 @@ def main(argv=None) -> int:
                               args.seed)]
         elif args.cmd == "impact":
             recs = [rig.impact(args.speed, args.load, args.duration, args.rate, args.location,
-                               args.seed)]
+                               args.seed, direction=args.direction)]
         else:
             fn = rig.pitting_stages if args.kind == "pitting" else rig.wear_stages
             recs = fn(args.per_stage, args.duration, args.seed, args.at_centre)

@@ -1,9 +1,12 @@
 """The impact hammer of an operational hammer test: blows at random instants, each a
-haversine force pulse, on a bearing housing or a free shaft end, struck from above.
+haversine force pulse, on a bearing housing or a free shaft end, struck from above or from
+the side.
 
 Vertical is z in this rig (the (y, z) pairs of the structure: y joins the shaft centres,
-z is up; the shaft weights act in -z). A blow pushes its point down: the generalised force is
--F(t) times the point's vertical DOF vector. Locations:
+z is up; the shaft weights act in -z). A vertical blow pushes its point down: the generalised
+force is -F(t) times the point's vertical DOF vector; a horizontal blow pushes it along -y
+(struck from the +y side, across the shafts' plane): -F(t) times its y DOF vector. Locations
+(vertical DOFs shown; the horizontal ones are the y entries of the same pairs):
 
 | location | point | DOF vector (structure.LinearModel) |
 |---|---|---|
@@ -21,7 +24,10 @@ from dataclasses import dataclass
 import numpy as np
 
 LOCATIONS = ("pinion_housing", "gear_housing", "pinion_shaft_end", "gear_shaft_end")
-VERTICAL = 1            # index of z in the (y, z) pairs
+#: Directions of a blow, by the index of its axis in the (y, z) pairs: from above (-z) or from
+#: the side (-y).
+DIRECTIONS = {"vertical": 1, "horizontal": 0}
+VERTICAL = DIRECTIONS["vertical"]
 _HOUSING = {"pinion_housing": 0, "gear_housing": 2}
 
 
@@ -33,6 +39,12 @@ def check_location(location) -> str:
     if location not in LOCATIONS:
         raise HammerError(f"unknown impact location {location!r}; known: {', '.join(LOCATIONS)}")
     return location
+
+
+def check_direction(direction) -> str:
+    if direction not in DIRECTIONS:
+        raise HammerError(f"unknown impact direction {direction!r}; known: {', '.join(DIRECTIONS)}")
+    return direction
 
 
 def check_rate(rate) -> float:
@@ -52,6 +64,7 @@ class Blows:
     starts: np.ndarray
     widths: np.ndarray
     peaks: np.ndarray
+    direction: str = "vertical"
 
     def force(self, t: np.ndarray) -> np.ndarray:
         """Hammer force [N, > 0 pressing] at times t (ascending): F sin^2(pi (t - t0) / T)."""
@@ -62,34 +75,40 @@ class Blows:
         return out
 
     def vector(self, model) -> np.ndarray:
-        """Generalised force per newton of hammer force (downward at the struck point)."""
+        """Generalised force per newton of hammer force (along -z or -y at the struck point)."""
         n = model.M.shape[0]
+        axis = DIRECTIONS[self.direction]
         if self.location in _HOUSING:
-            v = model.bearing_housing[_HOUSING[self.location], VERTICAL].copy()
+            v = model.bearing_housing[_HOUSING[self.location], axis].copy()
         else:
             v = np.zeros(n)
             node = (model.encoder if self.location == "pinion_shaft_end" else model.gear_encoder) - 4
-            v[node + VERTICAL] = 1.0
+            v[node + axis] = 1.0
         return -v
 
     def truth(self, model) -> dict:
+        axis = DIRECTIONS[self.direction]
+        name = "vertical z" if self.direction == "vertical" else "horizontal y"
         if self.location in _HOUSING:
-            dof = f"bearing_housing[{_HOUSING[self.location]}, 1] (housing vertical z, casing modes)"
+            dof = f"bearing_housing[{_HOUSING[self.location]}, {axis}] (housing {name}, casing modes)"
         else:
             node = (model.encoder if self.location == "pinion_shaft_end" else model.gear_encoder) - 4
-            dof = f"shaft DOF {node + VERTICAL} (free-end node, vertical z)"
-        return {"location": self.location, "dof": dof, "direction": "-z (struck from above)",
+            dof = f"shaft DOF {node + axis} (free-end node, {name})"
+        side = "-z (struck from above)" if self.direction == "vertical" else "-y (struck from the side)"
+        return {"location": self.location, "dof": dof, "direction": side,
                 "hit_times": [float(x) for x in self.starts],
                 "hit_times_are": "start of contact [s from the first sample]",
                 "contact_times": [float(x) for x in self.widths],
                 "peak_forces": [float(x) for x in self.peaks], "hits": int(self.starts.size)}
 
 
-def draw_blows(location: str, rate: float, duration: float, hammer, rng) -> Blows:
+def draw_blows(location: str, rate: float, duration: float, hammer, rng,
+               direction: str = "vertical") -> Blows:
     """Blows at a mean rate [1/s] within [0, duration): gamma-distributed intervals (a hand's
     rhythm) no shorter than hammer.min_interval, contact time and peak uniform in their ranges;
     the first blow within the first mean interval, none cut by the record's end."""
     location = check_location(location)
+    direction = check_direction(direction)
     mean = 1.0 / check_rate(rate)
     k = hammer.interval_shape
     starts, widths, peaks = [], [], []
@@ -103,4 +122,4 @@ def draw_blows(location: str, rate: float, duration: float, hammer, rng) -> Blow
         widths.append(w)
         peaks.append(f)
         t += max(float(rng.gamma(k, mean / k)), hammer.min_interval)
-    return Blows(location, np.array(starts), np.array(widths), np.array(peaks))
+    return Blows(location, np.array(starts), np.array(widths), np.array(peaks), direction)

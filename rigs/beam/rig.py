@@ -7,7 +7,7 @@ import numpy as np
 
 from . import acquire
 from .effects import resolve
-from .hammer import check_location, check_rate, draw_blows
+from .hammer import check_direction, check_location, check_rate, draw_blows
 from .params import VERSION, Params, scatter_params
 from .simulate import Damage, modal_for, resolve_damage, simulate
 from .structure import NDOF_NODE
@@ -123,7 +123,7 @@ class Rig:
 
     def impact(self, speed: float = 20.0, load: float = 20.0, duration: float = 4.0,
                impacts_per_second: float = 4.0, location: str = "pinion_housing", seed: int = 0,
-               name=None) -> RigRecord:
+               name=None, direction: str = "vertical") -> RigRecord:
         """An operational hammer test: blows at random instants while the rig runs (oiled,
         healthy), recorded as one more channel ``hammer`` [N] (the hammer's load cell, same
         acquisition rate and anti-alias filter as the accelerometers).
@@ -143,17 +143,21 @@ class Rig:
 
         The truth carries the location, its DOF and the blows (start of contact [s from the
         first sample], contact times, peaks) with the load cell's gain and range. Slow roll
-        (0.5 Hz) keeps the running excitation weak against the blows.
+        (0.5 Hz) keeps the running excitation weak against the blows. ``direction="horizontal"``
+        strikes the same point from the side, along -y (its y DOF), as a modal test does to
+        reach the modes that move across the shafts' plane.
         """
         location = check_location(location)
+        direction = check_direction(direction)
         rate = check_rate(impacts_per_second)
         _check_point(speed, load)
         if not 0.05 <= duration <= 60.0:
             raise RigError(f"duration {duration} s outside [0.05, 60]")
         blows = draw_blows(location, rate, float(duration), self.params.hammer,
-                           np.random.default_rng([self.box_seed, int(seed), 31]))
+                           np.random.default_rng([self.box_seed, int(seed), 31]), direction)
         if name is None:
-            name = f"impact_{speed:g}Hz_{load:g}Nm_{location}_seed{seed}"
+            side = "" if direction == "vertical" else f"_{direction}"
+            name = f"impact_{speed:g}Hz_{load:g}Nm_{location}{side}_seed{seed}"
         return self._record("impact", (speed, speed), 0.0, load, duration, None, None, seed,
                             True, name, 0.0, 0.015, None, hammer=(blows, rate))
 
@@ -258,6 +262,7 @@ class Rig:
             chans["hammer"] = f[:n_out]
             units["hammer"] = "N"
             attrs["impact_location"] = blows.location
+            attrs["impact_direction"] = blows.direction
             truth["hammer"] = {**blows.truth(sim["model"]), "impacts_per_second": rate,
                                "sensor_gain": gain, "sensor_range": r,
                                "sensor_noise_rms": p.hammer.noise}

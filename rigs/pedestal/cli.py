@@ -74,6 +74,7 @@ def _parser() -> argparse.ArgumentParser:
     sp.add_argument("--load", type=float, default=20.0)
     sp.add_argument("--duration", type=float, default=4.0)
     sp.add_argument("--location", default="pinion_pedestal")
+    sp.add_argument("--direction", default="vertical", help="struck from above (vertical) or from the side (horizontal)")
     sp = sub.add_parser("modes")
     common(sp, out=False)
     sp.add_argument("--speed", type=float, default=20.0)
@@ -110,7 +111,7 @@ def main(argv=None) -> int:
                               _damage(args.damage), args.seed, lubricated=not args.dry)]
         elif args.command == "impact":
             recs = [rig.impact(args.speed, args.load, args.duration, location=args.location,
-                               seed=args.seed)]
+                               seed=args.seed, direction=args.direction)]
         else:
             recs = rig.stage_records(args.kind, args.per_stage, args.duration, args.seed)
         write(args.out, recs)

@@ -130,14 +130,16 @@ class Rig:
 
     def impact(self, speed: float = 20.0, load: float = 20.0, duration: float = 4.0,
                impacts_per_second: float = 4.0, location: str = "pinion_pedestal",
-               seed: int = 0, name: str | None = None) -> RigRecord:
+               seed: int = 0, name: str | None = None, direction: str = "vertical") -> RigRecord:
         """An operational impact test: hammer blows (force channel ``hammer`` [N]) on a
-        pedestal (``pinion_pedestal``/``gear_pedestal``, vertical) while the rig runs."""
-        from .excitation import hammer_input
+        pedestal (``pinion_pedestal``/``gear_pedestal``) while the rig runs, struck from above
+        (``direction="vertical"``, along -y) or from the side (``"horizontal"``, along -x)."""
+        from .excitation import check_impact, hammer_input
         speed = _check_positive("speed", speed)
+        check_impact(location, direction)
 
         def make(n, fs_int, case):
-            return hammer_input(n, fs_int, case.struct, location, impacts_per_second, seed)
+            return hammer_input(n, fs_int, case.struct, location, impacts_per_second, seed, direction)
 
         return self._record("impact", (speed, speed), load, duration, None, None, seed,
                             name or f"impact_{seed}", True, 0.0, 0.0, hammer=make)
