@@ -3,14 +3,16 @@
     python bench/calibration_rigs.py [--rigs pedestal beam] [--seeds 6 7 8 9 10] [--workers 2]
                                      [--model GearTwin.Gearbox21Shafts] [--pairing frequency]
                                      [--visibility mesh] [--fit follow] [--hammer]
+                                     [--hammer-at default] [--hammer-from above]
                                      [--out bench_out/calibration_rigs]
 
 For each rig and seed: one gearbox with its base parameters scattered +-12 %
 (``Rig().scattered(seed, 0.12)``); a 2 s steady record at 20 Hz / 20 N.m and a 6 s run-up from 2 to
 20 Hz, written in the measurement format (truth apart); with ``--hammer`` also a hammer test per
 struck point (:data:`HAMMER`: the pedestal rig's two pedestals, the beam rig's two shaft ends;
-``--hammer-at`` another choice of :data:`HAMMER_AT`), vertical, at slow roll (0.5 Hz, 20 N.m, 8 s,
-4 blows/s), read together with the run-up for the modes. Then, as a user would:
+``--hammer-at`` another choice of :data:`HAMMER_AT`), vertical (``--hammer-from both``: also one from
+the side at each point, :data:`HAMMER_FROM`), at slow roll (0.5 Hz, 20 N.m, 8 s, 4 blows/s), read
+together with the run-up for the modes. Then, as a user would:
 
 1. ``twin modes`` on the run-up (every casing channel): the modes with confidence >= 0.3 against
    the rig's own modes (``box.modes()``, its linearisation). *Observable* rig modes: observability
@@ -66,6 +68,16 @@ HAMMER_AT = {"supports": {"pedestal": ("pinion_pedestal", "gear_pedestal"), "bea
 #: its housings on seeds 71-75, docs/calibration.md)
 HAMMER = {"pedestal": HAMMER_AT["supports"]["pedestal"], "beam": HAMMER_AT["shaft-ends"]["beam"]}
 HAMMER_SPEED, HAMMER_DURATION, HAMMER_RATE = 0.5, 8.0, 4.0
+#: The directions of the blows at each struck point (``Rig.impact(direction=...)``): from above only,
+#: or from above and from the side (a modal test's two lateral directions).
+HAMMER_FROM = {"above": ("vertical",), "both": ("vertical", "horizontal")}
+
+
+def hammer_tests(struck_at, hammer_from: str) -> tuple[tuple[str, str, str], ...]:
+    """(record name, location, direction) of each hammer test: a vertical blow's record is
+    ``hammer_<location>`` (as before the side blows), a side blow's ``hammer_<location>_horizontal``."""
+    return tuple((f"hammer_{loc}" + ("" if d == "vertical" else f"_{d}"), loc, d)
+                 for loc in struck_at for d in HAMMER_FROM[hammer_from])
 
 
 def _scenario(path: Path, fs: float, workers: int, model: str, pairing: str = "frequency",
@@ -195,7 +207,7 @@ def _nearest(values, f):
 
 def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str, pairing: str = "frequency",
                 visibility: str = "mesh", fit: str = "follow", hammer: bool = False,
-                hammer_at: str = "default") -> dict:
+                hammer_at: str = "default", hammer_from: str = "above") -> dict:
     from spectral_distance import spectral_distance_report
 
     from fmu_build import build_fmu
@@ -210,13 +222,15 @@ def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str, p
     box = rigmod.Rig().scattered(seed=seed, scatter=0.12)
     t = time.perf_counter()
     struck_at = (HAMMER if hammer_at == "default" else HAMMER_AT[hammer_at])[rig_name]
-    h5 = out / f"{rig_name}_{seed}{('_hammer_' + '_'.join(struck_at)) * hammer}.h5"
-    modes_from = ("runup",) + tuple(f"hammer_{loc}" for loc in struck_at if hammer)
+    tests = hammer_tests(struck_at, hammer_from) if hammer else ()
+    h5 = out / (f"{rig_name}_{seed}{('_hammer_' + '_'.join(struck_at)) * hammer}"
+                f"{'_both' * (hammer and hammer_from == 'both')}.h5")
+    modes_from = ("runup",) + tuple(name for name, _, _ in tests)
     if not h5.exists():          # the records depend on the rig version and the seeds only
         steady = box.steady(speed=SPEED, load=LOAD, duration=2.0, seed=seed, name="steady")
         runup = box.runup(speeds=(2.0, SPEED), load=LOAD, duration=6.0, seed=seed, name="runup")
         struck = [box.impact(speed=HAMMER_SPEED, load=LOAD, duration=HAMMER_DURATION, impacts_per_second=HAMMER_RATE,
-                             location=loc, seed=seed, name=f"hammer_{loc}") for loc in struck_at if hammer]
+                             location=loc, seed=seed, name=name, direction=d) for name, loc, d in tests]
         rigmod.write(h5, [steady, runup, *struck])
     rig_wall = time.perf_counter() - t
     truth = box.modes(speed=SPEED, load=LOAD)
@@ -297,6 +311,8 @@ def main() -> None:
     ap.add_argument("--hammer-at", choices=("default", *HAMMER_AT), default="default",
                     help="where --hammer strikes: HAMMER (the pedestals; the beam rig's shaft ends), the bearing "
                          "supports, or each shaft's free end (rigs/beam only)")
+    ap.add_argument("--hammer-from", choices=tuple(HAMMER_FROM), default="above",
+                    help="with --hammer: blows from above at each struck point, or from above and from the side")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--out", type=Path, default=REPO / "bench_out" / "calibration_rigs")
     ap.add_argument("--explain", action="store_true",
@@ -304,6 +320,8 @@ def main() -> None:
     args = ap.parse_args()
     if args.hammer_at != "default" and set(args.rigs) - set(HAMMER_AT[args.hammer_at]):
         ap.error(f"--hammer-at {args.hammer_at}: only {', '.join(HAMMER_AT[args.hammer_at])} can be struck there")
+    if args.hammer_from != "above" and not args.hammer:
+        ap.error(f"--hammer-from {args.hammer_from} needs --hammer")
     args.out.mkdir(parents=True, exist_ok=True)
     if args.explain:
         done = json.loads((args.out / "results.json").read_text())
@@ -320,7 +338,7 @@ def main() -> None:
         for seed in args.seeds:
             t = time.perf_counter()
             r = one_gearbox(rig, seed, args.out, args.workers, args.model, args.pairing, args.visibility,
-                            args.fit, args.hammer, args.hammer_at)
+                            args.fit, args.hammer, args.hammer_at, args.hammer_from)
             r["fit"] = args.fit
             r["load_after"] = os.getloadavg()
             r["first6_explained"] = explain_modes(rig, seed, r, args.out, args.visibility)
