@@ -4,7 +4,8 @@ The FMU is linearised about the operating point (:mod:`twin.linearize`) with its
 and the excitations of a run-up: the mesh (a transmission error), the drive and the brake torque,
 and a force at each gear in each lateral direction and across the line of action (shaft-order
 run-out and unbalance, the process force). A model mode is *visible* when it makes a peak of an
-excitation-to-sensor response, the way a measured mode shows in a run-up: with
+excitation-to-sensor response, the way a measured mode shows in a run-up, or dominates that
+response at its own frequency (:func:`dominant_modes`: two close modes can share one peak): with
 ``visibility="mesh"`` (default) of the mesh column's, with ``visibility="run-up"`` of any
 column's (:data:`VISIBILITY`). :mod:`twin.calibration.sensitivity` pairs measured modes with them.
 """
@@ -139,11 +140,48 @@ def model_modes(fmu_path, parameters: Mapping[str, float], *, speed_hz: float, l
                     near = np.abs(np.log(freq / grid[p])) <= np.maximum(0.03, 2 * damp)
                     if near.any():
                         by[name][np.flatnonzero(near)[np.argmax(g[near])]] = True
+            by[name] |= dominant_modes(mm, e, keep)[keep]
     visible = by["mesh"].copy() if visibility == "mesh" else np.any(list(by.values()), axis=0)
     top = gain[visible].max() if visible.any() else (gain.max() if gain.size else 1.0)
     table = dof_table(lm.state_names, masses)
     return ModelModes(freq, damp, visible, shapes, 20 * np.log10(np.maximum(gain, 1e-300) / top),
                       tuple(classify(shapes, table)), mm.residues[:, 0, keep], tuple(channels), by, visibility)
+
+
+#: A mode that dominates the response at its own frequency is visible only if its own peak there is
+#: at least this fraction of the strongest mode's peak in the same response (-40 dB): below it a
+#: record's noise hides it, as the rigs' observability threshold (2 % of their best mode) does.
+DOMINANT_FLOOR = 0.01
+
+
+def dominant_modes(mm, column: int, within: np.ndarray | None = None) -> np.ndarray:
+    """(m,) bool: the modes of ``mm`` (:class:`twin.linearize.ModalModel`) that dominate the response
+    from excitation ``column`` at some output at their own frequency; ``within`` (m,) bool, the
+    modes of the band (default all): the strongest of them sets the floor, so a stiff sensor mount
+    far above the band does not.
+
+    A mode is seen at a sensor when its own response there, at its frequency, is at least that of
+    all the other modes together, and it is not buried below the strongest mode of that response
+    (:data:`DOMINANT_FLOOR`). Two modes a few per cent apart can share one peak of the FRF, which a
+    peak search gives to one of them; by its own contribution each is seen (the rigs' observability
+    is a residue measure too, not a peak search)."""
+    m = mm.frequency.size
+    out = np.zeros(m, dtype=bool)
+    if m == 0:
+        return out
+    s = 2j * np.pi * mm.frequency                                     # (m,) each mode's own frequency
+    lam = mm.eigenvalues
+    res = mm.residues[:, column, :]                                   # (k, m)
+    # terms[k, i, j]: mode j's response at mode i's frequency (with its conjugate)
+    terms = (res[:, None, :] / (s[None, :, None] - lam[None, None, :])
+             + np.conj(res)[:, None, :] / (s[None, :, None] - np.conj(lam)[None, None, :]))
+    own = np.abs(terms[:, np.arange(m), np.arange(m)])                # (k, m)
+    rest = np.abs(terms.sum(axis=2) - terms[:, np.arange(m), np.arange(m)])
+    band = np.ones(m, dtype=bool) if within is None else np.asarray(within, bool)
+    if not band.any():
+        return out
+    strongest = own[:, band].max(axis=1, keepdims=True)
+    return np.any((own >= rest) & (own >= DOMINANT_FLOOR * strongest), axis=0)
 
 
 def _start(fmu_path, name: str, default: float) -> float:
