@@ -79,7 +79,7 @@ class Rig:
         return factor * np.concatenate([np.full(n_pre, start), ramp])
 
     def _record(self, kind, speeds, load, duration, effect, damage, seed, name, lubricated,
-                speed_scatter, load_scatter, extra_truth=None, hammer=None):
+                speed_scatter, load_scatter, extra_truth=None, hammer=None, extra_attrs=None):
         acq = self.acquisition
         duration = _check_positive("duration", duration)
         load = _check_positive("load", load)
@@ -98,6 +98,7 @@ class Rig:
         if kind == "runup":
             attrs["commanded_speed_from"] = float(speeds[0])
             attrs["commanded_speed_to"] = float(speeds[1])
+        attrs.update(extra_attrs or {})
         truth = {"simulator": VERSION, "kind": kind, "seed": int(seed),
                  "gearbox_seed": self.identity.seed, "scatter": self.scatter,
                  "gearbox": self.describe(),
@@ -141,8 +142,10 @@ class Rig:
         def make(n, fs_int, case):
             return hammer_input(n, fs_int, case.struct, location, impacts_per_second, seed, direction)
 
+        where = {"impact_location": location, "impact_direction": direction}
         return self._record("impact", (speed, speed), load, duration, None, None, seed,
-                            name or f"impact_{seed}", True, 0.0, 0.0, hammer=make)
+                            name or f"impact_{seed}", True, 0.0, 0.0, extra_truth={"hammer": where},
+                            hammer=make, extra_attrs=where)
 
     # -- degradation stages --------------------------------------------------------------------
     def pitting_stages(self):

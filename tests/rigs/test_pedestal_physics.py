@@ -94,6 +94,10 @@ def test_a_blow_from_the_side_pushes_the_pedestal_along_x(rig):
     assert np.array_equal(up["force"], side["force"])
     assert up["direction"][I_YA] == -1.0 and side["direction"][I_XA] == -1.0
     assert np.count_nonzero(up["direction"]) == np.count_nonzero(side["direction"]) == 1
+    rec = rig.impact(1.0, 5.0, 0.05, location="gear_pedestal", direction="horizontal", seed=2)
+    assert rec.attributes["impact_location"] == "gear_pedestal"
+    assert rec.attributes["impact_direction"] == "horizontal"
+    assert rec.truth["hammer"] == {"impact_location": "gear_pedestal", "impact_direction": "horizontal"}
     with pytest.raises(ValueError, match="diagonal"):
         rig.impact(1.0, 5.0, 0.2, direction="diagonal")
     with pytest.raises(ValueError, match="nowhere"):
