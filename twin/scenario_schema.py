@@ -81,10 +81,12 @@ CALIBRATION_SCHEMA: dict[str, Any] = {
                                "paired afresh at every candidate set, then that descent)"},
         "search_budget": {"type": "integer", "minimum": 8,
                           "description": "linearisations of the modes search (fit: search; default 160)"},
-        "visibility": {"enum": ["mesh", "run-up"],
+        "visibility": {"enum": ["mesh", "run-up", "mesh+dominant", "run-up+dominant"],
                        "description": "which excitations make a model mode visible (a pairing candidate): the "
                                       "mesh's alone (default) or any of a run-up's (mesh, drive and load torque, "
-                                      "lateral forces at the gears, the process force)"},
+                                      "lateral forces at the gears, the process force); '+dominant': a mode that "
+                                      "dominates such a response at its own frequency counts too, not only one "
+                                      "that makes a peak"},
         "evaluation_timeout": {"type": "number", "exclusiveMinimum": 0,
                                "description": "s; an evaluation still running then is stopped and scored infeasible "
                                               "(default 600)"},

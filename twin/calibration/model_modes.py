@@ -4,10 +4,11 @@ The FMU is linearised about the operating point (:mod:`twin.linearize`) with its
 and the excitations of a run-up: the mesh (a transmission error), the drive and the brake torque,
 and a force at each gear in each lateral direction and across the line of action (shaft-order
 run-out and unbalance, the process force). A model mode is *visible* when it makes a peak of an
-excitation-to-sensor response, the way a measured mode shows in a run-up, or dominates that
-response at its own frequency (:func:`dominant_modes`: two close modes can share one peak): with
+excitation-to-sensor response, the way a measured mode shows in a run-up: with
 ``visibility="mesh"`` (default) of the mesh column's, with ``visibility="run-up"`` of any
-column's (:data:`VISIBILITY`). :mod:`twin.calibration.sensitivity` pairs measured modes with them.
+column's (:data:`VISIBILITY`). With ``"mesh+dominant"`` or ``"run-up+dominant"`` a mode that
+dominates such a response at its own frequency counts as well (:func:`dominant_modes`: two close
+modes can share one peak). :mod:`twin.calibration.sensitivity` pairs measured modes with them.
 """
 from __future__ import annotations
 
@@ -23,8 +24,10 @@ MESH_EXCITATION = "profile_deviation"
 #: Levels of the broadband sources of GearTwin.Gearbox21Measured, set to zero to linearise.
 BROADBAND_LEVELS = ("pinion_roughness.rms", "gear_roughness.rms", "process.rms")
 #: Which excitation-to-sensor responses make a model mode visible: the mesh's alone (default), or
-#: any of a run-up's excitations (:data:`RUNUP_EXCITATIONS`, :data:`LATERAL_FORCES`).
-VISIBILITY = ("mesh", "run-up")
+#: any of a run-up's excitations (:data:`RUNUP_EXCITATIONS`, :data:`LATERAL_FORCES`); with
+#: ``+dominant`` a mode that dominates one of them at its own frequency counts too
+#: (:func:`dominant_modes`), not only one that makes a peak.
+VISIBILITY = ("mesh", "run-up", "mesh+dominant", "run-up+dominant")
 #: Excitations of a run-up that are FMU inputs, by column name (a unit change of the input). The
 #: speed reference acts through the motor's slip law as ``c_motor`` times the drive torque: the
 #: same column scaled, so it is not repeated.
@@ -97,7 +100,7 @@ def model_modes(fmu_path, parameters: Mapping[str, float], *, speed_hz: float, l
     """Linearise at the operating point and find the visible modes (see the module docstring).
 
     The run-up's other excitation columns are linearised only when they decide visibility
-    (``visibility="run-up"``) or are asked for (``every_excitation``, for the report of
+    (``visibility="run-up"``, ``"run-up+dominant"``) or are asked for (``every_excitation``, for the report of
     ``visible_by``): with the default rule the fit's many linearisations need the mesh column alone."""
     from scipy.signal import find_peaks
 
@@ -109,7 +112,8 @@ def model_modes(fmu_path, parameters: Mapping[str, float], *, speed_hz: float, l
     start, inputs = operating_point(speed_hz, load_nm)
     names = _variables(fmu_path)
     excitations = {"mesh": [MESH_EXCITATION + "[*]"]}
-    every_excitation = every_excitation or visibility == "run-up"
+    columns, _, rule = visibility.partition("+")
+    every_excitation = every_excitation or columns == "run-up"
     if every_excitation:
         excitations.update({k: list(v) for k, v in RUNUP_EXCITATIONS.items() if all(n in names for n in v)})
     # the broadband sources are excitation, not structure: linearised without them (a rough
@@ -140,8 +144,9 @@ def model_modes(fmu_path, parameters: Mapping[str, float], *, speed_hz: float, l
                     near = np.abs(np.log(freq / grid[p])) <= np.maximum(0.03, 2 * damp)
                     if near.any():
                         by[name][np.flatnonzero(near)[np.argmax(g[near])]] = True
-            by[name] |= dominant_modes(mm, e, keep)[keep]
-    visible = by["mesh"].copy() if visibility == "mesh" else np.any(list(by.values()), axis=0)
+            if rule == "dominant":
+                by[name] |= dominant_modes(mm, e, keep)[keep]
+    visible = by["mesh"].copy() if columns == "mesh" else np.any(list(by.values()), axis=0)
     top = gain[visible].max() if visible.any() else (gain.max() if gain.size else 1.0)
     table = dof_table(lm.state_names, masses)
     return ModelModes(freq, damp, visible, shapes, 20 * np.log10(np.maximum(gain, 1e-300) / top),

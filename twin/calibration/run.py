@@ -21,7 +21,8 @@ Scenario block (every key but ``parameters`` optional)::
       refine: true                # polish the pick by least squares on the modes (default)
       pairing: frequency          # measured to model modes: frequency (default) or shape (opt-in)
       visibility: mesh            # model modes a sensor shows: under the mesh (default) or any
-                                  #   excitation of a run-up (run-up, opt-in)
+                                  #   excitation of a run-up (run-up, opt-in); +dominant (opt-in):
+                                  #   a mode dominating a response at its frequency counts too
       fit: follow                 # the modes fit: follow the nominal pairing (default) or search
                                   #   (CMA-ES, modes paired afresh at every set; opt-in)
       search_budget: 160          # linearisations of that search

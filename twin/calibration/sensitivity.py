@@ -241,7 +241,9 @@ class Sensitivity:
                             for r in self.refused))
         if self.visible_by:
             rows.append(f"visible model modes at nominal [Hz], by excitation (visibility: {self.visibility}; "
-                        + ("any column counts" if self.visibility == "run-up" else "the mesh column counts") + "):")
+                        + ("any column counts" if self.visibility.startswith("run-up") else "the mesh column counts")
+                        + (", a mode dominating a response at its frequency too" if self.visibility.endswith("+dominant")
+                           else "") + "):")
             rows += [f"  {e:<13s} " + ", ".join(f"{f:.0f}" for f in fs) for e, fs in self.visible_by.items()]
         rows += [f"note: {n}" for n in self.notes]
         return "\n".join(rows)

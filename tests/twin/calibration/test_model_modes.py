@@ -38,3 +38,21 @@ def test_a_weak_mode_beside_a_strong_one_or_below_the_floor_is_not_seen():
     assert dominant_modes(mm, 0, within=np.array([False, False, True])).tolist() == [True, False, True]
     own = mm.gain[0, 0]
     assert own[2] < DOMINANT_FLOOR * own[0]        # the isolated mode's peak: about -46 dB
+
+
+def test_dominant_visibility_is_an_opt_in_that_only_adds_modes(gearbox_fmu):
+    """``+dominant`` keeps every mode the peak search shows and may add modes; the default and
+    ``run-up`` are unchanged by it; an unknown rule is refused by name."""
+    import pytest
+
+    from twin.calibration.model_modes import VISIBILITY, model_modes
+    kw = dict(speed_hz=20.0, load_nm=20.0)
+    assert VISIBILITY == ("mesh", "run-up", "mesh+dominant", "run-up+dominant")
+    for base in ("mesh", "run-up"):
+        peaks = model_modes(gearbox_fmu, {}, **kw, visibility=base)
+        both = model_modes(gearbox_fmu, {}, **kw, visibility=base + "+dominant")
+        assert np.array_equal(peaks.frequency, both.frequency)
+        assert np.all(both.visible[peaks.visible]) and both.visibility == base + "+dominant"
+        assert set(both.visible_by) == set(peaks.visible_by)
+    with pytest.raises(ValueError, match="dominant-ish"):
+        model_modes(gearbox_fmu, {}, **kw, visibility="dominant-ish")

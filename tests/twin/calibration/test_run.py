@@ -87,8 +87,10 @@ def test_bad_calibration_block_lists_problems(gearbox_fmu, rig, tmp_path):
         _scenario(gearbox_fmu, natural_frequencies=[])
     with pytest.raises(ScenarioError, match=r"calibration\.pairing: 'nearest' is not one of \['frequency', 'shape'\]"):
         _scenario(gearbox_fmu, pairing="nearest")
-    with pytest.raises(ScenarioError, match=r"calibration\.visibility: 'all' is not one of \['mesh', 'run-up'\]"):
+    with pytest.raises(ScenarioError, match=r"calibration\.visibility: 'all' is not one of \['mesh', 'run-up', "
+                                            r"'mesh\+dominant', 'run-up\+dominant'\]"):
         _scenario(gearbox_fmu, visibility="all")
+    assert _scenario(gearbox_fmu, visibility="run-up+dominant").raw["calibration"]["visibility"] == "run-up+dominant"
     with pytest.raises(ScenarioError, match=r"calibration\.fit: 'global' is not one of \['follow', 'search'\]"):
         _scenario(gearbox_fmu, fit="global")
     with pytest.raises(ScenarioError, match=r"calibration\.pairing: 'nearest' is not one of"):
