@@ -300,7 +300,8 @@ def main() -> None:
                          "pedestals on rigid ground)")
     ap.add_argument("--pairing", choices=("frequency", "shape"), default="frequency",
                     help="how twin calibrate pairs measured with model modes (calibration.pairing)")
-    ap.add_argument("--visibility", choices=("mesh", "run-up", "mesh+dominant", "run-up+dominant"), default="mesh",
+    from twin.calibration.model_modes import VISIBILITY
+    ap.add_argument("--visibility", choices=VISIBILITY, default="mesh",
                     help="which excitations make a model mode visible (calibration.visibility); the score looks "
                          "at the calibrated twin's visible modes under the same rule")
     ap.add_argument("--fit", choices=("follow", "search"), default="follow",
