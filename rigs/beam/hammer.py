@@ -27,7 +27,9 @@ LOCATIONS = ("pinion_housing", "gear_housing", "pinion_shaft_end", "gear_shaft_e
 #: Directions of a blow, by the index of its axis in the (y, z) pairs: from above (-z) or from
 #: the side (-y).
 DIRECTIONS = {"vertical": 1, "horizontal": 0}
-VERTICAL = DIRECTIONS["vertical"]
+#: How the truth file names each direction: (the struck DOF's axis, the blow's sense).
+_DIRECTION_NAMES = {"vertical": ("vertical z", "-z (struck from above)"),
+                    "horizontal": ("horizontal y", "-y (struck from the side)")}
 _HOUSING = {"pinion_housing": 0, "gear_housing": 2}
 
 
@@ -88,13 +90,12 @@ class Blows:
 
     def truth(self, model) -> dict:
         axis = DIRECTIONS[self.direction]
-        name = "vertical z" if self.direction == "vertical" else "horizontal y"
+        name, side = _DIRECTION_NAMES[self.direction]
         if self.location in _HOUSING:
             dof = f"bearing_housing[{_HOUSING[self.location]}, {axis}] (housing {name}, casing modes)"
         else:
             node = (model.encoder if self.location == "pinion_shaft_end" else model.gear_encoder) - 4
             dof = f"shaft DOF {node + axis} (free-end node, {name})"
-        side = "-z (struck from above)" if self.direction == "vertical" else "-y (struck from the side)"
         return {"location": self.location, "dof": dof, "direction": side,
                 "hit_times": [float(x) for x in self.starts],
                 "hit_times_are": "start of contact [s from the first sample]",

@@ -8,7 +8,7 @@ from .structure import I_XA, I_XB, I_YA, I_YB, LinearStructure
 #: Struck pedestals by name: their DOF along each blow direction (y is the vertical of this rig).
 LOCATIONS = {"pinion_pedestal": {"vertical": I_YA, "horizontal": I_XA},
              "gear_pedestal": {"vertical": I_YB, "horizontal": I_XB}}
-DIRECTIONS = ("vertical", "horizontal")
+DIRECTIONS = tuple(LOCATIONS["pinion_pedestal"])
 
 
 def hammer_input(n: int, fs: float, struct: LinearStructure, location: str,
