@@ -117,8 +117,10 @@ def test_ctrl_c_in_calibrate_is_one_line(tmp_path, gearbox_fmu):
     x = np.sin(2 * np.pi * 380 * np.arange(40000) / 1e5)
     write_measurements([Record("r", {"accel_pinion_casing": x}, {"accel_pinion_casing": "m/s2"}, 1e5,
                                nominal_speed=20.0, load=20.0)], tmp_path / "m.h5")
+    # 40 generations run far longer than 8 s: the interrupt at 8 s must find the search still
+    # running (with 5 the whole command took 14 s on a loaded 2-core machine: a fast one could finish first)
     (tmp_path / "c.yaml").write_text(PLAIN.format(name="c", fmu=gearbox_fmu, stop=0.05) + (
-        "calibration: {parameters: {kt12: [1000, 2500]}, algorithm: nsga2, pop_size: 4, n_gen: 5, "
+        "calibration: {parameters: {kt12: [1000, 2500]}, algorithm: nsga2, pop_size: 4, n_gen: 40, "
         "natural_frequencies: [22, 87, 218, 430], record_duration: 0.2, settle_time: 0.05}\n"
         "executor: {type: local, workers: 1}\n"))
     code, _, err = interrupt(tmp_path, ["calibrate", "c.yaml", "--measurements", "m.h5", "--out", "cal",
