@@ -28,6 +28,9 @@ MIN_CONFIDENCE = 0.3
 #: Whether a run-up with several vibration channels is also read through their cross-spectral
 #: matrix (frequency-domain decomposition, :mod:`twin.signals.fdd`) by default.
 FDD = True
+#: Whether the hammer tests among the records are also fitted together by the poly-reference LSCF
+#: method (:mod:`twin.signals.lscf`) by default.
+LSCF = True
 
 
 def shaft_angle(record) -> np.ndarray | None:
@@ -211,8 +214,13 @@ def survey_records(mset, names, **kwargs) -> ModalSurvey:
     if missing:
         raise MeasurementError(mset.source or "<memory>", missing[0],
                                f"no such record (the file has {', '.join(mset.names)})")
+    lscf = kwargs.pop("lscf", None)
+    lscf = LSCF if lscf is None else bool(lscf)
+    hammer = [mset[n] for n in names if _force_channel(mset[n]) is not None]
     if len(names) == 1:
-        return survey_record(mset[names[0]], **kwargs)
+        survey = survey_record(mset[names[0]], **kwargs)
+        return with_lscf(survey, hammer, kwargs.get("channels"), kwargs.get("fmin"), kwargs.get("fmax")) \
+            if lscf and hammer else survey
     surveys = [survey_record(mset[n], **kwargs) for n in names]
     merged = merge_surveys(surveys)
     # which records saw each merged mode: every record with a mode within the merge's reach
@@ -222,7 +230,64 @@ def survey_records(mset, names, **kwargs) -> ModalSurvey:
                                                           for o in s.modes)]
         modes.append(replace(m, evidence={**m.evidence, "records": seen}))
     method = "+".join(dict.fromkeys(s.method for s in surveys))
-    return replace(merged, modes=tuple(modes), method=method, channels=tuple(dict.fromkeys(merged.channels)))
+    merged = replace(merged, modes=tuple(modes), method=method, channels=tuple(dict.fromkeys(merged.channels)))
+    return with_lscf(merged, hammer, kwargs.get("channels"), kwargs.get("fmin"), kwargs.get("fmax")) \
+        if lscf and hammer else merged
+
+
+def with_lscf(survey: ModalSurvey, records, channels=None, fmin: float | None = None,
+              fmax: float | None = None) -> ModalSurvey:
+    """The survey with the modes a poly-reference LSCF fit of the hammer ``records`` adds.
+
+    Every hammer record is one reference (its force channel), every vibration channel they share
+    one output (:func:`twin.signals.impact.hammer_frf_matrix`). A stable pole within the merge's
+    reach of a mode the survey has (:func:`_same_mode`) adds nothing; any other is a new mode with
+    confidence = its stability (the share of the diagram's orders it was stable at; the coherence
+    already weights the fit, and a running gearbox's own vibration keeps it low at modes the fit
+    finds plainly) and evidence ``found_by: "lscf"``.
+    The band: ``fmin`` (default four bins) to ``fmax`` (default the tips' band, at most 0.4 fs and
+    10 kHz). A set of records whose FRFs cannot be formed together (different sample rates, no
+    common channel) is fitted no further: the survey is returned with a note saying why.
+    """
+    from twin.signals._checks import SignalError
+    from twin.signals.impact import hammer_frf_matrix, local_floor
+    from twin.signals.lscf import lscf_modes
+
+    vib = [c for c in (channels or records[0].channel_names)
+           if c in records[0] and records[0].units[c] in VIBRATION_UNITS and c != records[0].tachometer]
+    common = [c for c in vib if all(c in r for r in records)]
+    fs = {r.sample_rate for r in records}
+    if not common or len(fs) != 1:
+        why = "no vibration channel common to all" if not common else "their sample rates differ"
+        return replace(survey, notes=survey.notes + (f"hammer tests not fitted together by LSCF: {why}",))
+    fs = fs.pop()
+    try:
+        f, H, coh, top = hammer_frf_matrix([(r[_force_channel(r)], [r[c] for c in common]) for r in records], fs)
+    except SignalError as exc:
+        return replace(survey, notes=survey.notes + (f"hammer tests not fitted together by LSCF: {exc}",))
+    df = float(f[1] - f[0])
+    lo = float(4 * df if fmin is None else fmin)
+    hi = float(min(0.4 * fs, 10_000.0, top) if fmax is None else fmax)
+    if not lo < hi:
+        return survey
+    level = 20 * np.log10(np.maximum(np.sqrt(np.mean(np.abs(H) ** 2, axis=(1, 2))), np.finfo(float).tiny))
+    mean_coh = np.nanmean(coh, axis=(1, 2))
+    modes = list(survey.modes)
+    added = 0
+    for p in lscf_modes(f, H, coh, lo, hi):
+        if any(_same_mode(m.frequency, p.frequency, df) for m in modes):
+            continue
+        k = int(np.argmin(np.abs(f - p.frequency)))
+        c = float(np.clip(mean_coh[k], 0.0, 1.0))
+        modes.append(Mode(p.frequency, p.damping, p.stability, float(level[k] - local_floor(f, level, p.frequency)),
+                          {"reason": "stable pole of a poly-reference LSCF fit of the hammer FRFs",
+                           "found_by": "lscf", "stability": round(p.stability, 3), "coherence": round(c, 3),
+                           "resolution_hz": round(df, 4), "frequency_sd_hz": round(max(p.frequency_sd, df / 4), 4),
+                           "records": [r.name for r in records], "channels": common}))
+        added += 1
+    note = (f"LSCF fit of {len(records)} hammer test(s) x {len(common)} channel(s), {lo:.0f}-{hi:.0f} Hz: "
+            f"{added} mode(s) added")
+    return replace(survey, modes=tuple(sorted(modes, key=lambda m: m.frequency)), notes=survey.notes + (note,))
 
 
 def survey_file(path, record=None, **kwargs) -> ModalSurvey:

@@ -130,7 +130,7 @@ def _cmd_modes(args: argparse.Namespace) -> int:
             check_parent(path)
     record = args.record[0] if args.record and len(args.record) == 1 else args.record
     survey = modes.survey_file(Path(args.measurements), record, channels=args.channel, fmin=args.fmin,
-                               fmax=args.fmax, resolution=args.resolution, fdd=args.fdd)
+                               fmax=args.fmax, resolution=args.resolution, fdd=args.fdd, lscf=args.lscf)
     print(modes.survey_table(survey, args.min_confidence))
     if args.json:
         modes.write_survey_json(survey, args.json, file=str(args.measurements), record=record,
@@ -156,6 +156,9 @@ def _add_modes_parser(sub) -> None:
     p.add_argument("--fdd", action=argparse.BooleanOptionalAction, default=None,
                    help="with two or more vibration channels, also read their cross-spectral matrix for close modes "
                         "of different shapes (frequency-domain decomposition; default: on)")
+    p.add_argument("--lscf", action=argparse.BooleanOptionalAction, default=None,
+                   help="fit the hammer records' FRFs (every struck point and channel) together by the poly-reference "
+                        "LSCF method for modes whose humps overlap (default: on)")
     p.add_argument("--min-confidence", type=float, default=0.3,
                    help="confidence a mode needs to be used for calibration (default: 0.3)")
     p.add_argument("--json", type=Path, help="write the modes, lines and orders here")

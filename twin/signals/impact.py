@@ -39,6 +39,70 @@ def find_impacts(force, fs: float, *, min_gap: float = 0.05) -> np.ndarray:
 ESTIMATORS = ("auto", "H1", "H2")
 
 
+def impact_segments(hits, n_samples: int, fs: float, length: int | None = None) -> tuple[list[int], int]:
+    """Start samples and length [samples] of the segments an FRF averages: one per hit, from 1 % of
+    a segment before it, ``length`` long (default 95 % of the lower quartile of the intervals between
+    hits, of the shortest when there are fewer than five); a segment that would hold the next hit is
+    dropped (double-hit rejection)."""
+    hits = np.asarray(hits, dtype=np.int64)
+    if hits.size < 2:
+        raise SignalError(f"found {hits.size} impact(s) in the force channel; an FRF needs at least 2 "
+                          "(several hits, each followed by the response's decay)")
+    gaps = np.diff(hits)
+    if length is None:
+        length = int(0.95 * (np.quantile(gaps, 0.25) if gaps.size >= 4 else np.min(gaps)))
+    pre = max(1, length // 100)
+    nxt = np.append(hits[1:], np.iinfo(np.int64).max)
+    starts = [int(h - pre) for h, after in zip(hits, nxt)
+              if h - pre >= 0 and h - pre + length <= n_samples and after >= h - pre + length]
+    if len(starts) < 2 or length < 64:
+        raise SignalError(f"the hits are {np.min(gaps) / fs:.3g} s apart: too close for an FRF "
+                          "(need at least 64 samples and 2 whole segments)")
+    return starts, int(length)
+
+
+def hammer_frf_matrix(tests, fs: float, *, estimator: str = "auto"):
+    """The FRF matrix of several hammer tests with the same response channels.
+
+    tests : sequence of ``(force, responses)``, one per struck point: the force [N] (n,) and a
+    sequence of responses (n,) in the same channel order for every test. All are cut into segments
+    of one length (the shortest any test allows, :func:`impact_segments`), so the FRFs share one
+    frequency grid. Returns ``f`` (n_f,) [Hz], ``H`` (n_f, n_out, n_ref) complex [unit / N],
+    ``coherence`` (n_f, n_out, n_ref) and the upper edge [Hz] of the band every test's tip excites.
+    Each FRF by H1 or H2 as ``estimator`` (``"auto"``: per test and channel, as
+    :func:`analyse_impacts`).
+    """
+    if estimator not in ESTIMATORS:
+        raise SignalError(f"unknown FRF estimator {estimator!r}: use one of {', '.join(ESTIMATORS)}")
+    fs = positive(fs, "fs")
+    prepared = []
+    for force, responses in tests:
+        force = as_signal(force, "force")
+        responses = [as_signal(r, "response") for r in responses]
+        for r in responses:
+            same_length(force, r, "force", "response")
+        hits = find_impacts(force, fs)
+        prepared.append((force, responses, hits, impact_segments(hits, force.size, fs)[1]))
+    if not prepared or len({len(r) for _, r, _, _ in prepared}) != 1 or not prepared[0][1]:
+        raise SignalError("the hammer tests must have the same response channels (at least one)")
+    length = min(p[3] for p in prepared)
+    H, coh, top = [], [], []
+    for force, responses, hits, _ in prepared:
+        starts, _ = impact_segments(hits, force.size, fs, length)
+        fx = np.concatenate([force[s:s + length] for s in starts])
+        top.append(tip_band(fx, length, fs))
+        col, cc = [], []
+        for y in responses:
+            fy = np.concatenate([y[s:s + length] for s in starts])
+            est = noisier_channel_estimator(force, y, hits, fs) if estimator == "auto" else estimator
+            f, h1, h2, c = frf_h1_h2(fx, fy, fs, nperseg=length)
+            col.append(h1 if est == "H1" else h2)
+            cc.append(c)
+        H.append(np.array(col).T)
+        coh.append(np.array(cc).T)
+    return f, np.stack(H, axis=2), np.stack(coh, axis=2), float(min(top))
+
+
 def analyse_impacts(force, response, fs: float, *, fmin: float | None = None,
                     fmax: float | None = None, estimator: str = "auto") -> ModalSurvey:
     """Modes [Hz] with damping ratios from a hammer record (force [N], response [unit]).
@@ -53,19 +117,7 @@ def analyse_impacts(force, response, fs: float, *, fmin: float | None = None,
     same_length(force, response, "force", "response")
     fs = positive(fs, "fs")
     hits = find_impacts(force, fs)
-    if hits.size < 2:
-        raise SignalError(f"found {hits.size} impact(s) in the force channel; an FRF needs at least 2 "
-                          "(several hits, each followed by the response's decay)")
-    gaps = np.diff(hits)
-    length = int(0.95 * (np.quantile(gaps, 0.25) if gaps.size >= 4 else np.min(gaps)))
-    pre = max(1, length // 100)
-    # a segment must end before the next hit: double hits (closer than ``length``) are dropped
-    nxt = np.append(hits[1:], np.iinfo(np.int64).max)
-    starts = [h - pre for h, after in zip(hits, nxt)
-              if h - pre >= 0 and h - pre + length <= force.size and after >= h - pre + length]
-    if len(starts) < 2 or length < 64:
-        raise SignalError(f"the hits are {np.min(gaps) / fs:.3g} s apart: too close for an FRF "
-                          "(need at least 64 samples and 2 whole segments)")
+    starts, length = impact_segments(hits, force.size, fs)
     fx = np.concatenate([force[s:s + length] for s in starts])
     fy = np.concatenate([response[s:s + length] for s in starts])
     why = "as asked"
