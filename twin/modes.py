@@ -237,11 +237,13 @@ def survey_records(mset, names, **kwargs) -> ModalSurvey:
 
 def with_lscf(survey: ModalSurvey, records, channels=None, fmin: float | None = None,
               fmax: float | None = None) -> ModalSurvey:
-    """The survey with the modes a poly-reference LSCF fit of the hammer ``records`` adds.
+    """The survey with the modes a poly-reference LSCF fit of the hammer ``records`` adds or splits.
 
     Every hammer record is one reference (its force channel), every vibration channel they share
-    one output (:func:`twin.signals.impact.hammer_frf_matrix`). A stable pole within the merge's
-    reach of a mode the survey has (:func:`_same_mode`) adds nothing; any other is a new mode with
+    one output (:func:`twin.signals.impact.hammer_frf_matrix`). A survey mode with one stable pole
+    within the merge's reach (:func:`_same_mode`) stays as it is; one with two or more is a hump
+    that held close modes, and the poles replace it (evidence ``replaces_hz``: the parametric fit
+    resolves poles closer than the FRF's bins, peak picking cannot). Any other pole is a new mode with
     confidence = its stability (the share of the diagram's orders it was stable at; the coherence
     already weights the fit, and a running gearbox's own vibration keeps it low at modes the fit
     finds plainly) and evidence ``found_by: "lscf"``.
@@ -272,22 +274,31 @@ def with_lscf(survey: ModalSurvey, records, channels=None, fmin: float | None = 
         return survey
     level = 20 * np.log10(np.maximum(np.sqrt(np.mean(np.abs(H) ** 2, axis=(1, 2))), np.finfo(float).tiny))
     mean_coh = np.nanmean(coh, axis=(1, 2))
-    modes = list(survey.modes)
-    added = 0
-    for p in lscf_modes(f, H, coh, lo, hi):
-        if any(_same_mode(m.frequency, p.frequency, df) for m in modes):
-            continue
+    poles = lscf_modes(f, H, coh, lo, hi)
+
+    def as_mode(p, **extra) -> Mode:
         k = int(np.argmin(np.abs(f - p.frequency)))
         c = float(np.clip(mean_coh[k], 0.0, 1.0))
-        modes.append(Mode(p.frequency, p.damping, p.stability, float(level[k] - local_floor(f, level, p.frequency)),
-                          {"reason": "stable pole of a poly-reference LSCF fit of the hammer FRFs",
-                           "found_by": "lscf", "stability": round(p.stability, 3), "coherence": round(c, 3),
-                           "resolution_hz": round(df, 4), "frequency_sd_hz": round(max(p.frequency_sd, df / 4), 4),
-                           "records": [r.name for r in records], "channels": common}))
-        added += 1
+        return Mode(p.frequency, p.damping, p.stability, float(level[k] - local_floor(f, level, p.frequency)),
+                    {"reason": "stable pole of a poly-reference LSCF fit of the hammer FRFs",
+                     "found_by": "lscf", "stability": round(p.stability, 3), "coherence": round(c, 3),
+                     "resolution_hz": round(df, 4), "frequency_sd_hz": round(max(p.frequency_sd, df / 4), 4),
+                     "records": [r.name for r in records], "channels": common, **extra})
+
+    modes, used, split = [], set(), 0
+    for m in survey.modes:
+        near = [i for i, p in enumerate(poles) if _same_mode(m.frequency, p.frequency, df)]
+        if len(near) >= 2:      # one hump read as one mode holds several poles: they replace it
+            modes += [as_mode(poles[i], replaces_hz=round(m.frequency, 2)) for i in near if i not in used]
+            used.update(near)
+            split += 1
+        else:
+            modes.append(m)
+            used.update(near)
+    added = [as_mode(p) for i, p in enumerate(poles) if i not in used]
     note = (f"LSCF fit of {len(records)} hammer test(s) x {len(common)} channel(s), {lo:.0f}-{hi:.0f} Hz: "
-            f"{added} mode(s) added")
-    return replace(survey, modes=tuple(sorted(modes, key=lambda m: m.frequency)), notes=survey.notes + (note,))
+            f"{len(added)} mode(s) added, {split} hump(s) split into close modes")
+    return replace(survey, modes=tuple(sorted(modes + added, key=lambda m: m.frequency)), notes=survey.notes + (note,))
 
 
 def survey_file(path, record=None, **kwargs) -> ModalSurvey:

@@ -59,3 +59,31 @@ def synthetic_runup(*, fs=12800.0, duration=6.0, speeds=(2.0, 20.0),
 @pytest.fixture(scope="session")
 def runup_factory():
     return synthetic_runup
+
+
+def synthetic_hammer(modes, responses_per_force, fs: float, seconds: float, seed: int):
+    """A hammer record: half-sine blows (0.3 ms, 100 N) every 0.25 s and the responses [m] to them,
+    one per entry of ``responses_per_force`` (the residues of ``modes``, (fn [Hz], zeta) each), each a
+    sum of damped modes plus 1 % noise. Returns (force (n,), [response (n,), ...])."""
+    n = int(seconds * fs)
+    t = np.arange(n) / fs
+    force = np.zeros(n)
+    pulse = np.sin(np.pi * np.arange(int(3e-4 * fs)) / int(3e-4 * fs))
+    for start in range(int(0.02 * fs), n - pulse.size, int(0.25 * fs)):
+        force[start:start + pulse.size] += 100.0 * pulse
+    rng = np.random.default_rng(seed)
+    out = []
+    for residues in responses_per_force:
+        h = np.zeros(n)
+        for (fn, zeta), r in zip(modes, residues):
+            wn = 2 * np.pi * fn
+            wd = wn * np.sqrt(1 - zeta**2)
+            h += r * np.exp(-zeta * wn * t) * np.sin(wd * t) / wd / fs
+        y = np.fft.irfft(np.fft.rfft(force, 2 * n) * np.fft.rfft(h, 2 * n), 2 * n)[:n]
+        out.append(y + 0.01 * np.std(y) * rng.standard_normal(n))
+    return force, out
+
+
+@pytest.fixture(scope="session")
+def hammer_factory():
+    return synthetic_hammer
