@@ -3,7 +3,7 @@
     python bench/calibration_rigs.py [--rigs pedestal beam] [--seeds 6 7 8 9 10] [--workers 2]
                                      [--model GearTwin.Gearbox21Shafts] [--pairing frequency]
                                      [--visibility mesh] [--fit follow] [--hammer]
-                                     [--hammer-at default] [--hammer-from above] [--no-lscf]
+                                     [--hammer-at default] [--hammer-from above] [--lscf]
                                      [--out bench_out/calibration_rigs]
 
 For each rig and seed: one gearbox with its base parameters scattered +-12 %
@@ -315,9 +315,9 @@ def main() -> None:
     ap.add_argument("--hammer-from", choices=tuple(HAMMER_FROM), default="above",
                     help="with --hammer: blows from above at each struck point, or from above and from the side")
     ap.add_argument("--workers", type=int, default=2)
-    ap.add_argument("--no-lscf", action="store_true",
-                    help="read the hammer records peak by peak only, without the poly-reference LSCF fit of their "
-                         "FRFs together (twin.modes.LSCF; the measured modes before 2026-11-27)")
+    ap.add_argument("--lscf", action=argparse.BooleanOptionalAction, default=None,
+                    help="also fit the hammer records' FRFs together by the poly-reference LSCF method (twin.modes.LSCF, "
+                         "default off; scored on seeds 91-95 as the default, not adopted)")
     ap.add_argument("--out", type=Path, default=REPO / "bench_out" / "calibration_rigs")
     ap.add_argument("--explain", action="store_true",
                     help="only the per-mode analysis of the results already in --out (no new scoring)")
@@ -327,9 +327,9 @@ def main() -> None:
     if args.hammer_from != "above" and not args.hammer:
         ap.error(f"--hammer-from {args.hammer_from} needs --hammer")
     args.out.mkdir(parents=True, exist_ok=True)
-    if args.no_lscf:
+    if args.lscf is not None:
         import twin.modes
-        twin.modes.LSCF = False
+        twin.modes.LSCF = args.lscf
     if args.explain:
         done = json.loads((args.out / "results.json").read_text())
         rows = [m for r in done for m in explain_modes(r["rig"], r["seed"], r, args.out,

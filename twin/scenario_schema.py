@@ -56,6 +56,8 @@ CALIBRATION_SCHEMA: dict[str, Any] = {
                        "description": "record (run-up or hammer test) the measured modes are read from, or several "
                                       "read together (a run-up and a hammer test per struck point)"},
         "min_confidence": {"type": "number", "minimum": 0, "maximum": 1},
+        "lscf": {"type": "boolean", "description": "also fit the hammer-test records named in modes_from together by the "
+                                                   "poly-reference LSCF method (close modes one FRF hump hides; default false)"},
         "objectives": {"type": "array", "minItems": 1, "uniqueItems": True,
                        "items": {"enum": ["waveform", "correlation", "frequencies", "modes"]}},
         "algorithm": {"enum": ["mogoa", "nsga2"]},

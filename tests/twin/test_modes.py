@@ -134,9 +134,9 @@ def test_a_quantised_encoder_gives_the_same_survey(runup):
 
 def test_hammer_tests_fitted_together_split_the_hump_of_a_close_pair(hammer_factory, tmp_path, capsys):
     """Two struck points x two sensors: every FRF shows the shaft's close pair (584, 597 Hz, alike at
-    the sensors, unlike at the struck points) as one hump, which the peak survey reads as one mode
-    between them; the LSCF fit of the four FRFs splits it into the two, with its evidence, and
-    ``--no-lscf`` leaves the hump as it was."""
+    the sensors, unlike at the struck points) as one hump, which the peak survey (the default) reads
+    as one mode between them; the LSCF fit of the four FRFs (opt-in) splits it into the two, with
+    its evidence."""
     modes = ((584.0, 0.02), (597.0, 0.02), (900.0, 0.02), (1200.0, 0.01))
     shapes = np.array([[1.0, 0.8], [0.8, 1.0], [0.5, 0.7], [-0.6, 0.4]])
     part = np.array([[1.0, 0.8], [0.8, -1.0], [0.8, 0.6], [0.5, -0.9]])
@@ -150,15 +150,15 @@ def test_hammer_tests_fitted_together_split_the_hump_of_a_close_pair(hammer_fact
     write_measurements(records, h5)
     names = ["hammer_a", "hammer_b"]
     pair = lambda s: [m for m in s.modes if 575 < m.frequency < 606 and m.confidence >= 0.3]   # noqa: E731
-    alone = pair(survey_file(h5, names, lscf=False))
-    together = survey_file(h5, names)
+    alone = pair(survey_file(h5, names))
+    together = survey_file(h5, names, lscf=True)
     assert len(alone) == 1 and 586 < alone[0].frequency < 595
     found = pair(together)
     assert len(found) == 2 and all(abs(m.frequency - fn) < 0.003 * fn for m, fn in zip(found, (584.0, 597.0)))
     assert all(m.evidence["found_by"] == "lscf" and m.evidence["records"] == names
                and m.evidence["replaces_hz"] == round(alone[0].frequency, 2) for m in found)
     assert any("1 hump(s) split into close modes" in n for n in together.notes)
-    assert main(["modes", str(h5), "--record", "hammer_a", "--record", "hammer_b"]) == 0
+    assert main(["modes", str(h5), "--record", "hammer_a", "--record", "hammer_b", "--lscf"]) == 0
     assert "stable pole of a poly-reference LSCF fit" in capsys.readouterr().out
-    assert main(["modes", str(h5), "--record", "hammer_a", "--record", "hammer_b", "--no-lscf"]) == 0
+    assert main(["modes", str(h5), "--record", "hammer_a", "--record", "hammer_b"]) == 0
     assert "LSCF" not in capsys.readouterr().out

@@ -7,6 +7,7 @@ Scenario block (every key but ``parameters`` optional)::
       modes_from: runup           # record whose run-up (or hammer test) gives the measured modes;
                                   # or a list read together: [runup, hammer_pinion, hammer_gear]
       min_confidence: 0.3         # modes of that record used for calibration
+      lscf: false                 # also fit the hammer records together by poly-reference LSCF
       natural_frequencies: [22, 87, 218, 430]   # or typed by hand [Hz]
       foundation_modes: [13, 41]  # removed from the measured modes (paper: hammer test), in Hz
                                   #   or the name of a hammer-test record to read them from
@@ -141,7 +142,7 @@ def measured_modes(spec: dict, mset, source: str, out_dir: Path, *, with_damping
             if name not in mset.names:
                 raise ScenarioError([(source, "calibration.modes_from",
                                       f"no record {name!r} in the measurements (they have {', '.join(mset.names)})")])
-        survey = survey_records(mset, names)
+        survey = survey_records(mset, names, lscf=spec.get("lscf"))
         label = f"record {names[0]!r}" if len(names) == 1 else "records " + ", ".join(map(repr, names))
         write_survey_json(survey, out_dir / "modes.json", record=names[0] if len(names) == 1 else names)
         threshold = float(spec.get("min_confidence", MIN_CONFIDENCE))

@@ -158,7 +158,7 @@ def _add_modes_parser(sub) -> None:
                         "of different shapes (frequency-domain decomposition; default: on)")
     p.add_argument("--lscf", action=argparse.BooleanOptionalAction, default=None,
                    help="fit the hammer records' FRFs (every struck point and channel) together by the poly-reference "
-                        "LSCF method for modes whose humps overlap (default: on)")
+                        "LSCF method for modes whose humps overlap (default: off)")
     p.add_argument("--min-confidence", type=float, default=0.3,
                    help="confidence a mode needs to be used for calibration (default: 0.3)")
     p.add_argument("--json", type=Path, help="write the modes, lines and orders here")

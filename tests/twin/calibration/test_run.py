@@ -138,6 +138,27 @@ def test_foundation_modes_read_from_a_hammer_record(tmp_path):
     assert not (tmp_path / "o").exists()
 
 
+def test_lscf_in_the_block_fits_the_hammer_records_together(gearbox_fmu, tmp_path):
+    """``calibration.lscf: true`` reads the modes of the hammer records named in modes_from with the
+    poly-reference LSCF fit as well (its note in modes.json); a non-boolean is refused by name."""
+    from twin.calibration.run import measured_modes
+    from twin.measurements import MeasurementSet
+
+    mset = MeasurementSet((_hammer("hammer_a"), _hammer("hammer_b", hits=5)))
+    spec = {"modes_from": ["hammer_a", "hammer_b"]}
+    (tmp_path / "plain").mkdir()
+    (tmp_path / "lscf").mkdir()
+    plain, _, _ = measured_modes(spec, mset, "s.yaml", tmp_path / "plain")
+    fitted, _, _ = measured_modes({**spec, "lscf": True}, mset, "s.yaml", tmp_path / "lscf")
+    notes = json.loads((tmp_path / "lscf" / "modes.json").read_text())["notes"]
+    assert any(n.startswith("LSCF fit of 2 hammer test(s) x 1 channel(s)") for n in notes)
+    assert not any("LSCF" in n for n in json.loads((tmp_path / "plain" / "modes.json").read_text())["notes"])
+    for fn in (87.0, 218.0, 512.0):
+        assert np.min(np.abs(plain - fn)) < 0.02 * fn and np.min(np.abs(fitted - fn)) < 0.02 * fn
+    with pytest.raises(ScenarioError, match=r"calibration\.lscf: 'yes' is not of type 'boolean'"):
+        _scenario(gearbox_fmu, lscf="yes")
+
+
 def test_foundation_from_overrides_the_block(gearbox_fmu):
     from twin.calibration.run import _block
 
