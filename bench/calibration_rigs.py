@@ -4,6 +4,7 @@
                                      [--model GearTwin.Gearbox21Shafts] [--pairing frequency]
                                      [--visibility mesh] [--fit follow] [--hammer]
                                      [--hammer-at default] [--hammer-from above] [--lscf]
+                                     [--hammer-rate 4] [--hammer-duration 8]
                                      [--out bench_out/calibration_rigs]
 
 For each rig and seed: one gearbox with its base parameters scattered +-12 %
@@ -207,7 +208,8 @@ def _nearest(values, f):
 
 def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str, pairing: str = "frequency",
                 visibility: str = "mesh", fit: str = "follow", hammer: bool = False,
-                hammer_at: str = "default", hammer_from: str = "above") -> dict:
+                hammer_at: str = "default", hammer_from: str = "above", hammer_rate: float = HAMMER_RATE,
+                hammer_duration: float = HAMMER_DURATION) -> dict:
     from spectral_distance import spectral_distance_report
 
     from fmu_build import build_fmu
@@ -223,13 +225,15 @@ def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str, p
     t = time.perf_counter()
     struck_at = (HAMMER if hammer_at == "default" else HAMMER_AT[hammer_at])[rig_name]
     tests = hammer_tests(struck_at, hammer_from) if hammer else ()
+    design = (hammer_rate, hammer_duration) != (HAMMER_RATE, HAMMER_DURATION)
     h5 = out / (f"{rig_name}_{seed}{('_hammer_' + '_'.join(struck_at)) * hammer}"
-                f"{'_both' * (hammer and hammer_from == 'both')}.h5")
+                f"{'_both' * (hammer and hammer_from == 'both')}"
+                f"{f'_{hammer_rate:g}per_s_{hammer_duration:g}s' * (hammer and design)}.h5")
     modes_from = ("runup",) + tuple(name for name, _, _ in tests)
     if not h5.exists():          # the records depend on the rig version and the seeds only
         steady = box.steady(speed=SPEED, load=LOAD, duration=2.0, seed=seed, name="steady")
         runup = box.runup(speeds=(2.0, SPEED), load=LOAD, duration=6.0, seed=seed, name="runup")
-        struck = [box.impact(speed=HAMMER_SPEED, load=LOAD, duration=HAMMER_DURATION, impacts_per_second=HAMMER_RATE,
+        struck = [box.impact(speed=HAMMER_SPEED, load=LOAD, duration=hammer_duration, impacts_per_second=hammer_rate,
                              location=loc, seed=seed, name=name, direction=d) for name, loc, d in tests]
         rigmod.write(h5, [steady, runup, *struck])
     rig_wall = time.perf_counter() - t
@@ -315,6 +319,11 @@ def main() -> None:
     ap.add_argument("--hammer-from", choices=tuple(HAMMER_FROM), default="above",
                     help="with --hammer: blows from above at each struck point, or from above and from the side")
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--hammer-rate", type=float, default=HAMMER_RATE,
+                    help="with --hammer: blows per second (gamma-distributed intervals; the FRF's segment is 95 %% of "
+                         "their lower quartile, so fewer blows give a finer resolution)")
+    ap.add_argument("--hammer-duration", type=float, default=HAMMER_DURATION,
+                    help="with --hammer: length [s] of each hammer record")
     ap.add_argument("--lscf", action=argparse.BooleanOptionalAction, default=None,
                     help="also fit the hammer records' FRFs together by the poly-reference LSCF method (twin.modes.LSCF, "
                          "default off; scored on seeds 91-95 as the default, not adopted)")
@@ -345,7 +354,8 @@ def main() -> None:
         for seed in args.seeds:
             t = time.perf_counter()
             r = one_gearbox(rig, seed, args.out, args.workers, args.model, args.pairing, args.visibility,
-                            args.fit, args.hammer, args.hammer_at, args.hammer_from)
+                            args.fit, args.hammer, args.hammer_at, args.hammer_from, args.hammer_rate,
+                            args.hammer_duration)
             r["fit"] = args.fit
             r["load_after"] = os.getloadavg()
             r["first6_explained"] = explain_modes(rig, seed, r, args.out, args.visibility)
