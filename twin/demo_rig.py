@@ -66,6 +66,10 @@ def rig_calibration_demo(out_dir: Path, steady_file: Path, runup_file: Path, ham
                f"{mset['hammer'].nominal_speed or 0:g} Hz): {together.size} modes, "
                f"{len(added)} the run-up alone did not show ({', '.join(f'{f:.0f}' for f in added) or 'none'} Hz); "
                f"{both.notes[-1] if both.notes else ''}")
+        from twin.modes import with_lscf
+        fitted = with_lscf(both, [mset["hammer"]])
+        _lines(f"twin modes ... --lscf (the hammer FRFs also fitted by poly-reference LSCF, an opt-in): "
+               f"{fitted.notes[-1]}")
     scenario_file = d / "scenario.yaml"
     scenario_file.write_text(json.dumps({
         "version": 1, "name": "pedestal-rig", "fmu": "GearTwin.Gearbox21Measured", "stop_time": 2.0,
