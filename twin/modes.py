@@ -235,8 +235,60 @@ def survey_records(mset, names, **kwargs) -> ModalSurvey:
         modes.append(replace(m, evidence={**m.evidence, "records": seen}))
     method = "+".join(dict.fromkeys(s.method for s in surveys))
     merged = replace(merged, modes=tuple(modes), method=method, channels=tuple(dict.fromkeys(merged.channels)))
-    return with_lscf(merged, hammer, kwargs.get("channels"), kwargs.get("fmin"), kwargs.get("fmax")) \
-        if lscf and hammer else merged
+    if lscf and hammer:
+        merged = with_lscf(merged, hammer, kwargs.get("channels"), kwargs.get("fmin"), kwargs.get("fmax"))
+    return with_struck_levels(merged, hammer, kwargs.get("channels"))
+
+
+def _hammer_matrix(records, channels=None):
+    """``(f, H, coherence, f_tip, channels)`` of the hammer ``records`` together
+    (:func:`twin.signals.impact.hammer_frf_matrix`: every record one struck point, every vibration
+    channel they share one sensor), or a string saying why they cannot be read together."""
+    from twin.signals._checks import SignalError
+    from twin.signals.impact import hammer_frf_matrix
+
+    vib = [c for c in (channels or records[0].channel_names)
+           if c in records[0] and records[0].units[c] in VIBRATION_UNITS and c != records[0].tachometer]
+    common = [c for c in vib if all(c in r for r in records)]
+    fs = {r.sample_rate for r in records}
+    if not common or len(fs) != 1:
+        return "no vibration channel common to all" if not common else "their sample rates differ"
+    try:
+        f, H, coh, top = hammer_frf_matrix([(r[_force_channel(r)], [r[c] for c in common]) for r in records],
+                                           fs.pop())
+    except SignalError as exc:
+        return str(exc)
+    return f, H, coh, top, common
+
+
+def with_struck_levels(survey: ModalSurvey, records, channels=None) -> ModalSurvey:
+    """The survey with each mode's response to each struck point (``evidence["struck_db"]``).
+
+    Two or more hammer ``records`` struck at different points: for each mode in their band, the
+    r.m.s. FRF magnitude over the shared sensors and the bins of its hump (half-power half-width,
+    at least one bin each side) per record, in dB re the record that excites it most. Where a mode
+    is struck tells whose mode it is (a shaft's mode answers a blow at that shaft's end), which
+    the sensors on the casing alone may not (docs/calibration.md). Frequencies are not changed;
+    records that cannot be read together leave the survey as it is, with a note."""
+    if len(records) < 2:
+        return survey
+    matrix = _hammer_matrix(records, channels)
+    if isinstance(matrix, str):
+        return replace(survey, notes=survey.notes + (f"struck-point levels not read: {matrix}",))
+    f, H, _, top, _ = matrix
+    df = float(f[1] - f[0])
+    power = np.mean(np.abs(H) ** 2, axis=1)                                      # (n_f, n_records)
+    modes = []
+    for m in survey.modes:
+        if not 4 * df <= m.frequency <= top:
+            modes.append(m)
+            continue
+        half = max(df, m.frequency * (m.damping if np.isfinite(m.damping) else 0.0))
+        band = (f >= m.frequency - half) & (f <= m.frequency + half)
+        level = 10 * np.log10(np.maximum(power[band].mean(axis=0), np.finfo(float).tiny))
+        modes.append(replace(m, evidence={**m.evidence, "struck_db": {r.name: round(float(v - level.max()), 1)
+                                                                      for r, v in zip(records, level)}}))
+    return replace(survey, modes=tuple(modes))
 
 
 def with_lscf(survey: ModalSurvey, records, channels=None, fmin: float | None = None,
@@ -255,22 +307,14 @@ def with_lscf(survey: ModalSurvey, records, channels=None, fmin: float | None = 
     10 kHz). A set of records whose FRFs cannot be formed together (different sample rates, no
     common channel) is fitted no further: the survey is returned with a note saying why.
     """
-    from twin.signals._checks import SignalError
-    from twin.signals.impact import hammer_frf_matrix, local_floor
+    from twin.signals.impact import local_floor
     from twin.signals.lscf import lscf_modes
 
-    vib = [c for c in (channels or records[0].channel_names)
-           if c in records[0] and records[0].units[c] in VIBRATION_UNITS and c != records[0].tachometer]
-    common = [c for c in vib if all(c in r for r in records)]
-    fs = {r.sample_rate for r in records}
-    if not common or len(fs) != 1:
-        why = "no vibration channel common to all" if not common else "their sample rates differ"
-        return replace(survey, notes=survey.notes + (f"hammer tests not fitted together by LSCF: {why}",))
-    fs = fs.pop()
-    try:
-        f, H, coh, top = hammer_frf_matrix([(r[_force_channel(r)], [r[c] for c in common]) for r in records], fs)
-    except SignalError as exc:
-        return replace(survey, notes=survey.notes + (f"hammer tests not fitted together by LSCF: {exc}",))
+    matrix = _hammer_matrix(records, channels)
+    if isinstance(matrix, str):
+        return replace(survey, notes=survey.notes + (f"hammer tests not fitted together by LSCF: {matrix}",))
+    f, H, coh, top, common = matrix
+    fs = records[0].sample_rate
     df = float(f[1] - f[0])
     lo = float(4 * df if fmin is None else fmin)
     hi = float(min(0.4 * fs, 10_000.0, top) if fmax is None else fmax)
@@ -351,6 +395,8 @@ def survey_table(survey: ModalSurvey, min_confidence: float = MIN_CONFIDENCE) ->
             bits.append(shape_text(ev["shape"]))
         if ev.get("records"):
             bits.append(f"seen in {', '.join(ev['records'])}")
+        if ev.get("struck_db"):
+            bits.append("struck: " + ", ".join(f"{r} {v:+.1f} dB" for r, v in ev["struck_db"].items()))
         damping = f"{m.damping:7.4f}" if np.isfinite(m.damping) else "    n/a"
         rows.append(f"{mark}{m.frequency:10.2f}  {damping}  {m.confidence:10.2f}  {'; '.join(b for b in bits if b)}")
     if not survey.modes:

@@ -158,7 +158,30 @@ def test_hammer_tests_fitted_together_split_the_hump_of_a_close_pair(hammer_fact
     assert all(m.evidence["found_by"] == "lscf" and m.evidence["records"] == names
                and m.evidence["replaces_hz"] == round(alone[0].frequency, 2) for m in found)
     assert any("1 hump(s) split into close modes" in n for n in together.notes)
+    # where each isolated mode is struck hardest: |participation| 0.8 / 0.6 at 900 Hz, 0.5 / 0.9 at 1200 Hz
+    struck = {round(m.frequency, -2): m.evidence["struck_db"] for m in together.modes if m.frequency > 800}
+    assert struck[900.0]["hammer_a"] == 0.0 and abs(struck[900.0]["hammer_b"] - 20 * np.log10(0.6 / 0.8)) < 1.0
+    assert struck[1200.0]["hammer_b"] == 0.0 and abs(struck[1200.0]["hammer_a"] - 20 * np.log10(0.5 / 0.9)) < 1.0
     assert main(["modes", str(h5), "--record", "hammer_a", "--record", "hammer_b", "--lscf"]) == 0
-    assert "stable pole of a poly-reference LSCF fit" in capsys.readouterr().out
+    printed = capsys.readouterr().out
+    assert "stable pole of a poly-reference LSCF fit" in printed and "struck: hammer_a +0.0 dB, hammer_b" in printed
     assert main(["modes", str(h5), "--record", "hammer_a", "--record", "hammer_b"]) == 0
     assert "LSCF" not in capsys.readouterr().out
+
+
+def test_hammer_records_that_cannot_be_read_together_say_why(hammer_factory, tmp_path):
+    """Two hammer records at different sample rates: each is surveyed, the struck-point levels and
+    the LSCF fit are left out with a note naming why; nothing else changes."""
+    modes = ((900.0, 0.02), (1200.0, 0.01))
+    records = []
+    for r, (name, fs) in enumerate((("hammer_a", 10_000.0), ("hammer_b", 8_000.0))):
+        force, ys = hammer_factory(modes, [np.array([1.0, 0.5])], fs, 4.0, seed=r)
+        records.append(Record(name, {"hammer": force, "accel_pinion_casing": ys[0]},
+                              {"hammer": "N", "accel_pinion_casing": "m"}, fs))
+    h5 = tmp_path / "hammer.h5"
+    write_measurements(records, h5)
+    survey = survey_file(h5, ["hammer_a", "hammer_b"], lscf=True)
+    assert "struck-point levels not read: their sample rates differ" in survey.notes
+    assert "hammer tests not fitted together by LSCF: their sample rates differ" in survey.notes
+    assert all("struck_db" not in m.evidence for m in survey.modes)
+    assert np.any(np.abs(survey.frequencies(0.3) - 900.0) < 9.0) and np.any(np.abs(survey.frequencies(0.3) - 1200.0) < 12.0)
