@@ -235,9 +235,12 @@ def survey_records(mset, names, **kwargs) -> ModalSurvey:
         modes.append(replace(m, evidence={**m.evidence, "records": seen}))
     method = "+".join(dict.fromkeys(s.method for s in surveys))
     merged = replace(merged, modes=tuple(modes), method=method, channels=tuple(dict.fromkeys(merged.channels)))
-    if lscf and hammer:
-        merged = with_lscf(merged, hammer, kwargs.get("channels"), kwargs.get("fmin"), kwargs.get("fmax"))
-    return with_struck_levels(merged, hammer, kwargs.get("channels"))
+    if not (hammer and (lscf or len(hammer) > 1)):
+        return merged
+    matrix = _hammer_matrix(hammer, kwargs.get("channels"))      # read once for both
+    if lscf:
+        merged = _with_lscf(merged, hammer, matrix, kwargs.get("fmin"), kwargs.get("fmax"))
+    return _with_struck_levels(merged, hammer, matrix)
 
 
 def _hammer_matrix(records, channels=None):
@@ -270,9 +273,12 @@ def with_struck_levels(survey: ModalSurvey, records, channels=None) -> ModalSurv
     is struck tells whose mode it is (a shaft's mode answers a blow at that shaft's end), which
     the sensors on the casing alone may not (docs/calibration.md). Frequencies are not changed;
     records that cannot be read together leave the survey as it is, with a note."""
+    return _with_struck_levels(survey, records, _hammer_matrix(records, channels) if len(records) > 1 else "")
+
+
+def _with_struck_levels(survey: ModalSurvey, records, matrix) -> ModalSurvey:
     if len(records) < 2:
         return survey
-    matrix = _hammer_matrix(records, channels)
     if isinstance(matrix, str):
         return replace(survey, notes=survey.notes + (f"struck-point levels not read: {matrix}",))
     f, H, _, top, _ = matrix
@@ -307,10 +313,13 @@ def with_lscf(survey: ModalSurvey, records, channels=None, fmin: float | None = 
     10 kHz). A set of records whose FRFs cannot be formed together (different sample rates, no
     common channel) is fitted no further: the survey is returned with a note saying why.
     """
+    return _with_lscf(survey, records, _hammer_matrix(records, channels), fmin, fmax)
+
+
+def _with_lscf(survey: ModalSurvey, records, matrix, fmin: float | None, fmax: float | None) -> ModalSurvey:
     from twin.signals.impact import local_floor
     from twin.signals.lscf import lscf_modes
 
-    matrix = _hammer_matrix(records, channels)
     if isinstance(matrix, str):
         return replace(survey, notes=survey.notes + (f"hammer tests not fitted together by LSCF: {matrix}",))
     f, H, coh, top, common = matrix
