@@ -44,7 +44,7 @@ FREQ_TOL = 0.005
 DAMP_TOL = 0.10
 #: Share of the diagram's orders a group of stable poles must be seen at to be a mode.
 MIN_STABLE = 0.4
-#: Width of one sub-band (upper / lower edge) and the overlap of neighbours (as a ratio).
+#: Width of one sub-band, as the ratio of its upper to its lower edge.
 BAND_RATIO = 1.6
 #: Damping ratios outside (0, MAX_DAMPING] are not structural modes of a gearbox.
 MAX_DAMPING = 0.15
