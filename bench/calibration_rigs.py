@@ -81,8 +81,14 @@ def hammer_tests(struck_at, hammer_from: str) -> tuple[tuple[str, str, str], ...
                  for loc in struck_at for d in HAMMER_FROM[hammer_from])
 
 
+def struck_shafts(tests) -> dict[str, str]:
+    """``calibration.struck_shafts`` of the hammer ``tests`` (:func:`hammer_tests`): a blow at the
+    pinion's support or shaft end strikes the input shaft, at the gear's the output shaft."""
+    return {name: "input" if loc.startswith("pinion") else "output" for name, loc, _ in tests}
+
+
 def _scenario(path: Path, fs: float, workers: int, model: str, pairing: str = "frequency",
-              visibility: str = "mesh", fit: str = "follow", modes_from=("runup",)) -> Path:
+              visibility: str = "mesh", fit: str = "follow", modes_from=("runup",), struck=None) -> Path:
     path.write_text(json.dumps({
         "version": 1, "name": "rig-calibration", "fmu": model, "stop_time": 2.0,
         "output": {"sample_rate": fs, "variables": [CHANNEL]},
@@ -91,7 +97,7 @@ def _scenario(path: Path, fs: float, workers: int, model: str, pairing: str = "f
         "calibration": {"parameters": "auto", "modes_from": modes_from[0] if len(modes_from) == 1 else list(modes_from),
                         "record": "steady",
                         "pop_size": 12, "n_gen": 6, "pairing": pairing, "visibility": visibility,
-                        "fit": fit}}, indent=2))
+                        "fit": fit, **({"struck_shafts": struck} if struck else {})}}, indent=2))
     return path
 
 
@@ -209,7 +215,7 @@ def _nearest(values, f):
 def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str, pairing: str = "frequency",
                 visibility: str = "mesh", fit: str = "follow", hammer: bool = False,
                 hammer_at: str = "default", hammer_from: str = "above", hammer_rate: float = HAMMER_RATE,
-                hammer_duration: float = HAMMER_DURATION) -> dict:
+                hammer_duration: float = HAMMER_DURATION, name_shafts: bool = False) -> dict:
     from spectral_distance import spectral_distance_report
 
     from fmu_build import build_fmu
@@ -249,7 +255,8 @@ def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str, p
     rec_err = [abs(f - _nearest(extracted, f)) / f for f in observable]
 
     scenario = load_scenario(_scenario(out / f"{rig_name}_{seed}.yaml", float(load_measurements(h5)[0].sample_rate),
-                                       workers, model, pairing, visibility, fit, modes_from))
+                                       workers, model, pairing, visibility, fit, modes_from,
+                                       struck_shafts(tests) if name_shafts and tests else None))
     t0 = time.perf_counter()
     report = run_calibration(scenario, h5, out / f"{rig_name}_{seed}_cal", progress=False)
     t_cal = time.perf_counter() - t0
@@ -327,12 +334,17 @@ def main() -> None:
     ap.add_argument("--lscf", action=argparse.BooleanOptionalAction, default=None,
                     help="also fit the hammer records' FRFs together by the poly-reference LSCF method (twin.modes.LSCF, "
                          "default off; scored on seeds 91-95 as the default, not adopted)")
+    ap.add_argument("--struck-shafts", action="store_true",
+                    help="with --hammer: name the shaft each hammer record strikes (calibration.struck_shafts), so "
+                         "that no measured mode is paired with a model mode on the other shaft")
     ap.add_argument("--out", type=Path, default=REPO / "bench_out" / "calibration_rigs")
     ap.add_argument("--explain", action="store_true",
                     help="only the per-mode analysis of the results already in --out (no new scoring)")
     args = ap.parse_args()
     if args.hammer_at != "default" and set(args.rigs) - set(HAMMER_AT[args.hammer_at]):
         ap.error(f"--hammer-at {args.hammer_at}: only {', '.join(HAMMER_AT[args.hammer_at])} can be struck there")
+    if args.struck_shafts and not args.hammer:
+        ap.error("--struck-shafts needs --hammer")
     if args.hammer_from != "above" and not args.hammer:
         ap.error(f"--hammer-from {args.hammer_from} needs --hammer")
     args.out.mkdir(parents=True, exist_ok=True)
@@ -355,7 +367,7 @@ def main() -> None:
             t = time.perf_counter()
             r = one_gearbox(rig, seed, args.out, args.workers, args.model, args.pairing, args.visibility,
                             args.fit, args.hammer, args.hammer_at, args.hammer_from, args.hammer_rate,
-                            args.hammer_duration)
+                            args.hammer_duration, args.struck_shafts)
             r["fit"] = args.fit
             r["load_after"] = os.getloadavg()
             r["first6_explained"] = explain_modes(rig, seed, r, args.out, args.visibility)

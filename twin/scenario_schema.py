@@ -55,6 +55,11 @@ CALIBRATION_SCHEMA: dict[str, Any] = {
                                  {"type": "array", "items": {"type": "string"}, "minItems": 1, "uniqueItems": True}],
                        "description": "record (run-up or hammer test) the measured modes are read from, or several "
                                       "read together (a run-up and a hammer test per struck point)"},
+        "struck_shafts": {"type": "object", "minProperties": 2,
+                          "additionalProperties": {"enum": ["input", "output"]},
+                          "description": "the shaft each hammer record of modes_from strikes (record name: input or "
+                                         "output, one of each at least): a measured mode struck louder on one shaft "
+                                         "is never paired with a model mode that lives on the other"},
         "min_confidence": {"type": "number", "minimum": 0, "maximum": 1},
         "lscf": {"type": "boolean", "description": "also fit the hammer-test records named in modes_from together by the "
                                                    "poly-reference LSCF method (close modes one FRF hump hides; default false)"},

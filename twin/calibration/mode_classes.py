@@ -64,6 +64,11 @@ CLASSES = ("torsion", "pinion lateral x", "pinion lateral y", "gear lateral x", 
            "input pedestals x", "input pedestals y", "output pedestals x", "output pedestals y",
            "input shaft ends x", "input shaft ends y", "output shaft ends x", "output shaft ends y", "casing",
            "sensor path")
+#: The lateral classes of each shaft (all of the shaft's bodies, both planes): a blow at one shaft's
+#: end or bearing support answers in the modes whose lateral motion is on that shaft
+#: (:func:`side_levels`).
+SIDES = {"input": ("pinion lateral", "input pedestals", "input shaft ends"),
+         "output": ("gear lateral", "output pedestals", "output shaft ends")}
 #: A mode counts as the sensor path's own when the structure carries less than this share of the
 #: velocity (unweighted) of the mode: the path's modes do not act back, so the structure is still.
 SENSOR_PATH_SHARE = 1e-6
@@ -133,6 +138,28 @@ def classify(shapes: np.ndarray, table: Sequence[tuple[int, str, float]]) -> lis
         total = sum(energy.values()) or 1.0
         shares = {c: e / total for c, e in energy.items() if e > 0}
         out.append(ModeClass(_name(shares), shares))
+    return out
+
+
+def side_levels(shapes: np.ndarray, table: Sequence[tuple[int, str, float]]) -> np.ndarray:
+    """(m,) where each mode (column of ``shapes``, (n_states, m)) moves: the largest lateral
+    velocity on the input shaft's bodies over the largest on the output shaft's, in dB
+    (:data:`SIDES`; NaN where a shaft has no such state or neither moves).
+
+    Unweighted amplitudes, not energies: a hammer's response at a point is the mode's amplitude
+    there (by reciprocity the ratio of two struck points' FRFs at a lone mode is the ratio of the
+    mode's amplitudes at them, whatever the sensor), and the gear's larger mass would otherwise
+    tilt every mode towards the output shaft."""
+    def side(name):
+        return np.array([i for i, c, _ in table if c.rsplit(" ", 1)[0] in SIDES[name]], dtype=int)
+
+    a, b = side("input"), side("output")
+    out = np.full(shapes.shape[1], np.nan)
+    if a.size == 0 or b.size == 0:
+        return out
+    amp_a, amp_b = np.abs(shapes[a]).max(axis=0), np.abs(shapes[b]).max(axis=0)
+    ok = (amp_a > 0) & (amp_b > 0)
+    out[ok] = 20 * np.log10(amp_a[ok] / amp_b[ok])
     return out
 
 

@@ -77,6 +77,7 @@ class ModelModes:
     channels: tuple[str, ...] = ()
     visible_by: Mapping[str, np.ndarray] = field(default_factory=dict)   # excitation -> (m,) bool
     visibility: str = "mesh"      # the rule that made ``visible`` (VISIBILITY)
+    side_db: np.ndarray | None = None   # (m,) input over output shaft's largest lateral amplitude [dB]
 
     def sensor_shape(self, i: int, channels: Sequence[str]) -> np.ndarray:
         """Mode i's residues at ``channels`` (those it was linearised with; 0 for others), (len,)."""
@@ -104,7 +105,7 @@ def model_modes(fmu_path, parameters: Mapping[str, float], *, speed_hz: float, l
     ``visible_by``): with the default rule the fit's many linearisations need the mesh column alone."""
     from scipy.signal import find_peaks
 
-    from twin.calibration.mode_classes import classify, dof_table, mass_values
+    from twin.calibration.mode_classes import classify, dof_table, mass_values, side_levels
     from twin.linearize import frequency_response, linear_model, modal_model
     from twin.operating import operating_point
 
@@ -150,7 +151,8 @@ def model_modes(fmu_path, parameters: Mapping[str, float], *, speed_hz: float, l
     top = gain[visible].max() if visible.any() else (gain.max() if gain.size else 1.0)
     table = dof_table(lm.state_names, masses)
     return ModelModes(freq, damp, visible, shapes, 20 * np.log10(np.maximum(gain, 1e-300) / top),
-                      tuple(classify(shapes, table)), mm.residues[:, 0, keep], tuple(channels), by, visibility)
+                      tuple(classify(shapes, table)), mm.residues[:, 0, keep], tuple(channels), by, visibility,
+                      side_levels(shapes, table))
 
 
 #: A mode that dominates the response at its own frequency is visible only if its own peak there is

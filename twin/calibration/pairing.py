@@ -41,10 +41,21 @@ shape at the casing sensors must look like the measured one.
   :func:`twin.calibration.sensor_path.casing_path`); :func:`shape_refusals` lists them.
 * **Assignment.** One-to-one with least total cost (Hungarian algorithm); a measured mode is left
   unpaired at cost :data:`UNPAIRED`, more than any feasible pairing.
+
+**Which shaft** (both rules, when hammer records struck on each shaft name their shaft,
+``calibration.struck_shafts``). A mode answers a blow where it moves: its response to the blows on
+the input shaft over those on the output shaft (``evidence["struck_db"]`` of ``twin modes``) says on
+which shaft it lives, and the model mode's largest lateral amplitude on the input shaft over the
+output shaft's (``ModelModes.side_db``, :func:`twin.calibration.mode_classes.side_levels`) says the
+same of the model's. A pairing is refused when both say, by :data:`SIDE_DB` or more, that the two
+modes live on different shafts (:func:`side_refused`): the frequency order alone gave the rigs' gear
+shaft modes the twin's input shaft mode, and the fit then drove that shaft's bearing to its bound.
+A mode that lives on both shafts (within :data:`SIDE_DB` either side) or that the hammers did not
+reach is paired as before.
 """
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -66,6 +77,12 @@ UNPAIRED = 3.0
 REFUSE_COHERENCE = 0.8
 #: A well-measured shape is never paired with a model mode whose shape differs more than this (1 - MAC).
 REFUSE_MISMATCH = 0.5
+#: A mode lives on one shaft when it answers blows there, or moves there, this much more than on the
+#: other [dB]: twice the amplitude, well beyond the few dB a neighbouring mode's tail or a coherence
+#: of 0.7 puts on a struck-point level.
+SIDE_DB = 6.0
+#: The shafts a hammer record may be struck on (``calibration.struck_shafts``).
+SHAFTS = ("input", "output")
 
 
 @dataclass(frozen=True)
@@ -79,10 +96,15 @@ class MeasuredShapes:
     channels: tuple[str, ...]
     vectors: np.ndarray
     coherence: np.ndarray
+    side_db: np.ndarray | None = None     # (k,) input over output shaft's struck level [dB], NaN where unknown
 
     @classmethod
-    def from_evidence(cls, evidence: Sequence[dict]) -> "MeasuredShapes | None":
-        """From the modes' ``evidence["shape"]`` (``twin modes`` JSON); None when no mode has one."""
+    def from_evidence(cls, evidence: Sequence[dict], struck_shafts: Mapping[str, str] | None = None,
+                      ) -> "MeasuredShapes | None":
+        """From the modes' ``evidence["shape"]`` and ``evidence["struck_db"]`` (``twin modes`` JSON);
+        ``struck_shafts`` maps hammer record names to the shaft struck (:data:`SHAFTS`). None when no
+        mode has a shape at two channels and no mode a struck level on each shaft."""
+        sides = struck_sides(evidence, struck_shafts or {})
         shaped = [e.get("shape") for e in evidence]
         names: list[str] = []
         for s in shaped:
@@ -90,7 +112,9 @@ class MeasuredShapes:
                 if c not in names:
                     names.append(c)
         if len(names) < 2:
-            return None
+            if sides is None:
+                return None
+            return cls((), np.full((len(evidence), 0), np.nan, complex), np.zeros(len(evidence)), sides)
         vec = np.full((len(shaped), len(names)), np.nan, complex)
         coh = np.zeros(len(shaped))
         for i, s in enumerate(shaped):
@@ -99,7 +123,32 @@ class MeasuredShapes:
             for c, v in s["channels"].items():
                 vec[i, names.index(c)] = 10 ** (v["level_db"] / 20) * np.exp(1j * np.radians(v["phase_deg"]))
             coh[i] = float(s.get("min_coherence", 0.0))
-        return cls(tuple(names), vec, coh)
+        return cls(tuple(names), vec, coh, sides)
+
+
+def struck_sides(evidence: Sequence[dict], struck_shafts: Mapping[str, str]) -> np.ndarray | None:
+    """(k,) each mode's loudest response to the blows on the input shaft over that on the output
+    shaft [dB] (from ``evidence["struck_db"]``, records named in ``struck_shafts``), NaN where a mode
+    has no level on both; None when no mode has."""
+    out = np.full(len(evidence), np.nan)
+    for i, e in enumerate(evidence):
+        levels = e.get("struck_db") or {}
+        by = {s: [v for r, v in levels.items() if struck_shafts.get(r) == s] for s in SHAFTS}
+        if all(by.values()):
+            out[i] = max(by["input"]) - max(by["output"])
+    return out if np.isfinite(out).any() else None
+
+
+def side_refused(model, shapes: MeasuredShapes | None, cols: np.ndarray) -> np.ndarray:
+    """(k, len(cols)) True where measured mode i and model mode ``cols[j]`` live on different shafts,
+    each by :data:`SIDE_DB` or more (see the module docstring); (1, len(cols)) all False, which
+    broadcasts, without struck levels."""
+    model_side = getattr(model, "side_db", None)
+    if shapes is None or shapes.side_db is None or model_side is None:
+        return np.zeros((1, cols.size), bool)
+    meas = np.nan_to_num(shapes.side_db)[:, None]
+    mod = np.nan_to_num(np.asarray(model_side, float)[cols])[None, :]
+    return ((meas >= SIDE_DB) & (mod <= -SIDE_DB)) | ((meas <= -SIDE_DB) & (mod >= SIDE_DB))
 
 
 @dataclass(frozen=True, eq=False)
@@ -192,7 +241,7 @@ def pairing_cost(model, measured: np.ndarray, rel_sd: np.ndarray, cols: np.ndarr
         return np.where(within, excess / MATCH_REACH, np.inf)
     raw = raw_mismatch(model, shapes, cols)       # once: it weighs the cost and decides refusals
     cost = excess / MATCH_REACH + SHAPE_WEIGHT * np.nan_to_num(shapes.coherence[:, None] * raw)
-    return np.where(within & ~_refusal(raw, shapes.coherence), cost, np.inf)
+    return np.where(within & ~_refusal(raw, shapes.coherence) & ~side_refused(model, shapes, cols), cost, np.inf)
 
 
 def _gap(model, measured: np.ndarray, rel_sd: np.ndarray, cols: np.ndarray, reach: np.ndarray | None):
@@ -260,9 +309,10 @@ def check_pairing(pairing: str) -> str:
     return pairing
 
 
-def pair_by_frequency(model, measured, rel_sd=None) -> np.ndarray:
+def pair_by_frequency(model, measured, rel_sd=None, shapes: MeasuredShapes | None = None) -> np.ndarray:
     """Index of the visible model mode paired with each measured mode by frequency alone, -1 where
-    none is within :data:`MATCH_REACH` (the default rule; see the module docstring)."""
+    none is within :data:`MATCH_REACH` (the default rule; see the module docstring); with the
+    measured modes' struck levels (``shapes.side_db``) never across shafts (:func:`side_refused`)."""
     from twin.calibration.sensitivity import MODEL_FORM
 
     measured = np.asarray(measured, float)
@@ -273,7 +323,7 @@ def pair_by_frequency(model, measured, rel_sd=None) -> np.ndarray:
         return out
     dist = np.abs(np.log(model.frequency[idx][None, :] / measured[:, None]))
     big = 1e6
-    cost = np.where(dist <= MATCH_REACH, dist / rel_sd[:, None], big)
+    cost = np.where((dist <= MATCH_REACH) & ~side_refused(model, shapes, idx), dist / rel_sd[:, None], big)
     # dummy columns: leaving a measured mode unpaired costs as much as twice the reach
     dummy = np.full((measured.size, measured.size), MATCH_REACH / rel_sd.min() * 2)
     rows, cols = linear_sum_assignment(np.hstack([cost, dummy]))

@@ -125,6 +125,24 @@ def _block(scenario, modes_from: str | None, pairing: str | None = None, foundat
     return spec
 
 
+def _struck_shafts(spec: dict, names, source: str) -> dict[str, str]:
+    """``calibration.struck_shafts`` checked against the records the modes are read from: every record
+    it names is one of them, and each shaft has one (a ScenarioError naming the value otherwise)."""
+    struck = dict(spec.get("struck_shafts") or {})
+    if not struck:
+        return struck
+    for name in struck:
+        if name not in names:
+            raise ScenarioError([(source, f"calibration.struck_shafts.{name}",
+                                  f"{name!r} is not one of the records the modes are read from (modes_from: "
+                                  f"{', '.join(names)})")])
+    for shaft in ("input", "output"):
+        if shaft not in struck.values():
+            raise ScenarioError([(source, "calibration.struck_shafts", f"no record struck on the {shaft} shaft: a "
+                                  "mode's shaft is read from blows on both")])
+    return struck
+
+
 def measured_modes(spec: dict, mset, source: str, out_dir: Path, *, with_damping: bool = False):
     """(frequencies [Hz], relative sd, description) of the measured modes the block asks for;
     with ``with_damping`` also their damping ratios (NaN where unknown), confidences, the
@@ -142,6 +160,7 @@ def measured_modes(spec: dict, mset, source: str, out_dir: Path, *, with_damping
             if name not in mset.names:
                 raise ScenarioError([(source, "calibration.modes_from",
                                       f"no record {name!r} in the measurements (they have {', '.join(mset.names)})")])
+        struck = _struck_shafts(spec, names, source)
         survey = survey_records(mset, names, lscf=spec.get("lscf"))
         label = f"record {names[0]!r}" if len(names) == 1 else "records " + ", ".join(map(repr, names))
         write_survey_json(survey, out_dir / "modes.json", record=names[0] if len(names) == 1 else names)
@@ -155,7 +174,7 @@ def measured_modes(spec: dict, mset, source: str, out_dir: Path, *, with_damping
         damping = np.array([m.damping for m in used])
         confidence = np.array([m.confidence for m in used])
         channels = tuple(survey.channels)
-        shapes = MeasuredShapes.from_evidence([m.evidence for m in used])
+        shapes = MeasuredShapes.from_evidence([m.evidence for m in used], struck)
         what = (f"{freqs.size} modes read from {label} ({survey.method}, confidence >= {threshold:g}; "
                 f"{len(survey.lines)} fixed lines and {len(survey.orders)} orders set aside)")
     elif spec.get("natural_frequencies"):
@@ -283,7 +302,7 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
     mode_channels = tuple(c for c in seen_by if c in outputs) or (channel,)
     target = CalibrationTarget(signal, sample_rate, speed_hz, load_nm, freqs, channel=channel, fmin=band[0],
                                fmax=band[1], objectives=objectives, mode_rel_sd=rel_sd, mode_channels=mode_channels,
-                               mode_shapes=shapes if len(mode_channels) > 1 and pairing == "shape" else None,
+                               mode_shapes=_pairing_shapes(shapes, len(mode_channels), pairing),
                                pairing=pairing, visibility=visibility, fit=fit,
                                search_budget=int(spec.get("search_budget", SEARCH_BUDGET)))
     fixed = dict(scenario.parameters)
@@ -479,5 +498,15 @@ def scenario_sensitivity(scenario, measurements: str | Path | None = None, *, mo
         freqs = mm.frequency[mm.visible][:n_modes]
         rel = np.zeros(freqs.size)
     return mode_sensitivity(fmu, values, freqs, speed_hz=speed_hz, load_nm=load_nm, rel_sd=rel, channels=channels,
-                            executor=executor, shapes=shapes if len(channels) > 1 else None, pairing=pairing,
+                            executor=executor, shapes=_pairing_shapes(shapes, len(channels), "shape"), pairing=pairing,
                             visibility=visibility)
+
+
+def _pairing_shapes(shapes, n_channels: int, pairing: str):
+    """What the pairing reads of the measured modes: their shapes at the sensors (shape pairing, two
+    channels or more) and their struck levels (either rule, when ``struck_shafts`` names them)."""
+    if shapes is None:
+        return None
+    if (pairing == "shape" and n_channels > 1) or shapes.side_db is not None:
+        return shapes
+    return None

@@ -29,6 +29,8 @@
    :data:`twin.calibration.pairing.MIN_LEVEL_DB`) give each its reach within the bounds, and the
    measured modes are paired by frequency, shape at the sensors and reach; a pairing whose shape
    is clearly wrong (well measured and unlike) is refused and listed (``refused_by_shape``).
+   Under either rule, when hammer records name the shaft they strike, a measured and a model mode
+   that live on different shafts are never paired; each measured mode left unpaired so is a note.
 4. **Identifiable subset** by QR with column pivoting on the weighted matrix
    ``S[i, j] * h_j / s_i`` (``h_j`` half the log-range of the bounds, ``s_i`` the relative
    uncertainty of mode i): a column is kept while the information it adds beyond the columns
@@ -49,7 +51,7 @@ from scipy.optimize import linear_sum_assignment
 from twin.calibration.model_modes import ModelModes, check_visibility, model_modes
 from twin.calibration.pairing import (MATCH_REACH, REFUSE_COHERENCE, REFUSE_MISMATCH, MeasuredShapes, Pairing,
                                       candidate_modes, check_pairing, mode_reach, pair_by_frequency, pair_modes,
-                                      shape_mismatch, shape_refusals)
+                                      shape_mismatch, shape_refusals, side_refused)
 
 #: (unit, words in the description, relative bounds [lower, upper] about the nominal, reason); the
 #: first rule whose unit matches and whose words (if any) occur in the description applies
@@ -144,11 +146,31 @@ def match_measured(model: ModelModes, measured: np.ndarray, rel_sd: np.ndarray |
                    reach: np.ndarray | None = None) -> np.ndarray:
     """Index of the model mode paired with each measured mode, -1 where none is: with
     ``pairing="frequency"`` the nearest visible model modes within 15 %
-    (:func:`twin.calibration.pairing.pair_by_frequency`; ``shapes`` and ``reach`` unused), with
-    ``"shape"`` by frequency, shape at the sensors and reach (:func:`twin.calibration.pairing.pair_modes`)."""
+    (:func:`twin.calibration.pairing.pair_by_frequency`; of ``shapes`` only the struck levels,
+    ``reach`` unused), with ``"shape"`` by frequency, shape at the sensors and reach
+    (:func:`twin.calibration.pairing.pair_modes`); with struck levels never across shafts."""
     if check_pairing(pairing) == "frequency":
-        return pair_by_frequency(model, measured, rel_sd)
+        return pair_by_frequency(model, measured, rel_sd, shapes)
     return pair_modes(model, measured, rel_sd, shapes=shapes, reach=reach)
+
+
+def side_notes(model: ModelModes, measured: np.ndarray, match: np.ndarray,
+               shapes: MeasuredShapes | None) -> list[str]:
+    """One note per measured mode left unpaired although a visible model mode was within 15 %, because
+    every such mode lives on the other shaft (:func:`twin.calibration.pairing.side_refused`)."""
+    if shapes is None or shapes.side_db is None or model.side_db is None:
+        return []
+    vis = np.flatnonzero(model.visible)
+    no = side_refused(model, shapes, vis)
+    out = []
+    for i in np.flatnonzero((match < 0) & no.any(axis=1)):
+        near = vis[no[i] & (np.abs(np.log(model.frequency[vis] / measured[i])) <= MATCH_REACH)]
+        if near.size:
+            j = near[np.argmin(np.abs(np.log(model.frequency[near] / measured[i])))]
+            out.append(f"measured {measured[i]:.0f} Hz (struck {shapes.side_db[i]:+.1f} dB input over output shaft) "
+                       f"not paired with the model's {model.frequency[j]:.0f} Hz mode ({model.side_db[j]:+.1f} dB): "
+                       "they live on different shafts")
+    return out
 
 
 def _mac(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -294,7 +316,8 @@ def mode_sensitivity(fmu_path, values: Mapping[str, float], measured_hz, *, spee
     base = model_modes(fmu_path, values, **kw, every_excitation=True)      # each column's visible modes reported
     notes = []
     if pairing == "frequency":      # paired before the runs: only the paired modes' sensitivities are needed
-        match = match_measured(base, measured, rel)
+        match = match_measured(base, measured, rel, shapes=shapes)
+        notes += side_notes(base, measured, match, shapes)
         if not (match >= 0).any():
             raise ValueError("no measured mode has a visible model mode within 15 %: the model and the record "
                              f"do not share a mode (measured {np.round(measured, 1).tolist()} Hz, visible model "
