@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from twin.calibration.mode_classes import classify, dof_table
+from twin.calibration.mode_classes import classify, dof_table, side_levels
 from twin.calibration.model_modes import model_modes
 
 NAMES = ("theta5", "omega5", "y10", "vy10", "x10", "vx10", "casing.q[1]", "casing.qd[1]",
@@ -41,3 +41,26 @@ def test_the_twins_modes_get_their_physical_class(measured_fmu):
     assert any(abs(f - 1000.0) < 1 for f in panels), by              # a panel of the sensor path (default 1 kHz)
     assert mm.sensor_shapes.shape == (2, mm.frequency.size)
     assert np.all(mm.sensor_shape(int(lowest), ("accel_gear_casing", "nope"))[1:] == 0)
+    # where each mode lives: a gear lateral mode on the output shaft, a pinion lateral mode on the input
+    named = {"gear lateral": [], "pinion lateral": [], "sensor path": []}
+    for c, side in zip(mm.classes, mm.side_db):
+        for prefix in named:
+            if c.name.startswith(prefix):
+                named[prefix].append(side)
+    assert named["gear lateral"] and max(named["gear lateral"]) < -6.0, named
+    assert named["pinion lateral"] and min(named["pinion lateral"]) > 6.0, named
+    assert named["sensor path"] and np.isnan(named["sensor path"]).all()      # the structure still: no side
+
+
+def test_which_shaft_a_mode_lives_on_from_the_unweighted_amplitudes():
+    names = ("vx5", "vy5", "vy4", "vx10", "vy10", "vy_end11", "omega5")
+    table = dof_table(names, {"m5": 0.6, "m10": 3.5, "m4": 2.0, "m_end11": 0.4, "I5": 1e-4})
+    v = np.zeros((len(names), 4), complex)
+    v[0, 0], v[3, 0] = 1.0, 0.1              # input 10 x the output: +20 dB (the gear's mass does not count)
+    v[5, 1], v[2, 1] = 2.0, 1.0j             # an overhung end on the output shaft: -6 dB
+    v[6, 2] = 1.0                            # torsion only: no lateral motion on either shaft
+    v[1, 3], v[4, 3] = 1.0, 1.0
+    assert np.allclose(side_levels(v, table)[[0, 1, 3]], [20.0, -20 * np.log10(2), 0.0])
+    assert np.isnan(side_levels(v, table)[2])
+    # a model with no output-shaft states has no side levels
+    assert np.isnan(side_levels(v[:3], dof_table(names[:3], {}))).all()

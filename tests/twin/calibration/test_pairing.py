@@ -3,13 +3,15 @@ frequency, shape at the sensors and reach (opt-in), refusing a well-measured sha
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
 from twin.calibration.modal_fit import mode_errors
-from twin.calibration.pairing import (MATCH_REACH, PAIRINGS, REFUSE_COHERENCE, REFUSE_MISMATCH, MeasuredShapes,
-                                      Pairing, mac, mode_reach, pair_modes, refused, shape_mismatch, shape_refusals)
+from twin.calibration.pairing import (MATCH_REACH, PAIRINGS, REFUSE_COHERENCE, REFUSE_MISMATCH, SHAFTS, SIDE_DB,
+                                      MeasuredShapes, Pairing, mac, mode_reach, pair_modes, refused, shape_mismatch,
+                                      shape_refusals, side_refused, struck_sides)
 from twin.calibration.model_modes import ModelModes
 from twin.calibration.sensitivity import Candidate, Sensitivity, match_measured
 from twin.scenario_schema import CALIBRATION_SCHEMA
@@ -222,3 +224,73 @@ def test_the_sensitivity_json_says_where_each_refused_mode_went():
     assert [r["goes_to"] for r in out["refused_by_shape"]] == ["sensor_path", "unpaired"]
     assert [r["goes_to"] for r in sens.to_dict(sensor_path_hz=[])["refused_by_shape"]] == ["unpaired"] * 2
     assert sens.refused[0].get("goes_to") is None                             # the record itself is not changed
+
+
+#: a model mode on each shaft: 1000 Hz on the input shaft (+20 dB), 1100 Hz on the output shaft (-20 dB),
+#: 1300 Hz on both (+2 dB)
+TWO_SHAFTS = dict(freqs=[1000.0, 1100.0, 1300.0], sensor=[[1.0, 1.0, 1.0], [1.0, 1.0, 1.0]], gain_db=[0.0, 0.0, 0.0],
+                  visible=[True, True, True])
+STRUCK = {"hammer_pinion": "input", "hammer_gear": "output"}
+
+
+def _sided(side_db):
+    return replace(_model(**TWO_SHAFTS), side_db=np.array(side_db, float))
+
+
+def test_a_modes_shaft_from_its_levels_per_struck_point():
+    evidence = [{"struck_db": {"hammer_pinion": 0.0, "hammer_gear": -9.5}},
+                {"struck_db": {"hammer_pinion": -12.0, "hammer_gear": 0.0, "hammer_other": 3.0}},
+                {"struck_db": {"hammer_pinion": 0.0}}, {}]
+    assert np.allclose(struck_sides(evidence, STRUCK)[:2], [9.5, -12.0])
+    assert np.isnan(struck_sides(evidence, STRUCK)[2:]).all()
+    # two records on one shaft: the louder counts
+    both = {**STRUCK, "hammer_pinion_side": "input"}
+    assert struck_sides([{"struck_db": {"hammer_pinion": -8.0, "hammer_pinion_side": -1.0, "hammer_gear": 0.0}}],
+                        both).tolist() == [-1.0]
+    assert struck_sides(evidence, {}) is None and struck_sides([{}], STRUCK) is None
+    # from one channel's evidence (no shapes) the struck levels alone make the record
+    shapes = MeasuredShapes.from_evidence(evidence, STRUCK)
+    assert shapes.channels == () and shapes.vectors.shape == (4, 0) and shapes.side_db[0] == pytest.approx(9.5)
+    assert MeasuredShapes.from_evidence(evidence) is None
+
+
+@pytest.mark.parametrize("pairing", PAIRINGS)
+def test_a_mode_struck_on_one_shaft_is_never_paired_with_a_model_mode_on_the_other(pairing):
+    model = _sided([20.0, -20.0, 2.0])
+    measured = np.array([1010.0])
+    # by frequency, 1010 Hz goes to the input shaft's 1000 Hz mode
+    assert match_measured(model, measured, pairing=pairing).tolist() == [0]
+    # struck 10 dB louder on the output shaft: the output shaft's mode at 1100 Hz (9 % off) instead
+    gear = MeasuredShapes((), np.zeros((1, 0), complex), np.zeros(1), np.array([-10.0]))
+    assert match_measured(model, measured, pairing=pairing, shapes=gear).tolist() == [1]
+    # struck on the input shaft: unchanged; alike on both (within SIDE_DB): unchanged
+    for side in (10.0, SIDE_DB - 0.5, -(SIDE_DB - 0.5)):
+        shapes = MeasuredShapes((), np.zeros((1, 0), complex), np.zeros(1), np.array([side]))
+        assert match_measured(model, measured, pairing=pairing, shapes=shapes).tolist() == [0]
+    # a model mode that lives on both shafts takes a mode struck on either
+    assert match_measured(model, np.array([1290.0]), pairing=pairing, shapes=gear).tolist() == [2]
+    # a model without side levels (another naming) pairs by frequency alone
+    assert match_measured(_model(**TWO_SHAFTS), measured, pairing=pairing, shapes=gear).tolist() == [0]
+
+
+def test_the_refusal_needs_both_sides_clear():
+    model = _sided([20.0, -SIDE_DB + 0.5, np.nan])
+    gear = MeasuredShapes((), np.zeros((2, 0), complex), np.zeros(2), np.array([-10.0, np.nan]))
+    assert side_refused(model, gear, np.arange(3)).tolist() == [[True, False, False], [False, False, False]]
+    assert side_refused(model, None, np.arange(3)).shape == (1, 3)
+    assert SHAFTS == ("input", "output")
+    assert set(CALIBRATION_SCHEMA["properties"]["struck_shafts"]["additionalProperties"]["enum"]) == set(SHAFTS)
+
+
+def test_a_mode_left_unpaired_for_its_shaft_is_a_note():
+    from twin.calibration.sensitivity import side_notes
+
+    model = replace(_sided([20.0, -20.0, 2.0]), visible=np.array([True, False, True]))
+    gear = MeasuredShapes((), np.zeros((2, 0), complex), np.zeros(2), np.array([-10.0, -10.0]))
+    measured = np.array([1010.0, 1295.0])
+    match = match_measured(model, measured, shapes=gear)
+    assert match.tolist() == [-1, 2]
+    (note,) = side_notes(model, measured, match, gear)
+    assert note.startswith("measured 1010 Hz (struck -10.0 dB input over output shaft) not paired with the "
+                           "model's 1000 Hz mode (+20.0 dB)")
+    assert side_notes(model, measured, match_measured(model, measured), None) == []

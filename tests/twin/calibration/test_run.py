@@ -209,3 +209,39 @@ def test_a_bad_list_of_modes_records_is_refused_by_the_schema(gearbox_fmu, bad):
     assert _block(_scenario(gearbox_fmu, modes_from=["runup", "hammer_a"]), None)["modes_from"] == ["runup", "hammer_a"]
     with pytest.raises(ScenarioError, match="calibration.modes_from"):
         _block(_scenario(gearbox_fmu, modes_from=bad), None)
+
+
+def test_struck_shafts_give_each_measured_mode_its_shaft(hammer_factory, gearbox_fmu, tmp_path):
+    """``calibration.struck_shafts``: two hammer records, one per shaft; the mode struck harder on the
+    input shaft's record gets a positive side level, the other a negative one (the pairing reads
+    them); a record outside modes_from, a shaft without a record or an unknown shaft is refused by name."""
+    from twin.calibration.run import measured_modes
+    from twin.measurements import MeasurementSet
+
+    modes = ((900.0, 0.02), (1200.0, 0.01))
+    part = np.array([[1.0, 0.25], [0.3, 1.0]])      # 900 Hz answers the pinion's blows, 1200 Hz the gear's
+    records = []
+    for r, name in enumerate(("hammer_pinion", "hammer_gear")):
+        force, ys = hammer_factory(modes, [part[:, r]], 10_000.0, 4.0, seed=r)
+        records.append(Record(name, {"hammer": force, "accel_pinion_casing": ys[0]},
+                              {"hammer": "N", "accel_pinion_casing": "m"}, 10_000.0))
+    mset = MeasurementSet(tuple(records))
+    spec = {"modes_from": ["hammer_pinion", "hammer_gear"],
+            "struck_shafts": {"hammer_pinion": "input", "hammer_gear": "output"}}
+    freqs, _, _, _, _, _, shapes = measured_modes(spec, mset, "s.yaml", tmp_path, with_damping=True)
+    side = {round(f, -2): s for f, s in zip(freqs, shapes.side_db)}
+    # within 2 dB of the participations' ratio (the other mode's tail in each hump)
+    assert abs(side[900.0] - 20 * np.log10(1 / 0.3)) < 2.0 and abs(side[1200.0] - 20 * np.log10(0.25)) < 2.0
+    # without the key the struck levels stay evidence only
+    _, _, _, _, _, _, plain = measured_modes({"modes_from": spec["modes_from"]}, mset, "s.yaml", tmp_path,
+                                             with_damping=True)
+    assert plain is None
+    with pytest.raises(ScenarioError, match=r"calibration\.struck_shafts\.hammer_side: 'hammer_side' is not one of "
+                                            r"the records the modes are read from"):
+        measured_modes({**spec, "struck_shafts": {**spec["struck_shafts"], "hammer_side": "input"}}, mset, "s.yaml",
+                       tmp_path)
+    with pytest.raises(ScenarioError, match=r"calibration\.struck_shafts: no record struck on the output shaft"):
+        measured_modes({**spec, "struck_shafts": {"hammer_pinion": "input", "hammer_gear": "input"}}, mset,
+                       "s.yaml", tmp_path)
+    with pytest.raises(ScenarioError, match=r"calibration\.struck_shafts\.hammer_gear: 'gear' is not one of"):
+        _scenario(gearbox_fmu, struck_shafts={"hammer_pinion": "input", "hammer_gear": "gear"})
