@@ -6,6 +6,7 @@ and ``steady``; ``twin`` never imports ``rigs``). The step does what a user does
 
     twin modes rig.h5 --record runup --plot modes.png
     twin modes rig.h5 --record runup --record hammer        # with a hammer test: the two together
+    twin modes rig.h5 --record runup --record hammer --record hammer_gear   # struck on each shaft
     twin calibrate scenario.yaml --measurements rig.h5 --modes-from runup --out calibration_rig/
     twin compare calibration_rig/calibrated.yaml --measurements rig.h5 --record steady
 """
@@ -19,19 +20,23 @@ from pathlib import Path
 import numpy as np
 
 
-def merge_records(steady_file: Path, runup_file: Path, out: Path, hammer_file: Path | None = None) -> Path:
+#: The demo's hammer records and the shaft each strikes (calibration.struck_shafts): the pinion's
+#: pedestal on the input shaft, the gear's on the output shaft.
+STRUCK = {"hammer": "input", "hammer_gear": "output"}
+
+
+def merge_records(steady_file: Path, runup_file: Path, out: Path, *hammer_files: Path) -> Path:
     """One measurement file holding the first record of each file, named ``steady``, ``runup`` and
-    (when given) ``hammer``."""
+    (when given) ``hammer`` and ``hammer_gear`` (blows at the pinion's, then the gear's pedestal)."""
     from twin.measurements import load_measurements, write_measurements
 
     records = [replace(load_measurements(steady_file)[0], name="steady"),
                replace(load_measurements(runup_file)[0], name="runup")]
-    if hammer_file is not None:
-        records.append(replace(load_measurements(hammer_file)[0], name="hammer"))
+    records += [replace(load_measurements(f)[0], name=name) for f, name in zip(hammer_files, STRUCK)]
     return write_measurements(records, out)
 
 
-def rig_calibration_demo(out_dir: Path, steady_file: Path, runup_file: Path, hammer_file: Path | None = None) -> dict:
+def rig_calibration_demo(out_dir: Path, steady_file: Path, runup_file: Path, *hammer_files: Path) -> dict:
     """Step 6 (see the module docstring); returns the paths and headline numbers."""
     from twin.calibration.run import run_calibration
     from twin.compare import compare
@@ -44,8 +49,7 @@ def rig_calibration_demo(out_dir: Path, steady_file: Path, runup_file: Path, ham
     t = time.perf_counter()
     d = out_dir / "rig"
     d.mkdir(exist_ok=True)
-    h5 = merge_records(Path(steady_file), Path(runup_file), d / "pedestal.h5",
-                       Path(hammer_file) if hammer_file is not None else None)
+    h5 = merge_records(Path(steady_file), Path(runup_file), d / "pedestal.h5", *map(Path, hammer_files))
     mset = load_measurements(h5)
     survey = survey_record(mset["runup"])
     png = plot_modal_survey(survey, d / "modes.png", title="Run-up of the pedestal rig: modes (red), fixed lines "
@@ -58,16 +62,19 @@ def rig_calibration_demo(out_dir: Path, steady_file: Path, runup_file: Path, ham
     if "hammer" in mset.names:
         # what `twin modes --record runup --record hammer` shows: the run-up's survey (above)
         # merged with the hammer test's, the run-up not surveyed again
-        from twin.modes import MIN_CONFIDENCE, merge_surveys
-        both = merge_surveys([survey, survey_record(mset["hammer"])])
+        from twin.modes import MIN_CONFIDENCE, merge_surveys, with_lscf, with_struck_levels
+        hammers = [mset[n] for n in STRUCK if n in mset.names]
+        names = " ".join(f"--record {h.name}" for h in hammers)
+        both = merge_surveys([survey, *(survey_record(h) for h in hammers)])
         alone, together = survey.frequencies(MIN_CONFIDENCE), both.frequencies(MIN_CONFIDENCE)
         added = [f for f in together if not alone.size or np.min(np.abs(alone - f)) > 0.01 * f]
-        _lines(f"twin modes --record runup --record hammer (blows at the pinion pedestal, the gears rolling at "
-               f"{mset['hammer'].nominal_speed or 0:g} Hz): {together.size} modes, "
+        _lines(f"twin modes --record runup {names} (blows at the {' and the '.join(['pinion', 'gear'][:len(hammers)])} "
+               f"pedestal, the gears rolling at {hammers[0].nominal_speed or 0:g} Hz): {together.size} modes, "
                f"{len(added)} the run-up alone did not show ({', '.join(f'{f:.0f}' for f in added) or 'none'} Hz); "
                f"{both.notes[-1] if both.notes else ''}")
-        from twin.modes import with_lscf
-        fitted = with_lscf(both, [mset["hammer"]])
+        if len(hammers) == 2:
+            _lines(_shaft_reading(with_struck_levels(both, hammers)))
+        fitted = with_lscf(both, hammers)
         _lines(f"twin modes ... --lscf (the hammer FRFs also fitted by poly-reference LSCF, an opt-in): "
                f"{fitted.notes[-1]}")
     scenario_file = d / "scenario.yaml"
@@ -89,6 +96,24 @@ def rig_calibration_demo(out_dir: Path, steady_file: Path, runup_file: Path, ham
            f"{len(comp.findings)} findings (what the twin still lacks: docs/diagnosis.md)")
     _written(png, report.scenario_file, out_dir / "calibration_rig" / "report.html")
     return {"survey": survey, "report": report, "scenario": report.scenario_file, "compare_lsd_db": comp.lsd_db}
+
+
+def _shaft_reading(survey) -> str:
+    """Which shaft the surveyed modes live on, from their levels per struck pedestal (what
+    ``calibration.struck_shafts`` lets the pairing read)."""
+    from twin.calibration.pairing import SIDE_DB, struck_sides
+    from twin.modes import MIN_CONFIDENCE
+
+    modes = [m for m in survey.modes if m.confidence >= MIN_CONFIDENCE]
+    sides = struck_sides([m.evidence for m in modes], STRUCK)
+    if sides is None:
+        return "struck-point levels: no mode in both hammer records' band"
+    on = {k: [f"{m.frequency:.0f}" for m, s in zip(modes, sides) if test(s)] for k, test in
+          (("input", lambda s: s >= SIDE_DB), ("output", lambda s: s <= -SIDE_DB),
+           ("both", lambda s: abs(s) < SIDE_DB))}
+    return (f"where each mode lives, from its level per struck pedestal ({SIDE_DB:g} dB or more louder from one "
+            f"shaft; calibration.struck_shafts pairs no mode across shafts): input shaft {', '.join(on['input']) or '-'} "
+            f"Hz; output shaft {', '.join(on['output']) or '-'} Hz; both {', '.join(on['both']) or '-'} Hz")
 
 
 def loop_demo(out_dir: Path, records, calibrated) -> dict:
