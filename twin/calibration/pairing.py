@@ -98,6 +98,11 @@ class MeasuredShapes:
     coherence: np.ndarray
     side_db: np.ndarray | None = None     # (k,) input over output shaft's struck level [dB], NaN where unknown
 
+    def subset(self, keep: np.ndarray) -> "MeasuredShapes":
+        """The same for the measured modes ``keep`` ((k,) bool or indices) only."""
+        return MeasuredShapes(self.channels, self.vectors[keep], self.coherence[keep],
+                              None if self.side_db is None else self.side_db[keep])
+
     @classmethod
     def from_evidence(cls, evidence: Sequence[dict], struck_shafts: Mapping[str, str] | None = None,
                       ) -> "MeasuredShapes | None":

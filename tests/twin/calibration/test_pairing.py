@@ -252,6 +252,9 @@ def test_a_modes_shaft_from_its_levels_per_struck_point():
     shapes = MeasuredShapes.from_evidence(evidence, STRUCK)
     assert shapes.channels == () and shapes.vectors.shape == (4, 0) and shapes.side_db[0] == pytest.approx(9.5)
     assert MeasuredShapes.from_evidence(evidence) is None
+    # measured modes dropped (the foundation's) take their side levels with them
+    kept = shapes.subset(np.array([False, True, True, False]))
+    assert kept.side_db[0] == pytest.approx(-12.0) and kept.vectors.shape == (2, 0) and kept.coherence.size == 2
 
 
 @pytest.mark.parametrize("pairing", PAIRINGS)

@@ -119,7 +119,7 @@ def _hammer(name="hammer", modes=((87.0, 0.02), (218.0, 0.015), (512.0, 0.02)), 
 
 def test_foundation_modes_read_from_a_hammer_record(tmp_path):
     """The paper's procedure: the run-up's modes less those an impact test on the casing shows."""
-    from twin.calibration.run import measured_modes
+    from twin.calibration.measured import measured_modes
     from twin.measurements import MeasurementSet
 
     steady = Record("steady", {"accel_pinion_casing": np.zeros(1000)}, {"accel_pinion_casing": "m/s2"}, 1e4)
@@ -141,7 +141,7 @@ def test_foundation_modes_read_from_a_hammer_record(tmp_path):
 def test_lscf_in_the_block_fits_the_hammer_records_together(gearbox_fmu, tmp_path):
     """``calibration.lscf: true`` reads the modes of the hammer records named in modes_from with the
     poly-reference LSCF fit as well (its note in modes.json); a non-boolean is refused by name."""
-    from twin.calibration.run import measured_modes
+    from twin.calibration.measured import measured_modes
     from twin.measurements import MeasurementSet
 
     mset = MeasurementSet((_hammer("hammer_a"), _hammer("hammer_b", hits=5)))
@@ -169,7 +169,7 @@ def test_foundation_from_overrides_the_block(gearbox_fmu):
 def test_modes_read_from_several_records_together(tmp_path):
     """A mode seen in any of the records is a mode of the structure (two hammer tests struck where
     each shows modes the other does not), each mode naming the records that saw it."""
-    from twin.calibration.run import measured_modes
+    from twin.calibration.measured import measured_modes
     from twin.measurements import MeasurementSet
 
     a = _hammer("hammer_a", modes=((87.0, 0.02), (218.0, 0.015)))
@@ -215,7 +215,7 @@ def test_struck_shafts_give_each_measured_mode_its_shaft(hammer_factory, gearbox
     """``calibration.struck_shafts``: two hammer records, one per shaft; the mode struck harder on the
     input shaft's record gets a positive side level, the other a negative one (the pairing reads
     them); a record outside modes_from, a shaft without a record or an unknown shaft is refused by name."""
-    from twin.calibration.run import measured_modes
+    from twin.calibration.measured import measured_modes
     from twin.measurements import MeasurementSet
 
     modes = ((900.0, 0.02), (1200.0, 0.01))
