@@ -336,7 +336,8 @@ def main() -> None:
                          "default off; scored on seeds 91-95 as the default, not adopted)")
     ap.add_argument("--struck-shafts", action="store_true",
                     help="with --hammer: name the shaft each hammer record strikes (calibration.struck_shafts), so "
-                         "that no measured mode is paired with a model mode on the other shaft")
+                         "that no measured mode is paired with a model mode on the other shaft (scored on seeds "
+                         "101-105 with the overhangs model, not adopted)")
     ap.add_argument("--out", type=Path, default=REPO / "bench_out" / "calibration_rigs")
     ap.add_argument("--explain", action="store_true",
                     help="only the per-mode analysis of the results already in --out (no new scoring)")

@@ -51,7 +51,8 @@ same of the model's. A pairing is refused when both say, by :data:`SIDE_DB` or m
 modes live on different shafts (:func:`side_refused`): the frequency order alone gave the rigs' gear
 shaft modes the twin's input shaft mode, and the fit then drove that shaft's bearing to its bound.
 A mode that lives on both shafts (within :data:`SIDE_DB` either side) or that the hammers did not
-reach is paired as before.
+reach is paired as before. Scored on the rigs it lost matches (docs/calibration.md, seeds 101-105):
+the modes it refused there are a gear rocking on its shaft, which the twin's models lack; an opt-in.
 """
 from __future__ import annotations
 
