@@ -307,7 +307,8 @@ def main() -> None:
     ap.add_argument("--model", default="GearTwin.Gearbox21Shafts",
                     help="the twin's model (GearTwin.Gearbox21Walls: flexible casing walls; GearTwin.Gearbox21TiltingWalls: "
                          "walls that also tilt the housings; GearTwin.Gearbox21Overhangs: each shaft a beam through its "
-                         "gear and overhung ends; GearTwin.Gearbox21Measured: "
+                         "gear and overhung ends; GearTwin.Gearbox21Rocking: the same with the gear rocking on its "
+                         "shaft; GearTwin.Gearbox21Measured: "
                          "pedestals on rigid ground)")
     ap.add_argument("--pairing", choices=("frequency", "shape"), default="frequency",
                     help="how twin calibrate pairs measured with model modes (calibration.pairing)")

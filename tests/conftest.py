@@ -84,6 +84,12 @@ def overhangs_fmu(fmu_dir) -> Path:
 
 
 @pytest.fixture(scope="session")
+def rocking_fmu(fmu_dir) -> Path:
+    """The overhangs model with the gear rocking on its shaft (GearTwin.Gearbox21Rocking)."""
+    return build_shared("GearTwin.Gearbox21Rocking", fmu_dir)
+
+
+@pytest.fixture(scope="session")
 def walls_fmu(fmu_dir) -> Path:
     """The shafts model with flexible casing walls under the housings (GearTwin.Gearbox21Walls)."""
     return build_shared("GearTwin.Gearbox21Walls", fmu_dir)

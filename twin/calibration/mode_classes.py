@@ -21,6 +21,7 @@ whose energy is mostly rotation stays ``torsion`` and carries the pinion's share
 | ``output pedestals x`` / ``y`` | ``vx9``, ``vx11`` / ``vy9``, ``vy11`` | ``m9``, ``m11`` |
 | ``input shaft ends x`` / ``y`` | ``vx_end4``, ``vx_end6`` / ``vy_end4``, ``vy_end6``: parts on the input shaft outside its bearings (GearTwin.Gearbox21Overhangs) | ``m_end4``, ``m_end6`` |
 | ``output shaft ends x`` / ``y`` | ``vx_end9``, ``vx_end11`` / ``vy_end9``, ``vy_end11`` | ``m_end9``, ``m_end11`` |
+| ``gear rocking`` | ``w_rock_x``, ``w_rock_y``: the gear's tilt rates (GearTwin.Gearbox21Rocking) | ``I_rock10`` |
 | ``casing`` | ``vx_casing``, ``vy_casing`` / ``w_casing`` (GearTwin.Gearbox21Casing); ``casing.qd[k]`` (the wall modes of GearTwin.Gearbox21Walls and Gearbox21TiltingWalls, mass-normalised) | ``m_casing`` / ``I_casing``; 1 (modal states carry sqrt of the modal mass) |
 | ``sensor path`` | a sensor's panel or mount modes (massless: only when nothing else moves) | |
 
@@ -54,6 +55,7 @@ DOF_RULES: tuple[tuple[str, str, str | None], ...] = (
     (r"^vy_end(4|6)$", "input shaft ends y", r"m_end\1"),
     (r"^vx_end(9|11)$", "output shaft ends x", r"m_end\1"),
     (r"^vy_end(9|11)$", "output shaft ends y", r"m_end\1"),
+    (r"^w_rock_(x|y)$", "gear rocking", "I_rock10"),
     (r"^v(x|y)_casing$", "casing", "m_casing"),
     (r"^w_casing$", "casing", "I_casing"),
     (r"^casing\.qd\[(\d+)\]$", "casing", None),
@@ -62,8 +64,8 @@ DOF_RULES: tuple[tuple[str, str, str | None], ...] = (
 #: The classes, in the order reports list them.
 CLASSES = ("torsion", "pinion lateral x", "pinion lateral y", "gear lateral x", "gear lateral y",
            "input pedestals x", "input pedestals y", "output pedestals x", "output pedestals y",
-           "input shaft ends x", "input shaft ends y", "output shaft ends x", "output shaft ends y", "casing",
-           "sensor path")
+           "input shaft ends x", "input shaft ends y", "output shaft ends x", "output shaft ends y", "gear rocking",
+           "casing", "sensor path")
 #: The lateral classes of each shaft (all of the shaft's bodies, both planes): a blow at one shaft's
 #: end or bearing support answers in the modes whose lateral motion is on that shaft
 #: (:func:`side_levels`).
@@ -207,6 +209,6 @@ def mass_values(fmu_path, parameters: Mapping[str, float]) -> dict[str, float]:
     return out
 
 
-#: Names of mass and inertia parameters: ``I5``, ``m10``, ``m_casing``, ``I_casing``, ``m_end4``.
-_MASS = r"^(I|m)(\d+|_casing|_end\d+)$"
+#: Names of mass and inertia parameters: ``I5``, ``m10``, ``m_casing``, ``I_casing``, ``m_end4``, ``I_rock10``.
+_MASS = r"^(I|m)(\d+|_casing|_end\d+|_rock\d+)$"
 _STARTS: dict = {}
