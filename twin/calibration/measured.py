@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
+from twin.calibration.pairing import SHAFTS
 from twin.errors import ScenarioError
 
 
@@ -21,7 +22,7 @@ def _struck_shafts(spec: dict, names, source: str) -> dict[str, str]:
             raise ScenarioError([(source, f"calibration.struck_shafts.{name}",
                                   f"{name!r} is not one of the records the modes are read from (modes_from: "
                                   f"{', '.join(names)})")])
-    for shaft in ("input", "output"):
+    for shaft in SHAFTS:
         if shaft not in struck.values():
             raise ScenarioError([(source, "calibration.struck_shafts", f"no record struck on the {shaft} shaft: a "
                                   "mode's shaft is read from blows on both")])

@@ -143,11 +143,13 @@ def classify(shapes: np.ndarray, table: Sequence[tuple[int, str, float]]) -> lis
     return out
 
 
-def side_levels(shapes: np.ndarray, table: Sequence[tuple[int, str, float]]) -> np.ndarray:
+def side_levels(shapes: np.ndarray, table: Sequence[tuple[int, str, float]],
+                classes: Sequence[ModeClass] = ()) -> np.ndarray:
     """(m,) where each mode (column of ``shapes``, (n_states, m)) moves: the largest lateral
     velocity on the input shaft's bodies over the largest on the output shaft's, in dB
-    (:data:`SIDES`; NaN where a shaft has no such state or neither moves, and for a sensor path's own
-    modes, where the structure is still but for rounding).
+    (:data:`SIDES`; NaN where a shaft has no such state or neither moves). A sensor path's own modes
+    (``classes``, from :func:`classify`, when given) are NaN too: their structure is still but for
+    rounding.
 
     Unweighted amplitudes, not energies: a hammer's response at a point is the mode's amplitude
     there (by reciprocity the ratio of two struck points' FRFs at a lone mode is the ratio of the
@@ -161,10 +163,7 @@ def side_levels(shapes: np.ndarray, table: Sequence[tuple[int, str, float]]) -> 
     if a.size == 0 or b.size == 0:
         return out
     amp_a, amp_b = np.abs(shapes[a]).max(axis=0), np.abs(shapes[b]).max(axis=0)
-    idx = np.array([i for i, _, _ in table], dtype=int)
-    path = np.array([c == "sensor path" for _, c, _ in table])
-    v2 = np.abs(shapes[idx]) ** 2
-    still = v2[~path].sum(axis=0) <= SENSOR_PATH_SHARE * np.maximum(v2.sum(axis=0), 1e-300)
+    still = np.array([c.name == "sensor path" for c in classes], bool) if len(classes) else np.zeros(out.size, bool)
     ok = (amp_a > 0) & (amp_b > 0) & ~still
     out[ok] = 20 * np.log10(amp_a[ok] / amp_b[ok])
     return out

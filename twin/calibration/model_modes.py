@@ -150,9 +150,10 @@ def model_modes(fmu_path, parameters: Mapping[str, float], *, speed_hz: float, l
     visible = by["mesh"].copy() if columns == "mesh" else np.any(list(by.values()), axis=0)
     top = gain[visible].max() if visible.any() else (gain.max() if gain.size else 1.0)
     table = dof_table(lm.state_names, masses)
+    classes = tuple(classify(shapes, table))
     return ModelModes(freq, damp, visible, shapes, 20 * np.log10(np.maximum(gain, 1e-300) / top),
-                      tuple(classify(shapes, table)), mm.residues[:, 0, keep], tuple(channels), by, visibility,
-                      side_levels(shapes, table))
+                      classes, mm.residues[:, 0, keep], tuple(channels), by, visibility,
+                      side_levels(shapes, table, classes))
 
 
 #: A mode that dominates the response at its own frequency is visible only if its own peak there is

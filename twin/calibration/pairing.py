@@ -88,10 +88,12 @@ SHAFTS = ("input", "output")
 
 @dataclass(frozen=True)
 class MeasuredShapes:
-    """Shapes of the measured modes at the channels (from ``twin modes``).
+    """Shapes of the measured modes at the channels, and the shaft each lives on (from ``twin modes``).
 
     channels : (c,) names; vectors : (k, c) complex, level and phase re each mode's reference
-    (NaN where a channel has no estimate); coherence : (k,) lowest coherence with the reference.
+    (NaN where a channel has no estimate); coherence : (k,) lowest coherence with the reference;
+    side_db : (k,) the loudest blow on the input shaft over that on the output shaft [dB] (NaN where
+    a mode has no level on both, None without ``struck_shafts``: :func:`struck_sides`).
     """
 
     channels: tuple[str, ...]

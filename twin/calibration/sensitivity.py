@@ -350,6 +350,7 @@ def mode_sensitivity(fmu_path, values: Mapping[str, float], measured_hz, *, spee
         S_all[cols, j] = np.log(follow(base, mv, cols) / base.frequency[cols]) / math.log(1 + step)
     reach = mode_reach(S_all, cands)
     match = match_measured(base, measured, rel, pairing="shape", shapes=shapes, reach=reach)
+    notes += side_notes(base, measured, match, shapes)
     ok = match >= 0
     which = match[ok]
     if not ok.any():
