@@ -121,6 +121,25 @@ def test_level_fit_recovers_gain_and_roughness(measured_fmu):
     assert fit.gain == pytest.approx(0.6, rel=0.25)      # the roughness in the mesh lines biases it
     assert fit.parameters["pinion_roughness.rms"] == pytest.approx(1.5e-7, rel=0.4)
     assert fit.distance_db < 1.5
+    assert not fit.gain_on_bound and fit.warning() is None
+
+
+def test_level_fit_holds_the_gain_to_the_sensor_range_and_the_noise_below_the_quietest_band(measured_fmu):
+    # a record 30 times louder than a sensor gain of 0.6 gives: the mesh lines ask for 18, the
+    # sensor declares at most 10, so the roughness carries the rest of the broadband level
+    truth = {"sensor_pinion.gain": 0.6, "pinion_roughness.rms": 1.5e-7, "gear_roughness.rms": 1.5e-7,
+             "process.rms": 1.0}
+    x = 30 * simulate_operating_point(measured_fmu, 20.0, 20.0, parameters=truth, settle=0.1, duration=1.0,
+                                      channels=["accel_pinion_casing"], output_interval=4e-5)[:, 0]
+    # white noise at a tenth of the record's RMS: left free, the noise would take the broadband
+    x = x + 0.1 * np.std(x) * np.random.default_rng(1).standard_normal(x.size)
+    fit = fit_levels(measured_fmu, {}, x, 25000.0, speed_hz=20.0, load_nm=20.0, channel="accel_pinion_casing",
+                     fmin=20.0, fmax=5000.0)
+    assert fit.gain == 10.0 and fit.parameters["sensor_pinion.gain"] == 10.0
+    assert fit.gain_wanted == pytest.approx(18.0, rel=0.25) and fit.gain_on_bound
+    assert "sensor gain held at 10" in fit.warning()
+    assert fit.parameters["pinion_roughness.rms"] == pytest.approx(1.8 * 1.5e-7, rel=0.4)
+    assert fit.noise_psd <= 10 ** (np.min(fit.measured_db) / 10) * (1 + 1e-9)
 
 
 def test_modes_no_gearbox_mode_reaches_go_to_the_casing_path(measured_fmu, gearbox_fmu):

@@ -11,12 +11,15 @@ to the values simulated. So three simulations (nothing; roughness alone added; p
 alone added) give every level at once. The gain comes from the gear-mesh harmonics (measured over
 simulated amplitude: band levels alone cannot tell a louder mesh from more roughness, whose
 orders include the mesh orders; the roughness in the measured lines biases it by up to about
-20 %); ``a`` and ``b`` are then fitted to the measured spectrum's band
-levels (1/12 octave) by least squares in dB, with a third term for the measurement's own noise
-(white; it is reported, not put in the model).
+20 %), held to the range the sensor declares (a gain the lines push beyond it says the twin's mesh
+excitation or its path is off, not the sensor: a warning); ``a`` and ``b`` are then fitted to the
+measured spectrum's band levels (1/12 octave) by least squares in dB, with a third term for the
+measurement's own noise (white, so at most the level of the quietest measured band; it is
+reported, not put in the model).
 """
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
@@ -56,20 +59,34 @@ def band_levels(x, fs: float, fmin: float, fmax: float, *, resolution: float,
 
 @dataclass(frozen=True)
 class LevelFit:
-    gain: float                  # sensor gain g [-]
+    gain: float                  # sensor gain g [-], within the sensor's declared range
     roughness_scale: float       # factor on the simulated roughness RMS [-]
     process_scale: float         # factor on the simulated process-force RMS [-]
-    noise_psd: float             # white measurement noise [unit^2/Hz]
+    noise_psd: float             # white measurement noise [unit^2/Hz], at most the quietest band's level
     distance_db: float           # RMS dB difference of the band levels after the fit
     parameters: Mapping[str, float]   # FMU parameter values to set
     band_hz: np.ndarray | None = None       # (m,) band centres [Hz]
     measured_db: np.ndarray | None = None   # (m,) measured band levels [dB]
     model_db: np.ndarray | None = None      # (m,) fitted model band levels, noise included [dB]
+    gain_wanted: float | None = None        # the gain the mesh lines asked for, before the declared range [-]
+
+    @property
+    def gain_on_bound(self) -> bool:
+        """Whether the mesh lines asked for a gain outside the sensor's declared range."""
+        return self.gain_wanted is not None and not math.isclose(self.gain_wanted, self.gain, rel_tol=1e-9)
 
     def describe(self) -> str:
         return (f"sensor gain {self.gain:.3g}, roughness x{self.roughness_scale:.3g}, process force "
                 f"x{self.process_scale:.3g}, measurement noise {self.noise_psd:.3g} /Hz; band levels within "
                 f"{self.distance_db:.2f} dB RMS")
+
+    def warning(self) -> str | None:
+        """A one-line warning when the sensor gain is held at a bound of its declared range, else None."""
+        if not self.gain_on_bound:
+            return None
+        return (f"sensor gain held at {self.gain:.3g}: the measured gear-mesh harmonics ask for {self.gain_wanted:.3g} "
+                f"({20 * math.log10(self.gain_wanted / self.gain):+.1f} dB), more than a sensor's sensitivity error; "
+                "the twin's mesh excitation or its path to the casing is off")
 
 
 def has_levels(fmu_path, channel: str) -> bool:
@@ -83,7 +100,13 @@ def has_levels(fmu_path, channel: str) -> bool:
 
 def fit_levels(fmu_path, parameters: Mapping[str, float], measured, fs: float, *, speed_hz: float, load_nm: float,
                channel: str, fmin: float, fmax: float, settle: float = 0.1, duration: float = 0.5) -> LevelFit:
-    """Fit the sensor gain and the broadband levels to a measured steady record (see the docstring)."""
+    """Fit the sensor gain and the broadband levels to a measured steady record (see the docstring).
+
+    ``measured`` (n,) samples at ``fs`` [Hz] of ``channel``; ``speed_hz`` [Hz] and ``load_nm``
+    [N.m] the operating point of the three simulations. Every fitted value stays within the range
+    the FMU declares for it; a gain the mesh lines push beyond it is held at the bound before the
+    broadband levels are fitted, and reported (:meth:`LevelFit.warning`).
+    """
     from scipy.optimize import least_squares
 
     from twin.fmu import FMU
@@ -92,6 +115,7 @@ def fit_levels(fmu_path, parameters: Mapping[str, float], measured, fs: float, *
     sensor = SENSOR_OF_CHANNEL[channel]
     with FMU(fmu_path) as fmu:
         start = {n: float(parameters.get(n, fmu.variable(n).start)) for n in (*ROUGHNESS, PROCESS)}
+        limits = {sv.name: (sv.min, sv.max) for sv in fmu.model_description.modelVariables}
     r0 = max(start[ROUGHNESS[0]], 1e-9)
     p0 = max(start[PROCESS], 1e-3)
     base = {**parameters, f"{sensor}.gain": 1.0}
@@ -111,6 +135,8 @@ def fit_levels(fmu_path, parameters: Mapping[str, float], measured, fs: float, *
     R = np.maximum(levels["roughness"][:n] - M, 1e-6 * levels["roughness"][:n])
     F = np.maximum(levels["process"][:n] - M, 1e-6 * levels["process"][:n])
     target = 10 * np.log10(lm[:n])
+    # White measurement noise cannot stand above the quietest band of what was measured: left
+    # free, it took the place of the broadband content the spectrum needs from the model.
     noise0 = float(np.min(lm[:n]))
     # The gain from the mesh lines: band levels alone cannot tell a louder mesh from more
     # roughness, whose orders include the mesh orders. The measured lines hold some roughness too
@@ -120,29 +146,31 @@ def fit_levels(fmu_path, parameters: Mapping[str, float], measured, fs: float, *
     usable = np.isfinite(line_meas) & (line_meas >= 4.0 * ring_meas) & (line_mesh > 0)
     if not usable.any():
         raise ValueError("no gear-mesh harmonic stands out of the measured spectrum: the sensor gain cannot be set")
-    g2 = float(np.median(line_meas[usable] / line_mesh[usable]))
+    gain_wanted = float(np.sqrt(np.median(line_meas[usable] / line_mesh[usable])))
+    # held to the sensor's declared range before the broadband is fitted, so the levels fit the
+    # gain the FMU will read with
+    g_lo, g_hi = limits.get(f"{sensor}.gain", (None, None))
+    gain = float(np.clip(gain_wanted, float(g_lo) if g_lo is not None else 0.0,
+                         float(g_hi) if g_hi is not None else np.inf))
 
     def model(q):
         a, b, w = np.exp(q)
-        return 10 * np.log10(g2 * (M + a * R + b * F) + w * noise0)
+        return 10 * np.log10(gain ** 2 * (M + a * R + b * F) + w * noise0)
 
-    # the broadband levels within a factor 100 of the simulated ones (power 1e4), the noise free;
-    # a level the spectrum does not need goes to the low end, not to zero
+    # the broadband levels within a factor 100 of the simulated ones (power 1e4), the noise at most
+    # the quietest band; a level the spectrum does not need goes to the low end, not to zero
     lo = np.array([np.log(1e-4), np.log(1e-4), np.log(1e-6)])
-    hi = np.array([np.log(1e4), np.log(1e4), np.log(1e6)])
+    hi = np.array([np.log(1e4), np.log(1e4), 0.0])
     sol = least_squares(lambda q: model(q) - target, np.log([1.0, 1.0, 0.1]), bounds=(lo, hi))
     a, b, w = np.exp(sol.x)
-    gain = float(np.sqrt(g2))
     rs, ps = float(np.sqrt(a)), float(np.sqrt(b))
-    with FMU(fmu_path) as fmu:
-        limits = {sv.name: (sv.min, sv.max) for sv in fmu.model_description.modelVariables}
-    values = {}
-    for name, v in ((f"{sensor}.gain", gain), (ROUGHNESS[0], r0 * rs), (ROUGHNESS[1], r0 * rs), (PROCESS, p0 * ps)):
+    values = {f"{sensor}.gain": gain}
+    for name, v in ((ROUGHNESS[0], r0 * rs), (ROUGHNESS[1], r0 * rs), (PROCESS, p0 * ps)):
         lo_v, hi_v = limits.get(name, (None, None))
         values[name] = float(np.clip(v, float(lo_v) if lo_v is not None else -np.inf,
                                      float(hi_v) if hi_v is not None else np.inf))
     return LevelFit(gain, rs, ps, float(w * noise0), float(np.sqrt(np.mean(sol.fun ** 2))), values, fc[:n],
-                    target, model(sol.x))
+                    target, model(sol.x), gain_wanted=gain_wanted)
 
 
 def mesh_lines(x, fs: float, nominal_hz: float, *, teeth: int = 19, fmax: float = 5000.0, harmonics: int = 6
