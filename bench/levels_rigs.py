@@ -73,15 +73,15 @@ def refit(out: Path, gearbox: dict) -> dict:
 
 
 def main(argv=None) -> int:
+    from mode_losses import read_run
+
     dirs = [Path(a) for a in (sys.argv[1:] if argv is None else argv)]
     if not dirs:
         print(__doc__)
         return 2
     for out in dirs:
-        try:
-            gearboxes = json.loads((out / "results.json").read_text())
-        except (OSError, ValueError) as exc:
-            print(f"error: {out}: not a finished calibration_rigs run ({type(exc).__name__}: {exc})", file=sys.stderr)
+        gearboxes = read_run(out)
+        if gearboxes is None:
             return 2
         rows = []
         for g in gearboxes:

@@ -57,6 +57,16 @@ def losses(out: Path) -> Counter:
     return counts
 
 
+def read_run(out: Path) -> list | None:
+    """The gearboxes of OUT/results.json as `bench/calibration_rigs.py` wrote them, or None with a
+    one-line error on stderr naming what is missing (for the scripts that read a finished run)."""
+    try:
+        return json.loads((Path(out) / "results.json").read_text())
+    except (OSError, ValueError) as exc:
+        print(f"error: {out}: not a finished calibration_rigs run ({type(exc).__name__}: {exc})", file=sys.stderr)
+        return None
+
+
 def main(argv=None) -> int:
     outs = [Path(a) for a in (sys.argv[1:] if argv is None else argv)]
     if not outs:

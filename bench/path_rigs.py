@@ -12,7 +12,6 @@ the path passes at low against high frequencies. Printed per record and as a mea
 """
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 
@@ -21,6 +20,7 @@ from scipy import signal as sps
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
+sys.path.insert(0, str(REPO / "bench"))
 
 CHANNEL = "accel_pinion_casing"
 #: The twin's body (velocity state, mass parameter) for each rig's struck point: the pedestal rig's
@@ -64,6 +64,7 @@ def twin_frf(fmu, parameters: dict, state: str, mass: str, f: np.ndarray) -> np.
 
 
 def main(argv=None) -> int:
+    from mode_losses import read_run
     from twin.measurements import load_measurements
     from twin.scenario import load_scenario
 
@@ -73,10 +74,8 @@ def main(argv=None) -> int:
         return 2
     print("| rig, seed, record | " + " | ".join(f"{lo}-{2 * lo} Hz" for lo in BANDS) + " |  (dB re 800-1600 Hz: measured / twin)")
     for out in dirs:
-        try:
-            gearboxes = json.loads((out / "results.json").read_text())
-        except (OSError, ValueError) as exc:
-            print(f"error: {out}: not a finished calibration_rigs run ({type(exc).__name__}: {exc})", file=sys.stderr)
+        gearboxes = read_run(out)
+        if gearboxes is None:
             return 2
         shapes = []
         for g in gearboxes:
