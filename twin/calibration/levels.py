@@ -149,9 +149,7 @@ def fit_levels(fmu_path, parameters: Mapping[str, float], measured, fs: float, *
     gain_wanted = float(np.sqrt(np.median(line_meas[usable] / line_mesh[usable])))
     # held to the sensor's declared range before the broadband is fitted, so the levels fit the
     # gain the FMU will read with
-    g_lo, g_hi = limits.get(f"{sensor}.gain", (None, None))
-    gain = float(np.clip(gain_wanted, float(g_lo) if g_lo is not None else 0.0,
-                         float(g_hi) if g_hi is not None else np.inf))
+    gain = _within(gain_wanted, limits.get(f"{sensor}.gain"))
 
     def model(q):
         a, b, w = np.exp(q)
@@ -164,13 +162,16 @@ def fit_levels(fmu_path, parameters: Mapping[str, float], measured, fs: float, *
     sol = least_squares(lambda q: model(q) - target, np.log([1.0, 1.0, 0.1]), bounds=(lo, hi))
     a, b, w = np.exp(sol.x)
     rs, ps = float(np.sqrt(a)), float(np.sqrt(b))
-    values = {f"{sensor}.gain": gain}
-    for name, v in ((ROUGHNESS[0], r0 * rs), (ROUGHNESS[1], r0 * rs), (PROCESS, p0 * ps)):
-        lo_v, hi_v = limits.get(name, (None, None))
-        values[name] = float(np.clip(v, float(lo_v) if lo_v is not None else -np.inf,
-                                     float(hi_v) if hi_v is not None else np.inf))
+    values = {f"{sensor}.gain": gain, **{name: _within(v, limits.get(name)) for name, v in
+                                         ((ROUGHNESS[0], r0 * rs), (ROUGHNESS[1], r0 * rs), (PROCESS, p0 * ps))}}
     return LevelFit(gain, rs, ps, float(w * noise0), float(np.sqrt(np.mean(sol.fun ** 2))), values, fc[:n],
                     target, model(sol.x), gain_wanted=gain_wanted)
+
+
+def _within(value: float, limits) -> float:
+    """``value`` clipped to an FMU variable's declared (min, max), either of them None or absent."""
+    lo, hi = limits if limits is not None else (None, None)
+    return float(np.clip(value, float(lo) if lo is not None else -np.inf, float(hi) if hi is not None else np.inf))
 
 
 def mesh_lines(x, fs: float, nominal_hz: float, *, teeth: int = 19, fmax: float = 5000.0, harmonics: int = 6

@@ -268,8 +268,8 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
                 "beyond what physics allows, so the model's structure may lack something the rig has"
                 for n, lo, hi in zip(space.names, space.lower, space.upper)
                 if n in on_bounds(space.names, [chosen[k] for k in space.names], space.lower, space.upper)]
-    if levels is not None and levels.warning():
-        warnings.append(levels.warning())
+    if levels is not None and (held := levels.warning()):
+        warnings.append(held)
     notes = tuple(n for n in (path_note, f"levels: {levels.describe()}" if levels is not None else None) if n)
     if progress:
         for w in warnings:
