@@ -43,7 +43,7 @@ def without_levels(parameters: dict) -> dict:
 def refit(out: Path, gearbox: dict) -> dict:
     from spectral_distance import spectral_distance_report
 
-    from twin.calibration.levels import fit_levels, panel_participations
+    from twin.calibration.levels import fit_levels_and_panels
     from twin.measurements import load_measurements
     from twin.operating import simulate_operating_point
     from twin.scenario import load_scenario
@@ -58,13 +58,8 @@ def refit(out: Path, gearbox: dict) -> dict:
     kw = dict(speed_hz=float(rec.nominal_speed), load_nm=float(rec.load), channel=CHANNEL, fmin=20.0,
               fmax=min(5000.0, 0.45 * fs), settle=0.2)
     params = without_levels(dict(calibrated.parameters))
-    levels = fit_levels(fmu, params, x, fs, **kw)
-    params.update(levels.parameters)
-    panels = panel_participations(levels, params, CHANNEL)
-    if panels:
-        params.update(panels)
-        levels = fit_levels(fmu, params, x, fs, **kw)
-        params.update(levels.parameters)
+    levels, updates = fit_levels_and_panels(fmu, params, x, fs, **kw)
+    params.update(updates)
     y = simulate_operating_point(fmu, float(rec.nominal_speed), float(rec.load), parameters=params, settle=0.2,
                                  duration=min(x.size / fs, 2.0), channels=[CHANNEL], output_interval=1.0 / fs)[:, 0]
     now = spectral_distance_report(y, x[-y.size:], fs, fmin=20.0, fmax=5000.0)

@@ -168,6 +168,26 @@ def fit_levels(fmu_path, parameters: Mapping[str, float], measured, fs: float, *
                     target, model(sol.x), gain_wanted=gain_wanted)
 
 
+def fit_levels_and_panels(fmu_path, parameters: Mapping[str, float], measured, fs: float, *, channel: str,
+                          **kwargs) -> tuple[LevelFit, dict[str, float]]:
+    """The level fit as a calibration runs it: fit, correct the casing panels' participations from
+    its band levels (:func:`panel_participations`), and, if there are panels, fit again.
+
+    Returns the last fit and every value it set (levels, and participations when corrected);
+    ``kwargs`` as :func:`fit_levels`.
+    """
+    values = dict(parameters)
+    levels = fit_levels(fmu_path, values, measured, fs, channel=channel, **kwargs)
+    values.update(levels.parameters)
+    updates = dict(levels.parameters)
+    panels = panel_participations(levels, values, channel)
+    if panels:
+        values.update(panels)
+        levels = fit_levels(fmu_path, values, measured, fs, channel=channel, **kwargs)
+        updates.update({**panels, **levels.parameters})
+    return levels, updates
+
+
 def _within(value: float, limits) -> float:
     """``value`` clipped to an FMU variable's declared (min, max), either of them None or absent."""
     lo, hi = limits if limits is not None else (None, None)

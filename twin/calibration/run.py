@@ -135,7 +135,7 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
     ``pairing`` and ``foundation_from`` (a hammer record: ``foundation_modes``) override the
     calibration block's keys."""
     from twin._atomic import check_output_dir
-    from twin.calibration.levels import fit_levels, has_levels, panel_participations
+    from twin.calibration.levels import fit_levels_and_panels, has_levels
     from twin.calibration.modal_fit import mode_errors, on_bounds
     from twin.calibration.mode_search import SEARCH_BUDGET
     from twin.calibration.objectives import match_modes
@@ -249,15 +249,9 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
             # the level of the spectrum: sensor gain, roughness and process-force levels (three runs)
             level_kw = dict(speed_hz=target.drive_hz, load_nm=target.load, channel=channel, fmin=band[0],
                             fmax=min(band[1], 0.45 * rec.sample_rate), settle=settle)
-            levels = fit_levels(fmu, {**fixed, **chosen}, np.asarray(rec[channel], float), rec.sample_rate,
-                                **level_kw)
-            chosen.update(levels.parameters)
-            panels = panel_participations(levels, {**fixed, **chosen}, channel)
-            if panels:
-                chosen.update(panels)
-                levels = fit_levels(fmu, {**fixed, **chosen}, np.asarray(rec[channel], float), rec.sample_rate,
-                                    **level_kw)
-                chosen.update(levels.parameters)
+            levels, updates = fit_levels_and_panels(fmu, {**fixed, **chosen}, np.asarray(rec[channel], float),
+                                                    rec.sample_rate, **level_kw)
+            chosen.update(updates)
             if progress:
                 print(f"levels: {levels.describe()}")
         after, _ = evaluate_candidate(EvalTask(str(fmu), {**fixed, **chosen}, target, settle, duration, shaft))
