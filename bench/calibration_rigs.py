@@ -88,7 +88,8 @@ def struck_shafts(tests) -> dict[str, str]:
 
 
 def _scenario(path: Path, fs: float, workers: int, model: str, pairing: str = "frequency",
-              visibility: str = "mesh", fit: str = "follow", modes_from=("runup",), struck=None) -> Path:
+              visibility: str = "mesh", fit: str = "follow", modes_from=("runup",), struck=None,
+              path_from=None) -> Path:
     path.write_text(json.dumps({
         "version": 1, "name": "rig-calibration", "fmu": model, "stop_time": 2.0,
         "output": {"sample_rate": fs, "variables": [CHANNEL]},
@@ -97,8 +98,24 @@ def _scenario(path: Path, fs: float, workers: int, model: str, pairing: str = "f
         "calibration": {"parameters": "auto", "modes_from": modes_from[0] if len(modes_from) == 1 else list(modes_from),
                         "record": "steady",
                         "pop_size": 12, "n_gen": 6, "pairing": pairing, "visibility": visibility,
-                        "fit": fit, **({"struck_shafts": struck} if struck else {})}}, indent=2))
+                        "fit": fit, **({"struck_shafts": struck} if struck else {}),
+                        **({"path_from": path_from} if path_from else {})}}, indent=2))
     return path
+
+
+#: The bearing force of the twin that a blow at each rig's bearing supports stands for (``--path``).
+PATH_FORCES = ("bearing_force_input_y", "bearing_force_output_y")
+
+
+def mechanical(calibrated) -> tuple[Path, dict]:
+    """The calibrated twin's FMU and parameters without a measured path (its modes are the gearbox's)."""
+    from dataclasses import replace
+
+    from twin.calibration.transfer_path import SECTIONS_PARAMETER, without_path
+    if not calibrated.structural.get(SECTIONS_PARAMETER):
+        return calibrated.fmu_path(), dict(calibrated.parameters)
+    rest = {k: v for k, v in calibrated.structural.items() if k != SECTIONS_PARAMETER}
+    return replace(calibrated, structural=rest).fmu_path(), without_path(dict(calibrated.parameters))
 
 
 def observable_modes(box) -> np.ndarray:
@@ -136,7 +153,7 @@ def explain_modes(rig_name: str, seed: int, row: dict, out: Path, visibility: st
     rigmod = importlib.import_module(f"rigs.{rig_name}")
     truth = rigmod.Rig().scattered(seed=seed, scatter=0.12).modes(speed=SPEED, load=LOAD)
     calibrated = load_scenario(out / f"{rig_name}_{seed}_cal" / "calibrated.yaml")
-    mm = model_modes(calibrated.fmu_path(), calibrated.parameters, speed_hz=SPEED, load_nm=LOAD, channels=(CHANNEL,),
+    mm = model_modes(*mechanical(calibrated), speed_hz=SPEED, load_nm=LOAD, channels=(CHANNEL,),
                      visibility=visibility)
     vis = np.flatnonzero(mm.visible)
     extracted = np.asarray(row["extracted_hz"], float)
@@ -215,7 +232,7 @@ def _nearest(values, f):
 def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str, pairing: str = "frequency",
                 visibility: str = "mesh", fit: str = "follow", hammer: bool = False,
                 hammer_at: str = "default", hammer_from: str = "above", hammer_rate: float = HAMMER_RATE,
-                hammer_duration: float = HAMMER_DURATION, name_shafts: bool = False) -> dict:
+                hammer_duration: float = HAMMER_DURATION, name_shafts: bool = False, path: bool = False) -> dict:
     from spectral_distance import spectral_distance_report
 
     from fmu_build import build_fmu
@@ -231,16 +248,20 @@ def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str, p
     t = time.perf_counter()
     struck_at = (HAMMER if hammer_at == "default" else HAMMER_AT[hammer_at])[rig_name]
     tests = hammer_tests(struck_at, hammer_from) if hammer else ()
+    # the path is measured by blows at the bearing supports, whatever the modes' blows strike
+    path_tests = hammer_tests(HAMMER_AT["supports"][rig_name], "above") if path else ()
+    extra = tuple(t for t in path_tests if t[0] not in {name for name, _, _ in tests})
     design = (hammer_rate, hammer_duration) != (HAMMER_RATE, HAMMER_DURATION)
     h5 = out / (f"{rig_name}_{seed}{('_hammer_' + '_'.join(struck_at)) * hammer}"
                 f"{'_both' * (hammer and hammer_from == 'both')}"
-                f"{f'_{hammer_rate:g}per_s_{hammer_duration:g}s' * (hammer and design)}.h5")
+                f"{f'_{hammer_rate:g}per_s_{hammer_duration:g}s' * (hammer and design)}{'_path' * bool(extra)}.h5")
     modes_from = ("runup",) + tuple(name for name, _, _ in tests)
+    path_from = {name: force for (name, _, _), force in zip(path_tests, PATH_FORCES)}
     if not h5.exists():          # the records depend on the rig version and the seeds only
         steady = box.steady(speed=SPEED, load=LOAD, duration=2.0, seed=seed, name="steady")
         runup = box.runup(speeds=(2.0, SPEED), load=LOAD, duration=6.0, seed=seed, name="runup")
         struck = [box.impact(speed=HAMMER_SPEED, load=LOAD, duration=hammer_duration, impacts_per_second=hammer_rate,
-                             location=loc, seed=seed, name=name, direction=d) for name, loc, d in tests]
+                             location=loc, seed=seed, name=name, direction=d) for name, loc, d in tests + extra]
         rigmod.write(h5, [steady, runup, *struck])
     rig_wall = time.perf_counter() - t
     truth = box.modes(speed=SPEED, load=LOAD)
@@ -256,13 +277,14 @@ def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str, p
 
     scenario = load_scenario(_scenario(out / f"{rig_name}_{seed}.yaml", float(load_measurements(h5)[0].sample_rate),
                                        workers, model, pairing, visibility, fit, modes_from,
-                                       struck_shafts(tests) if name_shafts and tests else None))
+                                       struck_shafts(tests) if name_shafts and tests else None, path_from or None))
     t0 = time.perf_counter()
     report = run_calibration(scenario, h5, out / f"{rig_name}_{seed}_cal", progress=False)
     t_cal = time.perf_counter() - t0
     calibrated = load_scenario(out / f"{rig_name}_{seed}_cal" / "calibrated.yaml")
     fmu = calibrated.fmu_path()
-    mm = model_modes(fmu, calibrated.parameters, speed_hz=SPEED, load_nm=LOAD, channels=(CHANNEL,),
+    mech_fmu, mech_params = mechanical(calibrated)
+    mm = model_modes(mech_fmu, mech_params, speed_hz=SPEED, load_nm=LOAD, channels=(CHANNEL,),
                      visibility=visibility)
     twin_visible = mm.frequency[mm.visible]
     first6 = observable[:6]
@@ -278,6 +300,17 @@ def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str, p
     base_fmu = build_fmu("GearTwin.Gearbox21", REPO / "modelica", REPO / "build")
     sims = {"default twin (Gearbox21)": (base_fmu, {}),
             "calibrated twin": (fmu, dict(calibrated.parameters))}
+    if path:
+        # the same calibrated gearbox with its modelled casing path, levels fitted as `twin
+        # calibrate` without path_from fits them: the control of the measured path
+        from levels_rigs import without_levels
+
+        from twin.calibration.levels import fit_levels_and_panels
+        params = without_levels(mech_params)
+        _, updates = fit_levels_and_panels(mech_fmu, params, x, fs, speed_hz=float(meas.nominal_speed),
+                                           load_nm=float(meas.load), channel=CHANNEL, fmin=BAND[0],
+                                           fmax=min(BAND[1], 0.45 * fs), settle=0.1)
+        sims["calibrated twin, modelled path"] = (mech_fmu, {**params, **updates})
     spectrum = {}
     for label, (path, params) in sims.items():
         y = simulate_operating_point(path, float(meas.nominal_speed), float(meas.load), parameters=params,
@@ -339,6 +372,10 @@ def main() -> None:
                     help="with --hammer: name the shaft each hammer record strikes (calibration.struck_shafts), so "
                          "that no measured mode is paired with a model mode on the other shaft (scored on seeds "
                          "101-105 with the overhangs model, not adopted)")
+    ap.add_argument("--path", action="store_true",
+                    help="also strike each bearing support from above (HAMMER_AT['supports']) and let twin calibrate "
+                         "read the casing sensors through that measured path (calibration.path_from); the same "
+                         "calibration with the modelled path is reported beside it")
     ap.add_argument("--out", type=Path, default=REPO / "bench_out" / "calibration_rigs")
     ap.add_argument("--explain", action="store_true",
                     help="only the per-mode analysis of the results already in --out (no new scoring)")
@@ -369,7 +406,7 @@ def main() -> None:
             t = time.perf_counter()
             r = one_gearbox(rig, seed, args.out, args.workers, args.model, args.pairing, args.visibility,
                             args.fit, args.hammer, args.hammer_at, args.hammer_from, args.hammer_rate,
-                            args.hammer_duration, args.struck_shafts)
+                            args.hammer_duration, args.struck_shafts, args.path)
             r["fit"] = args.fit
             r["load_after"] = os.getloadavg()
             r["first6_explained"] = explain_modes(rig, seed, r, args.out, args.visibility)
@@ -378,7 +415,8 @@ def main() -> None:
             print(f"{rig} seed {seed}: {time.perf_counter() - t:.0f} s; first six "
                   f"{'PASS' if r['first6_pass'] else 'FAIL'} (max {max(r['first6_errors_pc']):.1f} %; within 3 %: "
                   f"{gearbox} by gearbox modes, {slots} by sensor-path slots), "
-                  f"{len(r['on_bounds'])} on bounds, {len(r['refused_by_shape'])} refused for their shape",
+                  f"{len(r['on_bounds'])} on bounds, {len(r['refused_by_shape'])} refused for their shape; spectral "
+                  "distance " + ", ".join(f"{k} {v['distance_db']:.1f} dB" for k, v in r["spectrum"].items()),
                   flush=True)
             (args.out / "results.json").write_text(json.dumps(rows, indent=2))
     cpu = next((ln.split(":", 1)[1].strip() for ln in open("/proc/cpuinfo") if ln.startswith("model name")), "?")

@@ -60,6 +60,15 @@ CALIBRATION_SCHEMA: dict[str, Any] = {
                           "description": "the shaft each hammer record of modes_from strikes (record name: input or "
                                          "output, one of each at least): a measured mode struck louder on one shaft "
                                          "is never paired with a model mode that lives on the other"},
+        "path_from": {"type": "object", "minProperties": 1,
+                      "additionalProperties": {"enum": ["bearing_force_input_x", "bearing_force_input_y",
+                                                        "bearing_force_output_x", "bearing_force_output_y"]},
+                      "description": "hammer records struck at the bearing housings (record name: the model's bearing "
+                                     "force that stands for the blow); the casing sensors then read the twin's "
+                                     "bearing forces through the accelerances these records measured (in-situ "
+                                     "transfer path analysis), not through the modelled casing"},
+        "path_sections": {"type": "integer", "minimum": 1, "maximum": 200,
+                          "description": "second-order sections fitted to each measured path (default 32)"},
         "min_confidence": {"type": "number", "minimum": 0, "maximum": 1},
         "lscf": {"type": "boolean", "description": "also fit the hammer-test records named in modes_from together by the "
                                                    "poly-reference LSCF method (close modes one FRF hump hides; default false)"},

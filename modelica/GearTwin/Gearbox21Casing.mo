@@ -14,8 +14,8 @@ model Gearbox21Casing "GearTwin.Gearbox21Measured with the casing in the loop: t
     excitation_mesh_displacement = pinion_roughness.displacement + gear_roughness.displacement,
     excitation_mesh_displacement_rate = pinion_roughness.displacement_rate + gear_roughness.displacement_rate,
     excitation_off_line_force = process.force,
-    sensor_path_acceleration_pinion = sensor_pinion.acceleration - casing_acceleration_pinion,
-    sensor_path_acceleration_gear = sensor_gear.acceleration - (cos(sensor_angle_gear) * der(vy9) + sin(sensor_angle_gear) * der(vx9)),
+    sensor_path_acceleration_pinion = noEvent(if n_path_sections > 0 then sensor_pinion.gain * path_pinion.acceleration else sensor_pinion.acceleration) - casing_acceleration_pinion,
+    sensor_path_acceleration_gear = noEvent(if n_path_sections > 0 then sensor_gear.gain * path_gear.acceleration else sensor_gear.acceleration) - (cos(sensor_angle_gear) * der(vy9) + sin(sensor_angle_gear) * der(vx9)),
     support_input_x = x_casing - shaft_height * phi_casing,
     support_input_y = y_casing - 0.5 * centre_distance * phi_casing,
     support_output_x = x_casing - shaft_height * phi_casing,
@@ -43,6 +43,13 @@ model Gearbox21Casing "GearTwin.Gearbox21Measured with the casing in the loop: t
   GearTwin.Excitation.ProcessForce process(enabled = broadband, seed = 3) "Friction and lubricant-film forces at the mesh, across the line of action";
   GearTwin.Sensors.CasingAccelerometer sensor_pinion(near_acceleration = cos(sensor_angle_pinion) * (der(vy_casing) - 0.5 * centre_distance * der(w_casing)) + sin(sensor_angle_pinion) * (der(vx_casing) - shaft_height * der(w_casing)), far_acceleration = cos(sensor_angle_pinion) * (der(vy_casing) - 0.5 * centre_distance * der(w_casing)) + sin(sensor_angle_pinion) * (der(vx_casing) - shaft_height * der(w_casing))) "B&K 4396 on the casing at the input-shaft bearing housing";
   GearTwin.Sensors.CasingAccelerometer sensor_gear(near_acceleration = cos(sensor_angle_gear) * (der(vy_casing) + 0.5 * centre_distance * der(w_casing)) + sin(sensor_angle_gear) * (der(vx_casing) - shaft_height * der(w_casing)), far_acceleration = cos(sensor_angle_gear) * (der(vy_casing) + 0.5 * centre_distance * der(w_casing)) + sin(sensor_angle_gear) * (der(vx_casing) - shaft_height * der(w_casing))) "B&K 4394 on the casing at the output-shaft bearing housing";
+  // ---- Transfer path measured by hammer tests (structural: 0 sections keeps the modelled casing) --
+  // With n_path_sections > 0 the sensors read the bearing forces through the accelerances measured
+  // by striking the housings of the real gearbox (GearTwin.Sensors.MeasuredPath, fitted by `twin
+  // calibrate` from hammer records); the casing above then only carries the pedestals.
+  parameter Integer n_path_sections = 0 "Second-order sections of each sensor's measured transfer path (structural; 0: the modelled casing and sensor path)";
+  GearTwin.Sensors.MeasuredPath path_pinion(n_sections = n_path_sections, n_forces = 4, force = {bearing_force_input_x, bearing_force_input_y, bearing_force_output_x, bearing_force_output_y}) "Measured path from the bearing forces to the B&K 4396";
+  GearTwin.Sensors.MeasuredPath path_gear(n_sections = n_path_sections, n_forces = 4, force = {bearing_force_input_x, bearing_force_input_y, bearing_force_output_x, bearing_force_output_y}) "Measured path from the bearing forces to the B&K 4394";
   // ---- Casing states -----------------------------------------------------------------------------
   Real x_casing(unit = "m", start = 0.0, fixed = true, nominal = 1e-6) "Horizontal displacement of the casing's centre of mass";
   Real y_casing(unit = "m", start = 0.0, fixed = true, nominal = 1e-6) "Vertical displacement of the casing's centre of mass";
@@ -56,11 +63,23 @@ model Gearbox21Casing "GearTwin.Gearbox21Measured with the casing in the loop: t
   Real pedestal_force_output_y(unit = "N") "Force of pedestals 9 and 11 on the casing, vertical";
   Real mount_force_x[2](each unit = "N") "Force of each mount on the casing, horizontal";
   Real mount_force_y[2](each unit = "N") "Force of each mount on the casing, vertical";
+  // The force the shafts put into their housings through the bearings (each housing's inertia force
+  // plus what it passes on to the casing). With the housings held still (their masses made very
+  // large) these are the blocked forces, which a transfer path measured by striking the housings
+  // of the assembled gearbox turns into the casing response (ISO 20270).
+  output Real bearing_force_input_x(unit = "N") "Force of the input shaft through its bearings on housings 4 and 6, horizontal";
+  output Real bearing_force_input_y(unit = "N") "Force of the input shaft through its bearings on housings 4 and 6, vertical";
+  output Real bearing_force_output_x(unit = "N") "Force of the output shaft through its bearings on housings 9 and 11, horizontal";
+  output Real bearing_force_output_y(unit = "N") "Force of the output shaft through its bearings on housings 9 and 11, vertical";
 equation
   pedestal_force_input_x = kx4 * (x4 - support_input_x) + cx4 * (vx4 - support_input_vx) + kx6 * (x6 - support_input_x) + cx6 * (vx6 - support_input_vx);
   pedestal_force_input_y = ky4 * (y4 - support_input_y) + cy4 * (vy4 - support_input_vy) + ky6 * (y6 - support_input_y) + cy6 * (vy6 - support_input_vy);
   pedestal_force_output_x = kx9 * (x9 - support_output_x) + cx9 * (vx9 - support_output_vx) + kx11 * (x11 - support_output_x) + cx11 * (vx11 - support_output_vx);
   pedestal_force_output_y = ky9 * (y9 - support_output_y) + cy9 * (vy9 - support_output_vy) + ky11 * (y11 - support_output_y) + cy11 * (vy11 - support_output_vy);
+  bearing_force_input_x = m4 * der(vx4) + m6 * der(vx6) + pedestal_force_input_x;
+  bearing_force_input_y = m4 * der(vy4) + m6 * der(vy6) + pedestal_force_input_y;
+  bearing_force_output_x = m9 * der(vx9) + m11 * der(vx11) + pedestal_force_output_x;
+  bearing_force_output_y = m9 * der(vy9) + m11 * der(vy11) + pedestal_force_output_y;
   // mount j at (s_j * mount_spacing / 2, -mount_height), s = {-1, +1}
   mount_force_x = {-kx_mount * (x_casing + mount_height * phi_casing) - cx_mount * (vx_casing + mount_height * w_casing) for j in 1:2};
   mount_force_y = {-ky_mount * (y_casing + (2 * j - 3) * 0.5 * mount_spacing * phi_casing) - cy_mount * (vy_casing + (2 * j - 3) * 0.5 * mount_spacing * w_casing) for j in 1:2};

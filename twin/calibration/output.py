@@ -27,13 +27,17 @@ def _absolute(value: str, base: Path | None) -> str:
     return str((base / p).resolve())
 
 
-def calibrated_scenario_dict(scenario, parameter_file: str, *, note: str = "") -> dict:
+def calibrated_scenario_dict(scenario, parameter_file: str, *, note: str = "",
+                             structural: Mapping[str, float] | None = None) -> dict:
     """The scenario's raw dict with paths made location-independent and the calibrated set in place.
 
     ``parameter_file`` is the parameter set's path relative to where the new scenario will be
-    written; it holds every parameter (the scenario's own and the calibrated ones).
+    written; it holds every parameter (the scenario's own and the calibrated ones). ``structural``
+    replaces the scenario's build options (a measured path's ``n_path_sections``).
     """
     data = copy.deepcopy(dict(scenario.raw))
+    if structural:
+        data["structural"] = dict(structural)
     base = scenario.source.parent if scenario.source is not None else None
     if str(data.get("fmu", "")).endswith(".fmu"):
         data["fmu"] = _absolute(data["fmu"], base)
@@ -50,7 +54,8 @@ def calibrated_scenario_dict(scenario, parameter_file: str, *, note: str = "") -
 
 
 def write_calibrated_scenario(scenario, out_path: str | Path, parameter_file: str | Path, *, note: str = "",
-                              calibrated: Mapping[str, float] | None = None) -> Path:
+                              calibrated: Mapping[str, float] | None = None,
+                              structural: Mapping[str, float] | None = None) -> Path:
     """Write the calibrated scenario (YAML) atomically; returns its path.
 
     ``calibrated`` (the fitted parameters) only goes into the header comment, for the reader;
@@ -66,7 +71,7 @@ def write_calibrated_scenario(scenario, out_path: str | Path, parameter_file: st
             rel = rel.relative_to(out_path.parent.resolve())
         except ValueError:
             pass
-    data = calibrated_scenario_dict(scenario, rel.as_posix(), note=note)
+    data = calibrated_scenario_dict(scenario, rel.as_posix(), note=note, structural=structural)
     scenario_from_dict(data, source=out_path)          # what is written must load
     header = ["# Written by twin calibrate. The parameter set in force is " + rel.as_posix() + "."]
     if calibrated:

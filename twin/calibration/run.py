@@ -161,12 +161,18 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
     if measurements is None:       # refused before anything is written
         objectives = modes_only_objectives(spec, source)
         speed_hz, load_nm = typed_operating_point(scenario, spec)
+    with_path = bool(scenario.structural.get("n_path_sections"))
+    if with_path:       # refused before anything is written when the block cannot fit the path again
+        from twin.calibration.transfer_path import mechanical_model
+        mechanical_fmu = mechanical_model(scenario, spec, source)
+    else:
+        mechanical_fmu = scenario.fmu_path()
     out_dir = check_output_dir(out_dir, "calibration output", create=True)
     duration = float(spec.get("record_duration", 0.3))
     settle = float(spec.get("settle_time", 0.1))
     channel = (scenario.outputs or ("accel_pinion_casing",))[0]
     auto = spec["parameters"] == "auto"
-    fmu = scenario.fmu_path()
+    fmu = mechanical_fmu
     # the model's modes are read at the sensors the measured ones were seen by (those it has)
     outputs = _outputs(fmu)
     rec = None
@@ -181,6 +187,9 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
         freqs, rel_sd, modes_what, damping, confidence, seen_by, shapes = measured_modes(spec, mset, source, out_dir,
                                                                                          with_damping=True)
         rec = _steady_record(spec, mset, scenario, channel, duration, source, measurements)
+        if spec.get("path_from"):     # refused before the modes fit
+            from twin.calibration.transfer_path import check_path_from
+            check_path_from(scenario, mset, spec, source)
         default_obj = (["waveform", "correlation", "frequencies"]
                        if not auto and not spec.get("modes_from") else ["correlation", "modes"])
         objectives = tuple(spec.get("objectives", default_obj))
@@ -195,6 +204,9 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
                                pairing=pairing, visibility=visibility, fit=fit,
                                search_budget=int(spec.get("search_budget", SEARCH_BUDGET)))
     fixed = dict(scenario.parameters)
+    if with_path:          # fitted again from the hammer records
+        from twin.calibration.transfer_path import without_path
+        fixed = without_path(fixed)
     if not auto:       # unknown or non-physical names and bounds: refused before the first evaluation
         check_calibration_parameters(fmu, ParameterSpace.from_bounds(spec["parameters"]),
                                      {k: v for k, v in fixed.items() if k not in spec["parameters"]})
@@ -244,17 +256,29 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
                            verbose=progress, resume=resume, refine=bool(spec.get("refine", True)),
                            nominal=nominal or None)
         chosen = dict(result.chosen)
-        levels = None
-        if rec is not None and has_levels(fmu, channel):
+        levels, measured_path, spectrum_fmu = None, None, fmu
+        if rec is not None and spec.get("path_from"):
+            # the sensors read the bearing forces through the path the hammer tests measured; the
+            # modes above were fitted on the model without it (its sections are not gearbox modes)
+            from twin.calibration.transfer_path import attach_measured_path
+            measured_path = attach_measured_path(scenario, mset, spec, source, fmin=band[0],
+                                                 fmax=min(band[1], 0.45 * rec.sample_rate))
+            spectrum_fmu = measured_path.fmu_path
+            chosen.update(measured_path.parameters)
+            if progress:
+                print(measured_path.describe())
+        if rec is not None and has_levels(spectrum_fmu, channel):
             # the level of the spectrum: sensor gain, roughness and process-force levels (three runs)
             level_kw = dict(speed_hz=target.drive_hz, load_nm=target.load, channel=channel, fmin=band[0],
                             fmax=min(band[1], 0.45 * rec.sample_rate), settle=settle)
-            levels, updates = fit_levels_and_panels(fmu, {**fixed, **chosen}, np.asarray(rec[channel], float),
+            levels, updates = fit_levels_and_panels(spectrum_fmu, {**fixed, **chosen}, np.asarray(rec[channel], float),
                                                     rec.sample_rate, **level_kw)
             chosen.update(updates)
             if progress:
                 print(f"levels: {levels.describe()}")
-        after, _ = evaluate_candidate(EvalTask(str(fmu), {**fixed, **chosen}, target, settle, duration, shaft))
+        path_values = measured_path.parameters if measured_path is not None else {}
+        mechanical = {k: v for k, v in chosen.items() if k not in path_values}
+        after, _ = evaluate_candidate(EvalTask(str(fmu), {**fixed, **mechanical}, target, settle, duration, shaft))
     finally:
         if executor is None:
             ex.close()
@@ -264,7 +288,8 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
                 if n in on_bounds(space.names, [chosen[k] for k in space.names], space.lower, space.upper)]
     if levels is not None and (held := levels.warning()):
         warnings.append(held)
-    notes = tuple(n for n in (path_note, f"levels: {levels.describe()}" if levels is not None else None) if n)
+    notes = tuple(n for n in (path_note, measured_path.describe() if measured_path is not None else None,
+                              f"levels: {levels.describe()}" if levels is not None else None) if n)
     if progress:
         for w in warnings:
             print(f"warning: {w}")
@@ -272,27 +297,32 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
     against = (f"{Path(measurements).name}, {modes_what}" if measurements is not None
                else f"modes {modes_what} at {speed_hz:g} Hz, {load_nm:g} N.m")
     write_parameter_set(full, out_dir / "calibrated.json")
-    write_parameter_set(full, out_dir / "calibrated.ssv", name=f"{scenario.name}-calibrated", fmu=fmu)
+    write_parameter_set(full, out_dir / "calibrated.ssv", name=f"{scenario.name}-calibrated", fmu=spectrum_fmu)
     from twin.ssp import write_ssp
-    write_ssp(fmu, full, out_dir / "calibrated.ssp", name=f"{scenario.name}-calibrated",
+    write_ssp(spectrum_fmu, full, out_dir / "calibrated.ssp", name=f"{scenario.name}-calibrated",
               description=f"{scenario.name}: parameters calibrated to {against}")
     write_parameter_set({**fixed, **result.knee}, out_dir / "knee.json")
     write_pareto(result, objectives, out_dir / "pareto.csv")
+    structural = ({**dict(scenario.structural), "n_path_sections": measured_path.n_sections}
+                  if measured_path is not None else None)
     scenario_file = write_calibrated_scenario(scenario, out_dir / "calibrated.yaml", "calibrated.json",
-                                              note=against, calibrated=chosen)
+                                              note=against, calibrated=mechanical, structural=structural)
+    full_mechanical = {**fixed, **mechanical}
     if "modes" in objectives:
         mb = mode_errors(model_modes(fmu, {**fixed, **nominal}, **kw), freqs, target.rel_sd, target.mode_shapes,
                          pairing=pairing)[1]
-        ma = mode_errors(model_modes(fmu, full, **kw), freqs, target.rel_sd, target.mode_shapes, pairing=pairing)[1]
+        ma = mode_errors(model_modes(fmu, full_mechanical, **kw), freqs, target.rel_sd, target.mode_shapes,
+                         pairing=pairing)[1]
     else:
         from twin.linearize import natural_frequencies
         b = natural_frequencies(fmu, n=freqs.size + 4, parameters={**fixed, **nominal, **_start(target)})
-        a = natural_frequencies(fmu, n=freqs.size + 4, parameters={**full, **_start(target)})
+        a = natural_frequencies(fmu, n=freqs.size + 4, parameters={**full_mechanical, **_start(target)})
         mb, ma = b[match_modes(b, freqs)], a[match_modes(a, freqs)]
     report = CalibrationReport(result, freqs, mb, ma, before, after, out_dir, objectives, tuple(warnings),
                                sensitivity, modes_what, scenario_file, notes)
-    if rec is not None:
-        psd_overlay(fmu, target, {**fixed, **nominal}, chosen, settle, duration, out_dir / "report_psd.png")
+    if rec is not None:       # before: the nominal parameters (with the measured path when there is one)
+        psd_overlay(spectrum_fmu, target, {**fixed, **nominal, **path_values}, chosen, settle, duration,
+                    out_dir / "report_psd.png")
     write_html(report, scenario, measurements, out_dir / "report.html")
     return report
 

@@ -106,6 +106,7 @@ class Conditions:
     z1: int                                     # pinion teeth
     z2: int                                     # gear teeth
     operating: Operating
+    structural: dict = field(default_factory=dict)   # the FMU's build-time Integers (n_path_sections, ...)
 
 
 def record_conditions(fmu_path, measured: np.ndarray, sample_rate: float, nominal_speed: float, load: float,
@@ -132,7 +133,8 @@ def record_conditions(fmu_path, measured: np.ndarray, sample_rate: float, nomina
     measured = measured[-int(round(min(duration, measured.size / sample_rate) * sample_rate)):]
     with FMU(fmu_path) as fmu:
         current = fmu.parameter_values()
-        teeth = {**{k: v for k, v in current.items() if k in ("z1", "z2")}, **fmu.structural_values()}
+        structural = fmu.structural_values()
+        teeth = {**{k: v for k, v in current.items() if k in ("z1", "z2")}, **structural}
     missing = [h for h in ("z1", "z2") if h not in teeth] + [h for h in ("c_motor",) if h not in current]
     if missing:
         raise ParameterError(f"{fmu_path} is not a GearTwin.Gearbox21 model (no parameter(s) "
@@ -141,7 +143,7 @@ def record_conditions(fmu_path, measured: np.ndarray, sample_rate: float, nomina
     op = measured_operating(measured, sample_rate, nominal_speed, load, teeth=z1, gear_teeth=z2,
                             c_motor=float(parameters.get("c_motor", current["c_motor"])),
                             solver_step=solver_step if "solver.step_size" in current else None)
-    return Conditions(measured, current, z1, z2, op)
+    return Conditions(measured, current, z1, z2, op, structural)
 
 
 def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed: float | None = None,
@@ -212,11 +214,9 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
     before = compare_signals(base_model, measured, sample_rate, shaft, z1=z1, z2=z2)
 
     if candidates_fmu is None:
-        from fmu_build import build_fmu
-
-        from twin.effects.variant import _REPO_MODELICA, base_of, candidates_model
-        candidates_fmu = build_fmu(candidates_model(base_of(current)), _REPO_MODELICA,
-                                   _REPO_MODELICA.parent / "build")
+        from twin.effects.variant import _REPO_MODELICA, base_of, build_like, candidates_model
+        candidates_fmu = build_like(candidates_model(base_of(current)), _REPO_MODELICA,
+                                    _REPO_MODELICA.parent / "build", cond.structural)
     # the candidate model starts from the current model: base parameters, the active effects at
     # their values in the current FMU, every other effect neutral
     probe = dict(parameters)

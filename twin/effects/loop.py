@@ -169,15 +169,14 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
     so runs on other gearboxes never overwrite it.
     """
     import yaml
-    from fmu_build import build_fmu
 
     from twin._atomic import atomic_path
     from twin.calibration.problem import write_parameter_set
     from twin.compare import compare_signals
     from twin.effects.diagnose import starting_values
     from twin.effects.verdict import _band_error
-    from twin.effects.variant import (_REPO_MODELICA, base_of, candidates_model, modelica_root, variant_source,
-                                      write_variant)
+    from twin.effects.variant import (_REPO_MODELICA, base_of, build_like, candidates_model, modelica_root,
+                                      variant_source, write_variant)
     from twin.errors import ParameterError
 
     eff = get_effect(effect_id)
@@ -208,8 +207,8 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
         guesses.update(split_fitted(effect_id, start)[0])
     if refit:
         if candidates_fmu is None:
-            candidates_fmu = build_fmu(candidates_model(base_of(current)), _REPO_MODELICA,
-                                       _REPO_MODELICA.parent / "build")
+            candidates_fmu = build_like(candidates_model(base_of(current)), _REPO_MODELICA,
+                                        _REPO_MODELICA.parent / "build", cond.structural)
         probe = {**base_params, **values, **neutral_values(active)}
         spec = TrialSpec(effect_id, str(candidates_fmu), channel, measured, op, probe, guesses, max_evals,
                          related=now, related_anchor=anchors)
@@ -226,7 +225,7 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
                                                      **{eff.parameter(k): v for k, v in fitted_effect.items()}},
                                                base=base_of(current)),
                                 modelica_dir)
-    fmu_path = build_fmu(model, modelica_dir, build_dir)
+    fmu_path = build_like(model, modelica_dir, build_dir, cond.structural)
     sim1 = simulate(fmu_path, base_params, op, measured.size, channel)
     after = compare_signals(sim1, measured, rec.sample_rate, shaft, z1=z1, z2=z2)
     per = tuple((f.description, _band_error(before, f.band_hz), _band_error(after, f.band_hz))

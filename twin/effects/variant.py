@@ -181,3 +181,21 @@ def write_variant(source: str, modelica_dir: str | Path | None = None) -> tuple[
         with atomic_path(top) as tmp:
             Path(tmp).write_text(top.read_text().rstrip("\n") + "\nVariants\n")
     return f"{VARIANTS_PACKAGE}.{short}", path
+
+
+#: Build options of a current model that a candidate or variant built from it keeps: a measured
+#: transfer path's sections (the path's values are parameters, but their number is structural).
+CARRIED_OPTIONS = ("n_path_sections",)
+
+
+def build_like(model: str, modelica_dir, build_dir, structural: Mapping[str, int] | None = None) -> Path:
+    """Build ``model`` (cached) with the options of :data:`CARRIED_OPTIONS` that ``structural`` (the
+    current FMU's structural values) sets, so a candidate or variant of a model with a measured
+    path has the same path blocks."""
+    from fmu_build import build_fmu
+    keep = {k: int(v) for k, v in (structural or {}).items() if k in CARRIED_OPTIONS and v}
+    if not keep:
+        return build_fmu(model, modelica_dir, build_dir)
+    from twin.variants import build_variant
+    return build_variant(model, keep, modelica_dir=modelica_dir, out_dir=build_dir)
+
