@@ -91,13 +91,11 @@ def one_case(rig_name: str, seed: int, effect: str, calibrated, out: Path, ex, s
                d.candidates[0])
     dist1 = None
     if top.fitted and top.error is None:
-        from fmu_build import build_fmu
-
-        from twin.effects.variant import _REPO_MODELICA, base_of, candidates_model
+        from twin.effects.variant import _REPO_MODELICA, base_of, build_like, candidates_model
         from twin.fmu import FMU
         with FMU(fmu) as f:
-            base = base_of(f.parameter_values())
-        cand = build_fmu(candidates_model(base), _REPO_MODELICA, _REPO_MODELICA.parent / "build")
+            base, structural = base_of(f.parameter_values()), f.structural_values()
+        cand = build_like(candidates_model(base), _REPO_MODELICA, _REPO_MODELICA.parent / "build", structural)
         probe = {**params, **{e.parameter(k): v for e in CATALOGUE.values() for k, v in e.neutral.items()},
                  **top.fitted}
         try:

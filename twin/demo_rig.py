@@ -9,6 +9,11 @@ and ``steady``; ``twin`` never imports ``rigs``). The step does what a user does
     twin modes rig.h5 --record runup --record hammer --record hammer_gear   # struck on each shaft
     twin calibrate scenario.yaml --measurements rig.h5 --modes-from runup --out calibration_rig/
     twin compare calibration_rig/calibrated.yaml --measurements rig.h5 --record steady
+
+With both hammer records (blows at the pinion's and the gear's pedestal) the twin is
+``GearTwin.Gearbox21Shafts`` and its casing sensors read the path those blows measured
+(``calibration.path_from``, :mod:`twin.calibration.transfer_path`); without them,
+``GearTwin.Gearbox21Measured`` with its modelled sensor path.
 """
 from __future__ import annotations
 
@@ -23,6 +28,8 @@ import numpy as np
 #: The demo's hammer records and the shaft each strikes (calibration.struck_shafts): the pinion's
 #: pedestal on the input shaft, the gear's on the output shaft.
 STRUCK = {"hammer": "input", "hammer_gear": "output"}
+#: The twin's bearing force each of those blows stands for (calibration.path_from).
+PATH_FROM = {"hammer": "bearing_force_input_y", "hammer_gear": "bearing_force_output_y"}
 
 
 def merge_records(steady_file: Path, runup_file: Path, out: Path, *hammer_files: Path) -> Path:
@@ -78,16 +85,19 @@ def rig_calibration_demo(out_dir: Path, steady_file: Path, runup_file: Path, *ha
         _lines(f"twin modes ... --lscf (the hammer FRFs also fitted by poly-reference LSCF, an opt-in): "
                f"{fitted.notes[-1]}")
     scenario_file = d / "scenario.yaml"
+    path = all(n in mset.names for n in PATH_FROM)
     scenario_file.write_text(json.dumps({
-        "version": 1, "name": "pedestal-rig", "fmu": "GearTwin.Gearbox21Measured", "stop_time": 2.0,
+        "version": 1, "name": "pedestal-rig", "fmu": "GearTwin.Gearbox21Shafts" if path else "GearTwin.Gearbox21Measured",
+        "stop_time": 2.0,
         "output": {"sample_rate": mset["steady"].sample_rate, "variables": ["accel_pinion_casing"]},
         "operating": {"speed": mset["steady"].nominal_speed, "load": mset["steady"].load}, "seed": 0,
         "calibration": {"parameters": "auto", "modes_from": "runup", "record": "steady", "objectives": ["modes"],
-                        "algorithm": "nsga2", "pop_size": 8, "n_gen": 2}}, indent=2))
+                        "algorithm": "nsga2", "pop_size": 8, "n_gen": 2, **({"path_from": PATH_FROM} if path else {})}},
+        indent=2))
     t = time.perf_counter()
     report = run_calibration(load_scenario(scenario_file), h5, out_dir / "calibration_rig", progress=False)
-    _lines(f"twin calibrate --modes-from runup, parameters chosen from the modes' sensitivities "
-           f"({', '.join(report.result.chosen)}; {time.perf_counter() - t:.0f} s):")
+    _lines(f"twin calibrate --modes-from runup{' (path_from: the two hammer records)' * path}, parameters chosen "
+           f"from the modes' sensitivities ({', '.join(report.result.chosen)}; {time.perf_counter() - t:.0f} s):")
     _lines(report.table())
     _lines("\n".join((*report.notes, *(f"warning: {w}" for w in report.warnings))))
     calibrated = load_scenario(report.scenario_file)

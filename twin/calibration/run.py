@@ -8,6 +8,9 @@ Scenario block (every key but ``parameters`` optional)::
                                   # or a list read together: [runup, hammer_pinion, hammer_gear]
       min_confidence: 0.3         # modes of that record used for calibration
       lscf: false                 # also fit the hammer records together by poly-reference LSCF
+      path_from: {hammer_pinion: bearing_force_input_y}   # hammer records struck at the housings: the
+                                  # sensors read the bearing forces through the path they measured
+      path_sections: 32           # second-order sections fitted to each measured path
       natural_frequencies: [22, 87, 218, 430]   # or typed by hand [Hz]
       foundation_modes: [13, 41]  # removed from the measured modes (paper: hammer test), in Hz
                                   #   or the name of a hammer-test record to read them from
@@ -100,7 +103,8 @@ def _col(model: float, measured: float) -> str:
     return f"{model:13.1f} {100 * (model - measured) / measured:+9.1f}"
 
 
-def _block(scenario, modes_from: str | None, pairing: str | None = None, foundation_from: str | None = None) -> dict:
+def _block(scenario, modes_from: str | None, pairing: str | None = None, foundation_from: str | None = None,
+           path_from: dict[str, str] | None = None) -> dict:
     import jsonschema
 
     spec = scenario.raw.get("calibration")
@@ -117,6 +121,8 @@ def _block(scenario, modes_from: str | None, pairing: str | None = None, foundat
         spec["pairing"] = pairing
     if foundation_from is not None:
         spec["foundation_modes"] = foundation_from
+    if path_from is not None:
+        spec["path_from"] = dict(path_from)
     errors = [(str(scenario.source), "calibration." + ".".join(map(str, e.absolute_path)),
                "must be 'auto' or a mapping of parameter name to [lower, upper]"
                if e.validator == "oneOf" else e.message)
@@ -129,11 +135,12 @@ def _block(scenario, modes_from: str | None, pairing: str | None = None, foundat
 def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Path, *, executor=None,
                     progress: bool = True, seed: int | None = None, resume: bool = False,
                     modes_from: str | list[str] | None = None, pairing: str | None = None,
-                    foundation_from: str | None = None) -> CalibrationReport:
+                    foundation_from: str | None = None, path_from: dict[str, str] | None = None
+                    ) -> CalibrationReport:
     """Calibrate the scenario's FMU to a measurement file, or with ``measurements=None`` to the
     block's typed natural frequencies alone (see the module docstring); ``modes_from``,
-    ``pairing`` and ``foundation_from`` (a hammer record: ``foundation_modes``) override the
-    calibration block's keys."""
+    ``pairing``, ``foundation_from`` (a hammer record: ``foundation_modes``) and ``path_from``
+    ({hammer record: bearing force}) override the calibration block's keys."""
     from twin._atomic import check_output_dir
     from twin.calibration.levels import fit_levels_and_panels, has_levels
     from twin.calibration.modal_fit import mode_errors, on_bounds
@@ -154,7 +161,7 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
     if measurements is None and scenario.raw.get("calibration") is None:
         raise ScenarioError([(source, "calibration", "the scenario has no calibration block: without --measurements "
                               "it must type the measured natural_frequencies [Hz]")])
-    spec = _block(scenario, modes_from, pairing, foundation_from)
+    spec = _block(scenario, modes_from, pairing, foundation_from, path_from)
     pairing = spec.get("pairing", "frequency")
     visibility = spec.get("visibility", "mesh")
     fit = spec.get("fit", "follow")

@@ -25,6 +25,10 @@ def add_subcommands(sub) -> None:
     p.add_argument("--foundation-from", metavar="RECORD",
                    help="hammer-test record of the foundation (casing root): its modes are left out of the "
                         "measured ones, as the paper does")
+    p.add_argument("--path-from", metavar="RECORD=FORCE", type=_path_pair, action="append",
+                   help="a hammer record struck at a bearing housing and the model's bearing force its blow stands "
+                        "for (e.g. hammer_pinion=bearing_force_input_y; repeat per record): the casing sensors then "
+                        "read the model's bearing forces through the measured path (calibration.path_from)")
     _add_pairing_option(p)
     p.add_argument("--no-progress", action="store_true", help="quiet")
     p.set_defaults(handler=_cmd_calibrate)
@@ -50,7 +54,8 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
                                                           progress=not args.no_progress, seed=args.seed,
                                                           resume=args.resume, modes_from=args.modes_from,
                                                           pairing=args.pairing,
-                                                          foundation_from=args.foundation_from)
+                                                          foundation_from=args.foundation_from,
+                                                          path_from=dict(args.path_from) if args.path_from else None)
     print(f"modes: {report.modes_source}")
     print(report.table())
     for n in report.notes:
@@ -101,6 +106,14 @@ def _record_list(text: str):
     if not all(names):
         raise argparse.ArgumentTypeError(f"empty record name in {text!r}")
     return names[0] if len(names) == 1 else names
+
+
+def _path_pair(text: str) -> tuple[str, str]:
+    """``--path-from``: ``RECORD=FORCE``."""
+    record, sep, force = text.partition("=")
+    if not sep or not record.strip() or not force.strip():
+        raise argparse.ArgumentTypeError(f"expected RECORD=FORCE (e.g. hammer_pinion=bearing_force_input_y), got {text!r}")
+    return record.strip(), force.strip()
 
 
 def _add_pairing_option(p) -> None:

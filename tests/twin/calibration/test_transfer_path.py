@@ -166,3 +166,106 @@ def test_a_build_without_a_path_keeps_the_modelled_casing_and_its_states(shafts_
         assert f.structural_values()["n_path_sections"] == 0
         assert all(name in {v.name for v in f.outputs} for name in FORCES)
         assert not any(n.startswith("path_pinion.x") for n in f.variables)
+
+
+@pytest.fixture(scope="module")
+def path_records(shafts_fmu, tmp_path_factory):
+    """A steady record of the shafts model and two hammer records (blows at each housing) of a
+    structure with two modes, in one measurement file."""
+    from twin.measurements import Record, write_measurements
+    from twin.operating import simulate_operating_point
+
+    fs = 12800.0
+    y = simulate_operating_point(shafts_fmu, 20.0, 20.0, settle=0.05, duration=0.3,
+                                 channels=["accel_pinion_casing"], output_interval=1 / fs)[:, 0]
+    records = [Record("steady", {"accel_pinion_casing": y}, {"accel_pinion_casing": "m/s2"}, fs,
+                      nominal_speed=20.0, load=20.0)]
+    for name, r, seed in (("hammer_a", [0.02, -0.01], 0), ("hammer_b", [-0.005, 0.02], 1)):
+        rec = _record(name, fs, [400.0, 1500.0], [0.02, 0.03], r, seconds=4.0, seed=seed)
+        records.append(Record(name, dict(rec.data), dict(rec.units), fs, nominal_speed=0.5, load=20.0))
+    path = tmp_path_factory.mktemp("path") / "rig.h5"
+    write_measurements(records, path)
+    return path
+
+
+def _path_scenario(fmu: str, **block):
+    from twin.scenario import scenario_from_dict
+    return scenario_from_dict({
+        "version": 1, "name": "pathcal", "fmu": fmu, "stop_time": 0.3,
+        "output": {"sample_rate": 12800.0, "variables": ["accel_pinion_casing"]},
+        "operating": {"speed": 20, "load": 20}, "executor": {"type": "local", "workers": 1},
+        "calibration": {"parameters": {"kt57": [9.0e3, 1.5e4]}, "natural_frequencies": [450.0],
+                        "objectives": ["modes"], "algorithm": "nsga2", "pop_size": 4, "n_gen": 1, "refine": False,
+                        "record": "steady", "record_duration": 0.1, "settle_time": 0.05,
+                        "path_from": {"hammer_a": "bearing_force_input_y", "hammer_b": "bearing_force_output_y"},
+                        "path_sections": 2, **block}})
+
+
+@pytest.mark.parametrize("change, message", [
+    ({"path_from": {"nope": "bearing_force_input_y"}}, "no record 'nope' in the measurements"),
+    ({"path_from": {"steady": "bearing_force_input_y"}}, "'steady' is not a hammer test"),
+])
+def test_a_bad_path_from_is_refused_naming_the_record(path_records, tmp_path, change, message):
+    from twin.calibration.run import run_calibration
+    from twin.errors import ScenarioError
+    with pytest.raises(ScenarioError, match=message):
+        run_calibration(_path_scenario("GearTwin.Gearbox21Shafts", **change), path_records, tmp_path / "out",
+                        progress=False)
+    assert not (tmp_path / "out" / "calibrated.yaml").exists()
+
+
+def test_a_path_needs_a_model_built_here_with_bearing_forces(path_records, shafts_fmu, tmp_path):
+    from twin.calibration.run import run_calibration
+    from twin.errors import ScenarioError
+    with pytest.raises(ScenarioError, match="must name a Modelica model"):
+        run_calibration(_path_scenario(str(shafts_fmu)), path_records, tmp_path / "a", progress=False)
+    with pytest.raises(ScenarioError, match="no bearing force outputs"):
+        run_calibration(_path_scenario("GearTwin.Gearbox21Measured"), path_records, tmp_path / "b", progress=False)
+
+
+def test_twin_calibrate_with_path_from_writes_a_scenario_that_reads_the_measured_path(path_records, tmp_path):
+    import json
+
+    from twin.calibration.run import run_calibration
+    from twin.fmu import FMU
+    from twin.operating import simulate_operating_point
+    from twin.scenario import load_scenario
+
+    report = run_calibration(_path_scenario("GearTwin.Gearbox21Shafts"), path_records, tmp_path / "out",
+                             progress=False)
+    assert any(n.startswith("measured transfer path (2 sections) from hammer_a (bearing_force_input_y)")
+               for n in report.notes)
+    calibrated = load_scenario(tmp_path / "out" / "calibrated.yaml")
+    assert dict(calibrated.structural) == {"n_path_sections": 2}
+    values = json.loads((tmp_path / "out" / "calibrated.json").read_text())["parameters"]
+    fitted = sorted(values[f"path_pinion.section_frequency[{r}]"] for r in (1, 2))
+    # the records' modes where their bilinear generator puts them (frequency warping at 12.8 kHz)
+    warped = [12800.0 / np.pi * np.arctan(np.pi * f / 12800.0) for f in (400.0, 1500.0)]
+    assert fitted == pytest.approx(warped, rel=0.01)
+    with FMU(calibrated.fmu_path()) as f:
+        assert f.structural_values()["n_path_sections"] == 2
+    y = simulate_operating_point(calibrated.fmu_path(), 20.0, 20.0, parameters=dict(calibrated.parameters),
+                                 settle=0.05, duration=0.1, channels=["accel_pinion_casing"], output_interval=1e-4)
+    assert np.all(np.isfinite(y)) and np.std(y) > 0
+    # calibrating the calibrated scenario again needs the path's records
+    from twin.errors import ScenarioError
+    again = {k: v for k, v in calibrated.raw["calibration"].items() if k not in ("path_from", "path_sections")}
+    from dataclasses import replace
+    with pytest.raises(ScenarioError, match="reads a measured transfer path"):
+        run_calibration(replace(calibrated, raw={**calibrated.raw, "calibration": again}), path_records,
+                        tmp_path / "again", progress=False)
+
+
+def test_path_from_on_the_command_line(capsys, shafts_fmu):
+    from twin.calibration.run import _block
+    from twin.cli import main
+    from twin.commands.calibration import _path_pair
+
+    assert _path_pair(" hammer_a = bearing_force_input_y") == ("hammer_a", "bearing_force_input_y")
+    assert main(["calibrate", "s.yaml", "--path-from", "hammer_a"]) == 2
+    assert "expected RECORD=FORCE" in capsys.readouterr().err
+    scenario = _path_scenario(str(shafts_fmu))
+    assert _block(scenario, None, path_from={"h": "bearing_force_output_x"})["path_from"] == {"h": "bearing_force_output_x"}
+    from twin.errors import ScenarioError
+    with pytest.raises(ScenarioError, match="bearing_force_sideways"):
+        _block(scenario, None, path_from={"h": "bearing_force_sideways"})
