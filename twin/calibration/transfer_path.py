@@ -41,13 +41,20 @@ DEFAULT_SECTIONS = 32
 @dataclass(frozen=True)
 class Accelerance:
     """One measured accelerance: ``frequency`` (m,) [Hz], ``value`` (m,) complex [m/s^2/N],
-    ``coherence`` (m,) [-], from ``record`` (struck) to ``channel``."""
+    ``coherence`` (m,) [-], from ``record`` (struck) to ``channel``, averaged over ``segments``."""
 
     record: str
     channel: str
     frequency: np.ndarray
     value: np.ndarray
     coherence: np.ndarray
+    segments: int = 1
+
+    def coherent(self, fmin: float, fmax: float) -> bool:
+        """Whether the response holds the blows at all over [fmin, fmax] Hz: a median coherence
+        above twice what two unrelated signals show over this many segments (about 1 / segments)."""
+        band = (self.frequency >= fmin) & (self.frequency <= fmax)
+        return bool(np.median(self.coherence[band]) > 2.0 / max(self.segments, 1))
 
 
 def force_channel(record) -> str:
@@ -76,7 +83,8 @@ def hammer_accelerance(record, channel: str, *, resolution: float = 4.0) -> Acce
     _, sxx = sps.welch(response, fs=fs, nperseg=n)
     h = sfx / np.maximum(sff, 1e-300)
     coh = np.abs(sfx) ** 2 / np.maximum(sff * sxx, 1e-300)
-    return Accelerance(record.name, channel, f, h, np.clip(coh, 0.0, 1.0))
+    segments = 1 + max(force.size - n, 0) // (n // 2)       # Welch's default half overlap
+    return Accelerance(record.name, channel, f, h, np.clip(coh, 0.0, 1.0), segments)
 
 
 class PathFit:
@@ -136,6 +144,9 @@ class PathFit:
         self.residue_ = (c0 * scale ** 2).T
         self.feedthrough_ = d
         self.error_db_ = np.sqrt(np.sum(ww * err ** 2, axis=1) / np.maximum(np.sum(ww, axis=1), 1e-300))
+        if not all(np.all(np.isfinite(v)) for v in (self.section_frequency_, self.residue_rate_, self.residue_,
+                                                     self.feedthrough_, self.error_db_)):
+            raise ValueError("the rational fit did not converge (non-finite sections)")
         return self
 
     def predict(self, frequency: np.ndarray) -> np.ndarray:
@@ -265,6 +276,15 @@ def fit_paths(mset, path_from: Mapping[str, str], channels: Sequence[str], *, n_
         if not all(channel in r for r in records):
             continue
         acc = [hammer_accelerance(r, channel) for r in records]
+        for a in acc:
+            band = (a.frequency >= fmin) & (a.frequency <= fmax)
+            if not (np.all(np.isfinite(a.value[band])) and np.any(np.abs(a.value[band]) > 0)):
+                raise ValueError(f"record {a.record!r} gives no accelerance to {channel} (no blow in its force "
+                                 "channel, or a response that is not finite)")
+            if not a.coherent(fmin, fmax):
+                raise ValueError(f"record {a.record!r}: the response of {channel} is not coherent with the blows "
+                                 f"(median coherence {np.median(a.coherence[band]):.3f} over {fmin:g}-{fmax:g} Hz, "
+                                 f"{a.segments} segments)")
         f = acc[0].frequency
         if any(a.frequency.size != f.size for a in acc):
             raise ValueError("the hammer records of the path have different sample rates")

@@ -269,3 +269,15 @@ def test_path_from_on_the_command_line(capsys, shafts_fmu):
     from twin.errors import ScenarioError
     with pytest.raises(ScenarioError, match="bearing_force_sideways"):
         _block(scenario, None, path_from={"h": "bearing_force_sideways"})
+
+
+def test_a_record_without_blows_or_coherence_is_named():
+    fs = 20000.0
+    silent = _record("silent", fs, [400.0], [0.02], [0.02])
+    silent.data["hammer"] = np.zeros_like(silent.data["hammer"])
+    with pytest.raises(ValueError, match="record 'silent' gives no accelerance"):
+        fit_paths({"silent": silent}, {"silent": "bearing_force_input_y"}, ["accel_pinion_casing"], n_sections=2)
+    noisy = _record("noisy", fs, [400.0], [0.02], [0.02])
+    noisy.data["accel_pinion_casing"] = np.random.default_rng(0).standard_normal(noisy.data["hammer"].size)
+    with pytest.raises(ValueError, match="record 'noisy': the response of accel_pinion_casing is not coherent"):
+        fit_paths({"noisy": noisy}, {"noisy": "bearing_force_input_y"}, ["accel_pinion_casing"], n_sections=2)
