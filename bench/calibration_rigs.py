@@ -109,13 +109,10 @@ PATH_FORCES = ("bearing_force_input_y", "bearing_force_output_y")
 
 def mechanical(calibrated) -> tuple[Path, dict]:
     """The calibrated twin's FMU and parameters without a measured path (its modes are the gearbox's)."""
-    from dataclasses import replace
-
-    from twin.calibration.transfer_path import SECTIONS_PARAMETER, without_path
+    from twin.calibration.transfer_path import SECTIONS_PARAMETER, model_without_path, without_path
     if not calibrated.structural.get(SECTIONS_PARAMETER):
         return calibrated.fmu_path(), dict(calibrated.parameters)
-    rest = {k: v for k, v in calibrated.structural.items() if k != SECTIONS_PARAMETER}
-    return replace(calibrated, structural=rest).fmu_path(), without_path(dict(calibrated.parameters))
+    return model_without_path(calibrated), without_path(dict(calibrated.parameters))
 
 
 def observable_modes(box) -> np.ndarray:

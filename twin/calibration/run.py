@@ -402,6 +402,10 @@ def scenario_sensitivity(scenario, measurements: str | Path | None = None, *, mo
     channel = (scenario.outputs or ("accel_pinion_casing",))[0]
     fmu = scenario.fmu_path()
     values = dict(scenario.parameters)
+    if scenario.structural.get("n_path_sections"):
+        # a scenario that reads a measured path: the modes are the gearbox's, not the path's sections
+        from twin.calibration.transfer_path import model_without_path, without_path
+        fmu, values = model_without_path(scenario), without_path(values)
     channels, shapes = (channel,), None
     if measurements is not None and (spec.get("modes_from") or spec.get("natural_frequencies")):
         mset = load_measurements(measurements)

@@ -401,13 +401,18 @@ def mechanical_model(scenario, spec: Mapping, source: str):
     """The scenario's model without its measured path, for a scenario that reads one (a calibrated
     one): its modes are the gearbox's, not the path's sections. The path must be fitted again
     (``path_from``): ScenarioError otherwise, since calibrating without it would drop the path."""
-    from dataclasses import replace
-
     from twin.errors import ScenarioError
 
     if not spec.get("path_from"):
         raise ScenarioError([(source, "structural.n_path_sections",
                               "the scenario reads a measured transfer path; calibrate it again with "
                               "calibration.path_from (the hammer records), or calibrate the scenario it came from")])
+    return model_without_path(scenario)
+
+
+def model_without_path(scenario):
+    """The FMU of the scenario's model built without a measured path (its other build options kept)."""
+    from dataclasses import replace
+
     rest = {k: v for k, v in scenario.structural.items() if k != SECTIONS_PARAMETER}
     return replace(scenario, structural=rest).fmu_path()

@@ -244,6 +244,9 @@ def test_twin_calibrate_with_path_from_writes_a_scenario_that_reads_the_measured
     assert fitted == pytest.approx(warped, rel=0.01)
     with FMU(calibrated.fmu_path()) as f:
         assert f.structural_values()["n_path_sections"] == 2
+    from twin.calibration.transfer_path import model_without_path
+    with FMU(model_without_path(calibrated)) as f:        # what its modes are read on (sensitivity, a new fit)
+        assert f.structural_values()["n_path_sections"] == 0
     y = simulate_operating_point(calibrated.fmu_path(), 20.0, 20.0, parameters=dict(calibrated.parameters),
                                  settle=0.05, duration=0.1, channels=["accel_pinion_casing"], output_interval=1e-4)
     assert np.all(np.isfinite(y)) and np.std(y) > 0
