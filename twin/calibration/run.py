@@ -166,20 +166,22 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
     visibility = spec.get("visibility", "mesh")
     fit = spec.get("fit", "follow")
     if measurements is None:       # refused before anything is written
+        if spec.get("path_from"):
+            raise ScenarioError([(source, "calibration.path_from", "a measured path needs the measurement file "
+                                  "that holds its hammer records (--measurements)")])
         objectives = modes_only_objectives(spec, source)
         speed_hz, load_nm = typed_operating_point(scenario, spec)
     with_path = bool(scenario.structural.get("n_path_sections"))
     if with_path:       # refused before anything is written when the block cannot fit the path again
         from twin.calibration.transfer_path import mechanical_model
-        mechanical_fmu = mechanical_model(scenario, spec, source)
+        fmu = mechanical_model(scenario, spec, source)
     else:
-        mechanical_fmu = scenario.fmu_path()
+        fmu = scenario.fmu_path()
     out_dir = check_output_dir(out_dir, "calibration output", create=True)
     duration = float(spec.get("record_duration", 0.3))
     settle = float(spec.get("settle_time", 0.1))
     channel = (scenario.outputs or ("accel_pinion_casing",))[0]
     auto = spec["parameters"] == "auto"
-    fmu = mechanical_fmu
     # the model's modes are read at the sensors the measured ones were seen by (those it has)
     outputs = _outputs(fmu)
     rec = None

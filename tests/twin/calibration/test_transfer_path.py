@@ -221,6 +221,9 @@ def test_a_path_needs_a_model_built_here_with_bearing_forces(path_records, shaft
         run_calibration(_path_scenario(str(shafts_fmu)), path_records, tmp_path / "a", progress=False)
     with pytest.raises(ScenarioError, match="no bearing force outputs"):
         run_calibration(_path_scenario("GearTwin.Gearbox21Measured"), path_records, tmp_path / "b", progress=False)
+    with pytest.raises(ScenarioError, match="needs the measurement file"):
+        run_calibration(_path_scenario("GearTwin.Gearbox21Shafts"), None, tmp_path / "c", progress=False)
+    assert not (tmp_path / "c").exists()
 
 
 def test_twin_calibrate_with_path_from_writes_a_scenario_that_reads_the_measured_path(path_records, tmp_path):
