@@ -198,7 +198,7 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
         rec = _steady_record(spec, mset, scenario, channel, duration, source, measurements)
         if spec.get("path_from"):     # refused before the modes fit
             from twin.calibration.transfer_path import check_path_from
-            check_path_from(scenario, mset, spec, source)
+            path_channels = check_path_from(scenario, mset, spec, source)
         default_obj = (["waveform", "correlation", "frequencies"]
                        if not auto and not spec.get("modes_from") else ["correlation", "modes"])
         objectives = tuple(spec.get("objectives", default_obj))
@@ -270,7 +270,7 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
             # the sensors read the bearing forces through the path the hammer tests measured; the
             # modes above were fitted on the model without it (its sections are not gearbox modes)
             from twin.calibration.transfer_path import attach_measured_path
-            measured_path = attach_measured_path(scenario, mset, spec, source, fmin=band[0],
+            measured_path = attach_measured_path(scenario, mset, spec, source, path_channels, fmin=band[0],
                                                  fmax=min(band[1], 0.45 * rec.sample_rate))
             spectrum_fmu = measured_path.fmu_path
             chosen.update(measured_path.parameters)

@@ -369,17 +369,14 @@ def check_path_from(scenario, mset, spec: Mapping, source: str) -> list[str]:
     return channels
 
 
-def attach_measured_path(scenario, mset, spec: Mapping, source: str, *, fmin: float = 20.0,
-                         fmax: float = 5000.0) -> MeasuredPath:
-    """Fit the path of the calibration block's ``path_from`` to the FMU's casing channels and build
-    the scenario's model with it (the structural ``n_path_sections``).
-
-    Raises :class:`~twin.errors.ScenarioError` as :func:`check_path_from`, and when a fit fails.
-    """
+def attach_measured_path(scenario, mset, spec: Mapping, source: str, channels: Sequence[str], *,
+                         fmin: float = 20.0, fmax: float = 5000.0) -> MeasuredPath:
+    """Fit the path of the calibration block's ``path_from`` to ``channels`` (what
+    :func:`check_path_from` returned for it) and build the scenario's model with it (the structural
+    ``n_path_sections``). Raises :class:`~twin.errors.ScenarioError` when a fit fails."""
     from twin.errors import ScenarioError
     from twin.variants import build_variant
 
-    channels = check_path_from(scenario, mset, spec, source)
     path_from = dict(spec["path_from"])
     n = int(spec.get("path_sections", DEFAULT_SECTIONS))
     try:
