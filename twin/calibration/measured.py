@@ -39,7 +39,7 @@ def measured_modes(spec: dict, mset, source: str, out_dir: Path, *, with_damping
     from twin.signals import remove_foundation_modes
 
     if isinstance(spec.get("foundation_modes"), str):      # refused before any survey is run or written
-        _hammer_record(spec["foundation_modes"], mset, source)
+        hammer_record(spec["foundation_modes"], mset, source)
     if spec.get("modes_from"):
         names = modes_records(spec)
         for name in names:
@@ -96,17 +96,17 @@ def modes_records(spec: dict) -> list[str]:
     return [names] if isinstance(names, str) else list(names)
 
 
-def _hammer_record(name: str, mset, source: str):
+def hammer_record(name: str, mset, source: str, where: str = "calibration.foundation_modes",
+                  hint: str = ": give the foundation's modes from an impact test, or in Hz"):
     """The record ``name`` of ``mset`` if it is a hammer test (a force channel in N); ScenarioError
-    naming it otherwise."""
-    where = "calibration.foundation_modes"
+    at ``where`` naming it otherwise (``hint`` ends the message)."""
     if name not in mset.names:
         raise ScenarioError([(source, where, f"no record {name!r} in the measurements "
                                              f"(they have {', '.join(mset.names)})")])
     record = mset[name]
     if not any(record.units[c] == "N" for c in record.channel_names):
         raise ScenarioError([(source, where, f"record {name!r} is not a hammer test (it has no force channel "
-                                             "in N): give the foundation's modes from an impact test, or in Hz")])
+                                             f"in N){hint}")])
     return record
 
 
@@ -117,7 +117,7 @@ def foundation_modes_of(name: str, spec: dict, mset, source: str, out_dir: Path)
     block's ``min_confidence`` are left in; the survey is written to ``foundation_modes.json``."""
     from twin.modes import MIN_CONFIDENCE, survey_record, write_survey_json
 
-    survey = survey_record(_hammer_record(name, mset, source))
+    survey = survey_record(hammer_record(name, mset, source))
     write_survey_json(survey, out_dir / "foundation_modes.json", record=name)
     threshold = float(spec.get("min_confidence", MIN_CONFIDENCE))
     return np.array([m.frequency for m in survey.modes if m.confidence >= threshold])

@@ -198,7 +198,7 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
         rec = _steady_record(spec, mset, scenario, channel, duration, source, measurements)
         if spec.get("path_from"):     # refused before the modes fit
             from twin.calibration.transfer_path import check_path_from
-            path_channels = check_path_from(scenario, mset, spec, source)
+            path_channels = check_path_from(scenario, mset, spec, source, outputs)
         default_obj = (["waveform", "correlation", "frequencies"]
                        if not auto and not spec.get("modes_from") else ["correlation", "modes"])
         objectives = tuple(spec.get("objectives", default_obj))

@@ -335,29 +335,21 @@ class MeasuredPath:
                 + ", ".join(f"{r} ({f})" for r, f in self.path_from.items()) + f": {fits}")
 
 
-def check_path_from(scenario, mset, spec: Mapping, source: str) -> list[str]:
+def check_path_from(scenario, mset, spec: Mapping, source: str, outputs: set[str]) -> list[str]:
     """Refuse a calibration block's ``path_from`` before any work: a record missing or not a hammer
-    test, a model given as a file (the path is built into the model) or without bearing forces.
-    Returns the casing channels the path will be fitted for. Raises
-    :class:`~twin.errors.ScenarioError` naming the bad value."""
+    test, a model given as a file (the path is built into the model) or without bearing forces
+    among its ``outputs`` (the FMU's output names). Returns the casing channels the path will be
+    fitted for. Raises :class:`~twin.errors.ScenarioError` naming the bad value."""
+    from twin.calibration.measured import hammer_record
     from twin.errors import ScenarioError
-    from twin.fmu import FMU
 
     where = "calibration.path_from"
     for name in spec["path_from"]:
-        if name not in mset.names:
-            raise ScenarioError([(source, where, f"no record {name!r} in the measurements "
-                                                 f"(they have {', '.join(mset.names)})")])
-        try:
-            force_channel(mset[name])
-        except ValueError as exc:
-            raise ScenarioError([(source, where, str(exc))]) from None
+        hammer_record(name, mset, source, where, hint="")
     model = str(scenario.fmu)
     if model.endswith((".fmu", ".ssp")):
         raise ScenarioError([(source, "fmu", f"a measured path is built into the model, so 'fmu' must name a "
                                              f"Modelica model (GearTwin.Gearbox21Shafts, ...), not the file {model!r}")])
-    with FMU(scenario.fmu_path()) as f:
-        outputs = {v.name for v in f.outputs}
     missing = [name for name in FORCES if name not in outputs]
     if missing:
         raise ScenarioError([(source, where, f"{model} has no bearing force outputs ({', '.join(missing)}): "
@@ -383,8 +375,7 @@ def attach_measured_path(scenario, mset, spec: Mapping, source: str, channels: S
         fits = fit_paths(mset, path_from, channels, n_sections=n, fmin=fmin, fmax=fmax)
     except ValueError as exc:
         raise ScenarioError([(source, "calibration.path_from", f"the path cannot be fitted: {exc}")]) from None
-    rest = {k: v for k, v in scenario.structural.items() if k != SECTIONS_PARAMETER}
-    built = build_variant(str(scenario.fmu), {**rest, SECTIONS_PARAMETER: n})
+    built = build_variant(str(scenario.fmu), {**_other_options(scenario), SECTIONS_PARAMETER: n})
     return MeasuredPath(built, path_parameters(fits, list(path_from.values())), fits, path_from, n)
 
 
@@ -411,5 +402,9 @@ def model_without_path(scenario):
     """The FMU of the scenario's model built without a measured path (its other build options kept)."""
     from dataclasses import replace
 
-    rest = {k: v for k, v in scenario.structural.items() if k != SECTIONS_PARAMETER}
-    return replace(scenario, structural=rest).fmu_path()
+    return replace(scenario, structural=_other_options(scenario)).fmu_path()
+
+
+def _other_options(scenario) -> dict:
+    """The scenario's build options but the path's sections."""
+    return {k: v for k, v in scenario.structural.items() if k != SECTIONS_PARAMETER}
