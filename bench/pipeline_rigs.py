@@ -2,7 +2,8 @@
 
     python bench/pipeline_rigs.py [--rigs pedestal,beam] [--tasks pitting,wear] [--members 5]
                                   [--epochs 80] [--retrainings 3] [--per-stage 8] [--jobs 2]
-                                  [--out bench_out/pipeline_rigs] [--no-ablation] [--no-reversal]
+                                  [--out bench_out/pipeline_rigs] [--arms path,calibrated,default]
+                                  [--no-ablation] [--no-reversal]
 
 For each rig (``rigs/``, used as black boxes through their public interface, defaults fixed) and
 each test (pitting: 6 stages at 20 Hz / 20 N.m; wear: 4 stages at 10 Hz / 5 N.m):
@@ -11,12 +12,18 @@ each test (pitting: 6 stages at 20 Hz / 20 N.m; wear: 4 stages at 10 Hz / 5 N.m)
    its healthy run-up and steady record at the test's load; its stage records in the order of the
    test (``per_stage`` per stage, 1 s each, seed 10) for the pipeline to adapt to; and a second,
    disjoint set of stage records (seed 11) for the test.  The stage labels stay in the rig's truth
-   file and are read by the scoring below only;
+   file and are read by the scoring below only.  For the ``path`` arm the same records plus two
+   hammer tests of the healthy rig at slow roll (0.5 Hz, the test's load, 8 s, 4 blows/s, seeds 103
+   and 104), struck from above at its bearing supports (pedestal: the two pedestals; beam: the two
+   housings), in a file of their own;
 2. **pipeline** with the calibrated twin: ``twin.pipeline.run_pipeline`` (calibrate on the healthy
    records, degradation run, archive, ensemble of ``members``, assess), timed as a whole; the test
-   records are assessed by the trained ensemble (``extra``);
+   records are assessed by the trained ensemble (``extra``).  Arm ``path``: the hammer tests are
+   healthy records too and measure the path to the sensor (``path_from``: the pinion's support for
+   ``bearing_force_input_y``, the gear's for ``bearing_force_output_y``), so the archive is simulated
+   through the rig's measured path; arm ``calibrated``: the modelled path;
 3. **retrainings**: the ensemble trained again ``retrainings - 1`` times with disjoint seeds on the
-   same archive, for the spread of the ensemble's accuracy;
+   same archive, for the spread of the ensemble's accuracy (the calibrated arms);
 4. **ablation**: the same pipeline with the default (uncalibrated) twin, one ensemble; every
    calibrated run comes first, so a run cut short loses the ablation first;
 5. **scores** on the test records (last epoch; no label steers anything): window accuracy exact and
@@ -49,6 +56,11 @@ sys.path.insert(0, str(REPO))
 TESTS = {"pitting": ("scenarios/lubricated.yaml", 20.0, 20.0), "wear": ("scenarios/dry.yaml", 10.0, 5.0)}
 GEARBOX_SEED = 1
 ADAPT_SEED, TEST_SEED = 10, 11
+HAMMER_SEEDS = (103, 104)
+#: Where the path's blows strike each rig (its bearing supports) and the twin's bearing force each stands for.
+PATH_BLOWS = {"pedestal": ("pinion_pedestal", "gear_pedestal"), "beam": ("pinion_housing", "gear_housing")}
+PATH_FORCES = ("bearing_force_input_y", "bearing_force_output_y")
+ARMS = {"path": "calibrated, measured path", "calibrated": "calibrated", "default": "default"}
 CHANNEL = "accel_pinion_casing"
 
 
@@ -78,18 +90,43 @@ def rig_data(name: str, task: str, per_stage: int, data: Path) -> tuple[Path, Pa
     if rig_file.exists() and test_file.exists() and key.exists() and key.read_text() == wanted:
         return rig_file, test_file
     box, write = _rig(name)
-    _, speed, load = TESTS[task]
-    if name == "pedestal":
-        runup = box.runup(speeds=(2.0, speed), load=load, duration=6.0, seed=101)
-        steady = box.steady(speed=speed, load=load, duration=2.0, seed=102)
-    else:
-        runup = box.runup((2.0, speed), load, 6.0, seed=101)
-        steady = box.steady(speed, load, 2.0, seed=102)
-    healthy = [dataclasses.replace(runup, name="runup"), dataclasses.replace(steady, name="steady")]
+    healthy = [dataclasses.replace(r, name=n) for r, n in zip(_healthy(name, box, task), ("runup", "steady"))]
     write(str(rig_file), healthy + _stage_records(name, box, task, per_stage, ADAPT_SEED))
     write(str(test_file), _stage_records(name, box, task, per_stage, TEST_SEED))
     key.write_text(wanted)
     return rig_file, test_file
+
+
+def path_data(name: str, task: str, per_stage: int, data: Path) -> tuple[Path, dict]:
+    """(the rig file of :func:`rig_data` with two hammer tests of the healthy rig added, path_from); cached."""
+    from twin.measurements import load_measurements
+    rig_file, _ = rig_data(name, task, per_stage, data)
+    path_file = data / f"{name}_{task}_path.h5"
+    path_from = {f"hammer_{loc}": force for loc, force in zip(PATH_BLOWS[name], PATH_FORCES)}
+    if path_file.exists() and path_file.stat().st_mtime >= rig_file.stat().st_mtime:
+        return path_file, path_from
+    box, write = _rig(name)
+    _, _, load = TESTS[task]
+    blows = [box.impact(speed=0.5, load=load, duration=8.0, impacts_per_second=4.0, location=loc, seed=seed,
+                        name=f"hammer_{loc}") for loc, seed in zip(PATH_BLOWS[name], HAMMER_SEEDS)]
+    # the same records as rig_file (re-simulated with the same seeds), then the blows
+    healthy = [dataclasses.replace(r, name=n) for r, n in zip(_healthy(name, box, task), ("runup", "steady"))]
+    write(str(path_file), healthy + _stage_records(name, box, task, per_stage, ADAPT_SEED) + blows)
+    # the stage records must be the ones the other arms adapt to
+    a, b = load_measurements(rig_file, channels=[CHANNEL]), load_measurements(path_file, channels=[CHANNEL])
+    for r in a.records:
+        if not np.array_equal(np.asarray(r[CHANNEL]), np.asarray(b[r.name][CHANNEL])):
+            path_file.unlink()
+            raise SystemExit(f"{path_file}: record {r.name} differs from {rig_file}'s; the rig is not repeatable")
+    return path_file, path_from
+
+
+def _healthy(name: str, box, task: str) -> list:
+    _, speed, load = TESTS[task]
+    if name == "pedestal":
+        return [box.runup(speeds=(2.0, speed), load=load, duration=6.0, seed=101),
+                box.steady(speed=speed, load=load, duration=2.0, seed=102)]
+    return [box.runup((2.0, speed), load, 6.0, seed=101), box.steady(speed, load, 2.0, seed=102)]
 
 
 def labelled(path: Path) -> list:
@@ -123,20 +160,25 @@ def score(ens, records) -> dict:
 
 
 def run_arm(name: str, task: str, arm: str, args, out: Path) -> dict:
-    """One pipeline run (``arm``: calibrated or default twin) on one rig's test, scored on its test records."""
+    """One pipeline run (``arm``: :data:`ARMS`) on one rig's test, scored on its test records."""
     from twin.pipeline import PipelinePlan, run_pipeline
     from twin.transfer.ensemble import Ensemble, train_ensemble
 
     rig_file, test_file = rig_data(name, task, args.per_stage, out / "data")
     test = labelled(test_file)
     d = out / f"{name}_{task}_{arm}"
+    healthy, path_from = ("runup", "steady"), {}
+    if arm == "path":
+        rig_file, path_from = path_data(name, task, args.per_stage, out / "data")
+        healthy += tuple(path_from)
     t = time.perf_counter()
-    run_pipeline(PipelinePlan(rig_file, ("runup", "steady"), REPO / TESTS[task][0], d, members=args.members,
-                              epochs=args.epochs, jobs=args.jobs, calibrate=arm == "calibrated", time_ordered=True),
+    run_pipeline(PipelinePlan(rig_file, healthy, REPO / TESTS[task][0], d, members=args.members,
+                              epochs=args.epochs, jobs=args.jobs, calibrate=arm != "default", time_ordered=True,
+                              path_from=path_from),
                  progress=False, log=lambda m: print(f"  [{name} {task} {arm}] {m}", flush=True))
     wall = time.perf_counter() - t
     runs = [score(Ensemble.load(d / "assessor"), test)]
-    if arm == "calibrated":
+    if arm != "default":
         adapt = _unlabelled(labelled(rig_file))
         for k in range(1, args.retrainings):
             ens = train_ensemble(d / "archive.h5", adapt, d / f"assessor_{k}", members=args.members,
@@ -204,7 +246,7 @@ def table(rows: list[dict]) -> str:
              "agreement [%] | members' records exact [%] | order | reliable | wall time [s] | ms/window |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for row in rows:
-        for arm in ("calibrated", "default"):
+        for arm in ARMS:
             if arm not in row:
                 continue
             runs = row[arm]["runs"]
@@ -213,7 +255,7 @@ def table(rows: list[dict]) -> str:
                 return f"{v.mean():.1f} +- {v.std(ddof=1):.1f}" if v.size > 1 else f"{v.mean():.1f}"
             m = 100 * np.array([a for r in runs for a in r["member_record_exact"]])
             mem = f"{m.mean():.1f} +- {m.std(ddof=1):.1f}"
-            lines.append(f"| {row['rig']} | {row['task']} | {arm} | {ms('window_exact')} | {ms('window_within_one')} | "
+            lines.append(f"| {row['rig']} | {row['task']} | {ARMS[arm]} | {ms('window_exact')} | {ms('window_within_one')} | "
                          f"{ms('record_exact')} | {ms('record_exact_time_order')} | {ms('agreement')} | {mem} | "
                          f"{'/'.join(sorted({r['order'] for r in runs}))} | "
                          f"{sum(r['reliable'] for r in runs)}/{len(runs)} | {row[arm]['wall_time']:.0f} | "
@@ -231,14 +273,20 @@ def main() -> None:
     ap.add_argument("--per-stage", type=int, default=8)
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--out", default=str(REPO / "bench_out" / "pipeline_rigs"))
-    ap.add_argument("--no-ablation", action="store_true")
+    ap.add_argument("--arms", default="path,calibrated,default",
+                    help="comma-separated, in this order: path (calibrated, measured path), calibrated (modelled "
+                         "path), default (uncalibrated)")
+    ap.add_argument("--no-ablation", action="store_true", help="leave out the default arm")
     ap.add_argument("--no-reversal", action="store_true")
     args = ap.parse_args()
     out = Path(args.out)
     (out / "data").mkdir(parents=True, exist_ok=True)
     print(f"Machine: {machine()}", flush=True)
     rows, t0 = {}, time.perf_counter()
-    arms = ("calibrated",) if args.no_ablation else ("calibrated", "default")
+    arms = [a for a in args.arms.split(",") if a and not (args.no_ablation and a == "default")]
+    unknown = [a for a in arms if a not in ARMS]
+    if unknown:
+        raise SystemExit(f"unknown arm(s) {', '.join(unknown)}: {', '.join(ARMS)}")
     for arm in arms:                # every calibrated run first: the ablation is what a short run drops
         for name in args.rigs.split(","):
             for task in args.tasks.split(","):

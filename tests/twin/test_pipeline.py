@@ -97,3 +97,60 @@ def test_pipeline_runs_every_stage_and_resumes(tmp_path, gearbox_fmu):
     assert any("archive: kept" in line for line in lines) and any("train: kept" in line for line in lines)
     stages = json.loads((out / "pipeline.json").read_text())["stages"]
     assert {"archive", "train", "report"} <= set(stages)
+
+
+def _hammer(name, seed):
+    rng = np.random.default_rng(seed)
+    f = np.zeros(int(2 * FS))
+    f[rng.choice(f.size - 100, 8, replace=False)] = 200.0
+    x = np.convolve(f, np.exp(-np.arange(400) / 40.0) * np.sin(np.arange(400) * 0.3), mode="same")
+    return Record(name, {CH: x + rng.normal(0, 0.01, f.size), "hammer": f}, {CH: "m/s2", "hammer": "N"}, FS,
+                  nominal_speed=0.5, load=20.0)
+
+
+def test_path_from_hands_the_hammer_records_and_a_model_with_bearing_forces_to_the_calibration(tmp_path,
+                                                                                              monkeypatch):
+    import twin.calibration.run as cal
+
+    recs = [_record("runup", 2.0, 20.0, 3.0, 0), _record("steady", 20.0, 20.0, 1.0, 1), _hammer("hammer_p", 2),
+            _record("r0", 20.0, 20.0, 0.5, 10)]
+    rig = write_measurements(recs, tmp_path / "rig.h5")
+    seen = {}
+
+    class Stop(Exception):
+        pass
+
+    def calibrate(scenario, measurements, out, **kw):
+        seen.update(fmu=scenario.fmu, block=scenario.raw["calibration"])
+        raise Stop
+
+    monkeypatch.setattr(cal, "run_calibration", calibrate)
+    plan = PipelinePlan(rig, ("runup", "steady", "hammer_p"), REPO / "scenarios" / "lubricated.yaml",
+                        tmp_path / "out", path_from={"hammer_p": "bearing_force_input_y"})
+    assert plan.path_from == (("hammer_p", "bearing_force_input_y"),)
+    lines = []
+    with pytest.raises(Stop):
+        run_pipeline(plan, progress=False, log=lines.append)
+    assert seen["fmu"] == "GearTwin.Gearbox21Shafts"
+    assert seen["block"]["path_from"] == {"hammer_p": "bearing_force_input_y"}
+    assert seen["block"]["modes_from"] == ["runup", "hammer_p"] and seen["block"]["record"] == "steady"
+    assert "path from 'hammer_p' (bearing_force_input_y)" in lines[0]
+    # without the path: the modelled one, on the measured-gearbox model
+    with pytest.raises(Stop):
+        run_pipeline(PipelinePlan(rig, ("runup", "steady"), REPO / "scenarios" / "lubricated.yaml", tmp_path / "o2"),
+                     progress=False, log=lines.append)
+    assert seen["fmu"] == "GearTwin.Gearbox21Measured" and "path_from" not in seen["block"]
+
+
+def test_a_path_record_must_be_healthy_and_calibrated(tmp_path, capsys):
+    from twin.cli import main
+    scen = REPO / "scenarios" / "lubricated.yaml"
+    with pytest.raises(ParameterError, match="'hammer_p' is not among the healthy records"):
+        PipelinePlan(tmp_path / "rig.h5", ("runup", "steady"), scen, tmp_path / "out",
+                     path_from={"hammer_p": "bearing_force_input_y"})
+    with pytest.raises(ParameterError, match="--path-from needs the calibration"):
+        PipelinePlan(tmp_path / "rig.h5", ("runup", "steady", "h"), scen, tmp_path / "out", calibrate=False,
+                     path_from={"h": "bearing_force_input_y"})
+    assert main(["pipeline", "rig.h5", "--healthy", "a,b", "--scenario", str(scen), "--out", "o",
+                 "--path-from", "hammer_p"]) == 2
+    assert "expected RECORD=FORCE" in capsys.readouterr().err

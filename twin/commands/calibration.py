@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from twin.commands.common import lib, local_executor, positive_int
+from twin.commands.common import lib, local_executor, path_pair, positive_int
 
 
 def add_subcommands(sub) -> None:
@@ -25,7 +25,7 @@ def add_subcommands(sub) -> None:
     p.add_argument("--foundation-from", metavar="RECORD",
                    help="hammer-test record of the foundation (casing root): its modes are left out of the "
                         "measured ones, as the paper does")
-    p.add_argument("--path-from", metavar="RECORD=FORCE", type=_path_pair, action="append",
+    p.add_argument("--path-from", metavar="RECORD=FORCE", type=path_pair, action="append",
                    help="a hammer record struck at a bearing housing and the model's bearing force its blow stands "
                         "for (e.g. hammer_pinion=bearing_force_input_y; repeat per record): the casing sensors then "
                         "read the model's bearing forces through the measured path (calibration.path_from)")
@@ -106,14 +106,6 @@ def _record_list(text: str):
     if not all(names):
         raise argparse.ArgumentTypeError(f"empty record name in {text!r}")
     return names[0] if len(names) == 1 else names
-
-
-def _path_pair(text: str) -> tuple[str, str]:
-    """``--path-from``: ``RECORD=FORCE``."""
-    record, sep, force = text.partition("=")
-    if not sep or not record.strip() or not force.strip():
-        raise argparse.ArgumentTypeError(f"expected RECORD=FORCE (e.g. hammer_pinion=bearing_force_input_y), got {text!r}")
-    return record.strip(), force.strip()
 
 
 def _add_pairing_option(p) -> None:

@@ -79,6 +79,14 @@ def positive_int(text: str) -> int:
     return value
 
 
+def path_pair(text: str) -> tuple[str, str]:
+    """``--path-from``: ``RECORD=FORCE``, a hammer record and the model's bearing force its blow stands for."""
+    record, sep, force = text.partition("=")
+    if not sep or not record.strip() or not force.strip():
+        raise argparse.ArgumentTypeError(f"expected RECORD=FORCE (e.g. hammer_pinion=bearing_force_input_y), got {text!r}")
+    return record.strip(), force.strip()
+
+
 def local_executor(workers):
     if workers is None:
         return None

@@ -9,6 +9,8 @@ import argparse
 import importlib
 from pathlib import Path
 
+from twin.commands.common import path_pair
+
 _PUBLIC = ("PipelinePlan", "STAGES", "run_pipeline", "healthy_roles", "archive_for_records")
 
 __all__ = [*_PUBLIC, "add_subcommands"]
@@ -27,7 +29,8 @@ def _cmd_pipeline(args: argparse.Namespace) -> int:
                             members=args.members, epochs=args.epochs, jobs=args.jobs,
                             calibrate=not args.no_calibration,
                             time_ordered=True if args.time_ordered else None,
-                            extra=Path(args.assess) if args.assess else None)
+                            extra=Path(args.assess) if args.assess else None,
+                            path_from=tuple(args.path_from or ()))
     run.run_pipeline(plan, progress=not args.no_progress)
     return 0
 
@@ -49,6 +52,10 @@ def add_subcommands(sub) -> None:
                    help="the records are in time order in the file (a run-to-failure history); without it, the "
                         "records' own time stamps (time_start, cycles) decide")
     p.add_argument("--assess", metavar="FILE", help="more records of the same rig to assess with the trained ensemble")
+    p.add_argument("--path-from", metavar="RECORD=FORCE", type=path_pair, action="append",
+                   help="a healthy hammer record struck at a bearing housing and the model's bearing force its blow "
+                        "stands for (e.g. hammer_pinion=bearing_force_input_y; repeat per record): the twin's sensors "
+                        "then read its bearing forces through the measured path, in the calibration and the archive")
     p.add_argument("--no-calibration", action="store_true",
                    help="use the scenario's twin as it is, uncalibrated (to see what calibration adds)")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bars")

@@ -11,7 +11,11 @@ The paper's chain, one stage after the other, each writing into ``DIR``:
    the parameters they identify chosen automatically, the steady record for the spectrum.  The model
    is the gearbox as its accelerometers measure it (``GearTwin.Gearbox21Measured`` for
    ``GearTwin.Gearbox21``: flank roughness, process force, sensor path), whose sensor gain and
-   broadband levels the calibration fits; ``calibrated.yaml`` is the calibrated twin;
+   broadband levels the calibration fits; ``calibrated.yaml`` is the calibrated twin.  With hammer
+   records struck at the bearing housings (``path_from``) the path to the sensors is the measured
+   one: the model is ``GearTwin.Gearbox21Shafts`` (the casing in the loop, bearing-force outputs) and
+   its sensors read the bearing forces through the accelerances of those records
+   (:mod:`twin.calibration.transfer_path`), so the archive is simulated through the rig's own path;
 2. **archive** (``DIR/archive.h5``): the calibrated twin's degradation run and its labelled archive
    (:func:`twin.archive.build_archive`), at the operating point of the rig's records;
 3. **train** (``DIR/assessor/``): an ensemble of assessors on the archive and the rig's other records,
@@ -48,6 +52,9 @@ STAGES = ("calibrate", "archive", "train", "assess", "rul", "report")
 # The gearbox as its casing accelerometers measure it: the same model with flank roughness and a process
 # force (broadband) and a sensor path, whose levels and gain the calibration fits to the steady record.
 MEASURED = {"GearTwin.Gearbox21": "GearTwin.Gearbox21Measured"}
+# With a measured path: the casing in the loop and bending shafts, whose bearing forces the hammer
+# records' accelerances carry to the sensors (the model bench/calibration_rigs.py --path scored).
+MEASURED_PATH = {"GearTwin.Gearbox21": "GearTwin.Gearbox21Shafts"}
 # The calibration block when the scenario has none: the parameters the run-up's modes identify, and a
 # search sized for the pipeline's time budget (bench/calibration_rigs.py measured it on the rigs).
 CALIBRATION = {"parameters": "auto", "pop_size": 12, "n_gen": 6}
@@ -80,6 +87,11 @@ class PipelinePlan:
         None: the records' own time stamps decide; True: the file order is the time order.
     extra : Path or None
         Another file of the same rig's records to assess with the trained ensemble.
+    path_from : tuple of (str, str)
+        (healthy hammer record, bearing force of the model its blows stand for) pairs, e.g.
+        ``(("hammer_pinion", "bearing_force_input_y"),)``: the calibration fits the measured path
+        from those records (``calibration.path_from``); empty: the modelled path.  A mapping is
+        accepted.
     """
 
     measurements: Path
@@ -92,6 +104,7 @@ class PipelinePlan:
     calibrate: bool = True
     time_ordered: bool | None = None
     extra: Path | None = None
+    path_from: tuple = ()
 
     def __post_init__(self) -> None:
         for name, lo in (("members", 2), ("epochs", 1), ("jobs", 1)):
@@ -100,6 +113,15 @@ class PipelinePlan:
                 raise ParameterError(f"pipeline: {name} must be an integer >= {lo}, got {v!r}")
         if not self.healthy:
             raise ParameterError("pipeline: --healthy needs at least one record name (a run-up and a steady record)")
+        pairs = tuple(self.path_from.items()) if isinstance(self.path_from, dict) else tuple(map(tuple, self.path_from))
+        object.__setattr__(self, "path_from", pairs)
+        for record, _ in pairs:
+            if record not in self.healthy:
+                raise ParameterError(f"pipeline: --path-from record {record!r} is not among the healthy records "
+                                     f"({', '.join(self.healthy)}); the path is measured on the healthy gearbox")
+        if pairs and not self.calibrate:
+            raise ParameterError("pipeline: --path-from needs the calibration (it fits the measured path); "
+                                 "drop --no-calibration")
 
 
 @dataclass
@@ -215,25 +237,27 @@ def run_pipeline(plan: PipelinePlan, *, progress: bool = True, log=print) -> dic
     if plan.calibrate:
         healthy = [mset[n] for n in plan.healthy]
         modes_rec, steady_rec = healthy_roles(healthy)
-        key = _key("calibrate", scen, meas, list(plan.healthy), scenario.raw)
+        key = _key("calibrate", scen, meas, list(plan.healthy), scenario.raw, list(plan.path_from))
         cal_file = cal_dir / "calibrated.yaml"
         if man.done("calibrate", key, [cal_file]):
             log(f"[1/6] calibrate: kept {cal_file}")
         else:
             from twin.calibration.run import run_calibration
-            log(f"[1/6] calibrate: modes from {', '.join(map(repr, modes_rec))}, spectrum from '{steady_rec}'")
+            log(f"[1/6] calibrate: modes from {', '.join(map(repr, modes_rec))}, spectrum from '{steady_rec}'"
+                + "".join(f", path from {r!r} ({f})" for r, f in plan.path_from))
             t = time.perf_counter()
             block = {**(scenario.raw.get("calibration") or CALIBRATION),
                      "modes_from": modes_rec[0] if len(modes_rec) == 1 else list(modes_rec),
-                     "record": steady_rec}
-            model = MEASURED.get(scenario.fmu, scenario.fmu)
+                     "record": steady_rec, **({"path_from": dict(plan.path_from)} if plan.path_from else {})}
+            model = (MEASURED_PATH if plan.path_from else MEASURED).get(scenario.fmu, scenario.fmu)
             cal_sc = scenario.with_overrides(fmu=model, raw={**scenario.raw, "fmu": model, "calibration": block},
                                              executor={"type": "local", "workers": plan.jobs})
             report = run_calibration(cal_sc, meas, cal_dir, progress=progress)
             for w in report.warnings:
                 log(f"warning: {w}")
             man.record("calibrate", key, time.perf_counter() - t, modes=list(modes_rec), steady=steady_rec,
-                       table=report.table(), warnings=list(report.warnings))
+                       model=model, path_from=dict(plan.path_from), table=report.table(),
+                       warnings=list(report.warnings))
         timings["calibrate"] = man.stages["calibrate"]["seconds"]
         twin_sc, twin_file, key_up = load_scenario(cal_file), cal_file, man.stages["calibrate"]["key"]
     else:
@@ -375,7 +399,8 @@ def _report(out: Path, plan, man, assessed, rul, timings, per_window) -> Path:
     from twin.transfer.report import write_html
     blocks = [("Inputs", f"rig records: {plan.measurements}\nhealthy: {', '.join(plan.healthy)}\n"
                          f"scenario: {plan.scenario}\ncalibrated: {plan.calibrate}\nensemble: {plan.members} members, "
-                         f"{plan.epochs} epochs")]
+                         f"{plan.epochs} epochs\npath to the sensors: "
+                         + (", ".join(f"measured, {r} -> {f}" for r, f in plan.path_from) or "modelled"))]
     cal = man.stages.get("calibrate")
     if plan.calibrate and cal:
         text = cal.get("table", "") + "".join(f"\nwarning: {w}" for w in cal.get("warnings", []))

@@ -265,9 +265,9 @@ def test_twin_calibrate_with_path_from_writes_a_scenario_that_reads_the_measured
 def test_path_from_on_the_command_line(capsys, shafts_fmu):
     from twin.calibration.run import _block
     from twin.cli import main
-    from twin.commands.calibration import _path_pair
+    from twin.commands.common import path_pair
 
-    assert _path_pair(" hammer_a = bearing_force_input_y") == ("hammer_a", "bearing_force_input_y")
+    assert path_pair(" hammer_a = bearing_force_input_y") == ("hammer_a", "bearing_force_input_y")
     assert main(["calibrate", "s.yaml", "--path-from", "hammer_a"]) == 2
     assert "expected RECORD=FORCE" in capsys.readouterr().err
     scenario = _path_scenario(str(shafts_fmu))
