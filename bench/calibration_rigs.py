@@ -89,7 +89,7 @@ def struck_shafts(tests) -> dict[str, str]:
 
 def _scenario(path: Path, fs: float, workers: int, model: str, pairing: str = "frequency",
               visibility: str = "mesh", fit: str = "follow", modes_from=("runup",), struck=None,
-              path_from=None) -> Path:
+              path_from=None, mesh_form: bool = False) -> Path:
     path.write_text(json.dumps({
         "version": 1, "name": "rig-calibration", "fmu": model, "stop_time": 2.0,
         "output": {"sample_rate": fs, "variables": [CHANNEL]},
@@ -99,7 +99,8 @@ def _scenario(path: Path, fs: float, workers: int, model: str, pairing: str = "f
                         "record": "steady",
                         "pop_size": 12, "n_gen": 6, "pairing": pairing, "visibility": visibility,
                         "fit": fit, **({"struck_shafts": struck} if struck else {}),
-                        **({"path_from": path_from} if path_from else {})}}, indent=2))
+                        **({"path_from": path_from} if path_from else {}),
+                        **({"mesh_form": "fit"} if mesh_form else {})}}, indent=2))
     return path
 
 
@@ -229,7 +230,8 @@ def _nearest(values, f):
 def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str, pairing: str = "frequency",
                 visibility: str = "mesh", fit: str = "follow", hammer: bool = False,
                 hammer_at: str = "default", hammer_from: str = "above", hammer_rate: float = HAMMER_RATE,
-                hammer_duration: float = HAMMER_DURATION, name_shafts: bool = False, path: bool = False) -> dict:
+                hammer_duration: float = HAMMER_DURATION, name_shafts: bool = False, path: bool = False,
+                mesh_form: bool = False) -> dict:
     from spectral_distance import spectral_distance_report
 
     from fmu_build import build_fmu
@@ -274,7 +276,8 @@ def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str, p
 
     scenario = load_scenario(_scenario(out / f"{rig_name}_{seed}.yaml", float(load_measurements(h5)[0].sample_rate),
                                        workers, model, pairing, visibility, fit, modes_from,
-                                       struck_shafts(tests) if name_shafts and tests else None, path_from or None))
+                                       struck_shafts(tests) if name_shafts and tests else None, path_from or None,
+                                       mesh_form))
     t0 = time.perf_counter()
     report = run_calibration(scenario, h5, out / f"{rig_name}_{seed}_cal", progress=False)
     t_cal = time.perf_counter() - t0
@@ -308,6 +311,17 @@ def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str, p
                                            load_nm=float(meas.load), channel=CHANNEL, fmin=BAND[0],
                                            fmax=min(BAND[1], 0.45 * fs), settle=0.1)
         sims["calibrated twin, modelled path"] = (mech_fmu, {**params, **updates})
+    if mesh_form:
+        # the same calibrated gearbox with perfect involutes, levels refitted: the control of the profile fit
+        from levels_rigs import without_levels
+
+        from twin.calibration.levels import fit_levels_and_panels
+        params = {k: (0.0 if k.startswith("profile_deviation[") else v)
+                  for k, v in without_levels(dict(calibrated.parameters)).items()}
+        _, updates = fit_levels_and_panels(fmu, params, x, fs, speed_hz=float(meas.nominal_speed),
+                                           load_nm=float(meas.load), channel=CHANNEL, fmin=BAND[0],
+                                           fmax=min(BAND[1], 0.45 * fs), settle=0.1)
+        sims["calibrated twin, perfect involutes"] = (fmu, {**params, **updates})
     spectrum = {}
     for label, (path, params) in sims.items():
         y = simulate_operating_point(path, float(meas.nominal_speed), float(meas.load), parameters=params,
@@ -373,6 +387,9 @@ def main() -> None:
                     help="also strike each bearing support from above (HAMMER_AT['supports']) and let twin calibrate "
                          "read the casing sensors through that measured path (calibration.path_from); the same "
                          "calibration with the modelled path is reported beside it")
+    ap.add_argument("--mesh-form", action="store_true",
+                    help="fit the pinion's as-manufactured profile (slope, crowning) to the mesh harmonics "
+                         "(calibration.mesh_form: fit); the same calibration with perfect involutes is reported beside it")
     ap.add_argument("--out", type=Path, default=REPO / "bench_out" / "calibration_rigs")
     ap.add_argument("--explain", action="store_true",
                     help="only the per-mode analysis of the results already in --out (no new scoring)")
@@ -403,7 +420,7 @@ def main() -> None:
             t = time.perf_counter()
             r = one_gearbox(rig, seed, args.out, args.workers, args.model, args.pairing, args.visibility,
                             args.fit, args.hammer, args.hammer_at, args.hammer_from, args.hammer_rate,
-                            args.hammer_duration, args.struck_shafts, args.path)
+                            args.hammer_duration, args.struck_shafts, args.path, args.mesh_form)
             r["fit"] = args.fit
             r["load_after"] = os.getloadavg()
             r["first6_explained"] = explain_modes(rig, seed, r, args.out, args.visibility)

@@ -106,6 +106,21 @@ def _model(spec: dict[str, Any]):
         raise ScenarioError([("<scenario>", "degradation.coefficients", str(exc))]) from None
 
 
+def manufactured_form(state, parameters, n_nodes: int):
+    """The wear state with a scenario's ``profile_deviation[1..n]`` (material missing from the pinion
+    flank [m], e.g. the as-manufactured profile a calibration fitted, ``mesh_form: fit``) added to the
+    pinion flank's form, so the wear runs it in: a wear run rewrites ``profile_deviation`` from the
+    flanks at every update, which would otherwise drop it after the first."""
+    from twin.degradation import WearState
+    from twin.degradation._nodes import hat_matrix
+    nodes = np.array([float(parameters.get(f"profile_deviation[{i}]", 0.0)) for i in range(1, n_nodes + 1)])
+    if not np.any(nodes):
+        return state
+    e = hat_matrix(state.xi, n_nodes) @ nodes
+    return WearState(state.cycles, state.xi, state.depth, state.geometry, state.gear_depth,
+                     state.pinion_form + (e.max() - e), state.gear_form)
+
+
 def _damage(model_name: str, state) -> tuple[float, float, np.ndarray, np.ndarray]:
     if model_name == "pitting":
         return float(state.pitting_density), float(np.max(state.density)), state.xi, state.density
@@ -183,6 +198,8 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
         k_healthy = tuple(scenario.parameters.get(f"k_pair[{i}]", fmu.variable(f"k_pair[{i}]").start)
                           for i in range(1, n_nodes + 1))
         state = model.initial_state(geometry)
+        if model_name == "wear":
+            state = manufactured_form(state, scenario.parameters, n_nodes)
         if model_name == "pitting" and f"tooth_pit_field[{geometry.z1 * n_nodes}]" not in fmu.variables:
             raise ScenarioError([(str(fmu_file), "degradation.model",
                                   f"pitting needs the per-tooth field tooth_pit_field[1..{geometry.z1 * n_nodes}]"

@@ -67,6 +67,10 @@ CALIBRATION_SCHEMA: dict[str, Any] = {
                                      "force that stands for the blow); the casing sensors then read the twin's "
                                      "bearing forces through the accelerances these records measured (in-situ "
                                      "transfer path analysis), not through the modelled casing"},
+        "mesh_form": {"enum": ["none", "fit"],
+                      "description": "fit: the pinion's as-manufactured profile deviation (slope and crowning, "
+                                     "profile_deviation) fitted to the measured gear-mesh harmonics before the "
+                                     "levels; none (default): perfect involutes"},
         "path_sections": {"type": "integer", "minimum": 1, "maximum": 200,
                           "description": "second-order sections fitted to each measured path (default 32)"},
         "min_confidence": {"type": "number", "minimum": 0, "maximum": 1},

@@ -11,6 +11,8 @@ Scenario block (every key but ``parameters`` optional)::
       path_from: {hammer_pinion: bearing_force_input_y}   # hammer records struck at the housings: the
                                   # sensors read the bearing forces through the path they measured
       path_sections: 32           # second-order sections fitted to each measured path
+      mesh_form: none             # or fit: the pinion's as-manufactured profile (slope, crowning)
+                                  #   fitted to the measured mesh harmonics before the levels
       natural_frequencies: [22, 87, 218, 430]   # or typed by hand [Hz]
       foundation_modes: [13, 41]  # removed from the measured modes (paper: hammer test), in Hz
                                   #   or the name of a hammer-test record to read them from
@@ -69,7 +71,7 @@ from pathlib import Path
 import numpy as np
 
 from twin.calibration.measured import measured_modes, modes_records
-from twin.errors import ScenarioError
+from twin.errors import MeasurementError, ScenarioError
 from twin.scenario_schema import CALIBRATION_SCHEMA
 
 
@@ -101,6 +103,22 @@ def _col(model: float, measured: float) -> str:
     if not np.isfinite(model):
         return f"{'none':>13s} {'':>9s}"
     return f"{model:13.1f} {100 * (model - measured) / measured:+9.1f}"
+
+
+def _mesh_form(scenario, fmu, parameters, rec, channel, target, settle, fmax):
+    """``mesh_form: fit``: the profile fit (:mod:`twin.calibration.mesh_form`) on the steady record."""
+    from twin.calibration.levels import has_levels
+    from twin.calibration.mesh_form import fit_mesh_form, has_profile
+    if not (has_levels(fmu, channel) and has_profile(fmu)):
+        raise ScenarioError([(str(scenario.source), "calibration.mesh_form", f"{Path(str(fmu)).name} has no sensor "
+                              f"gain for {channel!r} or no profile_deviation; mesh_form: fit needs a model that reads "
+                              "its casing sensors with the broadband sources (GearTwin.Gearbox21Measured and the "
+                              "models on GearTwin.Gearbox21Casing)")])
+    try:
+        return fit_mesh_form(fmu, parameters, np.asarray(rec[channel], float), rec.sample_rate,
+                             speed_hz=target.drive_hz, load_nm=target.load, channel=channel, fmax=fmax, settle=settle)
+    except ValueError as exc:
+        raise MeasurementError(f"record {rec.name!r}: {exc}") from None
 
 
 def _block(scenario, modes_from: str | None, pairing: str | None = None, foundation_from: str | None = None,
@@ -276,6 +294,13 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
             chosen.update(measured_path.parameters)
             if progress:
                 print(measured_path.describe())
+        form = None
+        if rec is not None and spec.get("mesh_form", "none") == "fit":
+            form = _mesh_form(scenario, spectrum_fmu, {**fixed, **chosen}, rec, channel, target, settle,
+                              min(band[1], 0.45 * rec.sample_rate))
+            chosen.update(form.parameters)
+            if progress:
+                print(form.describe())
         if rec is not None and has_levels(spectrum_fmu, channel):
             # the level of the spectrum: sensor gain, roughness and process-force levels (three runs)
             level_kw = dict(speed_hz=target.drive_hz, load_nm=target.load, channel=channel, fmin=band[0],
@@ -297,7 +322,12 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
                 if n in on_bounds(space.names, [chosen[k] for k in space.names], space.lower, space.upper)]
     if levels is not None and (held := levels.warning()):
         warnings.append(held)
+    if form is not None and form.on_bound():
+        from twin.calibration.mesh_form import BOUND
+        warnings.append(f"{form.describe()}: on the bound of +-{1e6 * BOUND:g} um (about ISO 1328-1 grade 9); "
+                        "the mesh harmonics ask for more than a gear's profile deviation")
     notes = tuple(n for n in (path_note, measured_path.describe() if measured_path is not None else None,
+                              form.describe() if form is not None else None,
                               f"levels: {levels.describe()}" if levels is not None else None) if n)
     if progress:
         for w in warnings:
