@@ -20,8 +20,14 @@ positions xi in [0, 1]; a constant is backlash and changes nothing):
 The mesh's response is not linear in them (a deviation of a few um takes pairs out of contact and
 brings them back), so each candidate (s, c) is simulated: the mesh alone (no broadband, gain 1),
 its harmonics 1-6 against the measured ones (those standing 6 dB out of their surroundings),
-scored by the RMS dB difference left after the best sensor gain within the sensor's declared
-range.  A 5 x 5 grid over +-:data:`BOUND`, then Nelder-Mead from the best point.
+scored by their RMS dB difference at the sensor's own gain (its value in ``parameters``, else the
+FMU's start, 1).  The gain is not fitted here: with it free, a larger deviation read at a smaller
+gain matched the lines as well (the level is then not identifiable); the level fit that follows
+sets the gain from the lines the fitted profile makes.  Six line amplitudes do not fix both shapes
+(a steep slope with a little crowning and a milder slope with a hollow can give the same lines), so
+among profiles that match alike the smallest is taken: :data:`PENALTY` dB per um of the larger
+amplitude is added to the score.  A 9 x 9 grid over +-:data:`BOUND`, then Nelder-Mead from the
+best point.
 """
 from __future__ import annotations
 
@@ -35,6 +41,8 @@ from twin.calibration.levels import PROCESS, ROUGHNESS, SENSOR_OF_CHANNEL, mesh_
 
 #: Largest |slope| and |crowning| [m]: about ISO 1328-1 grade 9 for a module-3 pinion.
 BOUND = 20e-6
+#: Score added per um of the larger of |slope| and |crowning| [dB/um]: the smallest of equal fits.
+PENALTY = 0.1
 PARAMETER = "profile_deviation"
 
 
@@ -59,7 +67,7 @@ class MeshFormFit:
     slope: float                   # [m]
     crowning: float                # [m]
     parameters: Mapping[str, float]   # profile_deviation[1..n] [m]
-    lines_db_before: float         # RMS dB error of the mesh harmonics with perfect involutes, best gain
+    lines_db_before: float         # RMS dB error of the mesh harmonics with perfect involutes, at the gain
     lines_db_after: float          # the same with the fitted deviation
     gain_before: float             # the gain the lines asked for with perfect involutes [-]
     gain_after: float              # ... with the fitted deviation [-]
@@ -94,16 +102,14 @@ def fit_mesh_form(fmu_path, parameters: Mapping[str, float], measured, fs: float
     sensor = SENSOR_OF_CHANNEL[channel]
     with FMU(fmu_path) as fmu:
         n_nodes = int(fmu.structural_values().get("n_profile", 11))
-        gain_limits = next(((sv.min, sv.max) for sv in fmu.model_description.modelVariables
-                            if sv.name == f"{sensor}.gain"), (None, None))
+        gain = float(parameters.get(f"{sensor}.gain", fmu.variable(f"{sensor}.gain").start))
     measured = np.asarray(measured, float)
     line_meas, ring_meas = mesh_lines(measured, fs, speed_hz, fmax=fmax)
-    usable = np.isfinite(line_meas) & (line_meas >= 4.0 * ring_meas)
+    usable = np.isfinite(line_meas) & (line_meas > 0) & (line_meas >= 4.0 * ring_meas)
     if not usable.any():
         raise ValueError("no gear-mesh harmonic stands out of the measured spectrum: the profile cannot be fitted")
     base = {**parameters, f"{sensor}.gain": 1.0, ROUGHNESS[0]: 0.0, ROUGHNESS[1]: 0.0, PROCESS: 0.0}
-    lo_db, hi_db = (20 * math.log10(float(v)) if v is not None and float(v) > 0 else sign * math.inf
-                    for v, sign in zip(gain_limits, (-1, 1)))
+    g = 20 * math.log10(gain)
     cache: dict[tuple[float, float], tuple[float, float]] = {}
 
     def score(q) -> float:
@@ -119,17 +125,17 @@ def fit_mesh_form(fmu_path, parameters: Mapping[str, float], measured, fs: float
                 cache[key] = (math.inf, math.nan)
             else:
                 need = 10 * np.log10(line_meas[ok] / line[ok])      # dB of gain each harmonic asks for
-                g = float(np.clip(np.mean(need), lo_db, hi_db))
                 cache[key] = (float(np.sqrt(np.mean((need - g) ** 2))), 10 ** (float(np.mean(need)) / 20))
-        return cache[key][0]
+        return cache[key][0] + PENALTY * 1e6 * max(abs(s), abs(c))
 
-    grid = np.linspace(-1.0, 1.0, 5)
+    grid = np.linspace(-1.0, 1.0, 9)
     points = [(a, b) for a in grid for b in grid]
     scores = [score(p) for p in points]
     before, gain_before = cache[(0, 0)]
     best = np.array(points[int(np.argmin(scores))])
+    step = np.where(best > 0, -0.125, 0.125)        # into the box from a point on its edge
     res = minimize(score, best, method="Nelder-Mead",
-                   options={"initial_simplex": [best, best + [0.25, 0.0], best + [0.0, 0.25]], "maxfev": 24,
+                   options={"initial_simplex": [best, best + [step[0], 0.0], best + [0.0, step[1]]], "maxfev": 24,
                             "xatol": 0.01, "fatol": 0.05})
     q = res.x if res.fun <= min(scores) else best
     s, c = (float(np.clip(v, -1.0, 1.0)) * BOUND for v in q)

@@ -105,7 +105,7 @@ def _col(model: float, measured: float) -> str:
     return f"{model:13.1f} {100 * (model - measured) / measured:+9.1f}"
 
 
-def _mesh_form(scenario, fmu, parameters, rec, channel, target, settle, fmax):
+def _mesh_form(scenario, fmu, parameters, rec, channel, target, settle, fmax, source=None):
     """``mesh_form: fit``: the profile fit (:mod:`twin.calibration.mesh_form`) on the steady record."""
     from twin.calibration.levels import has_levels
     from twin.calibration.mesh_form import fit_mesh_form, has_profile
@@ -118,7 +118,7 @@ def _mesh_form(scenario, fmu, parameters, rec, channel, target, settle, fmax):
         return fit_mesh_form(fmu, parameters, np.asarray(rec[channel], float), rec.sample_rate,
                              speed_hz=target.drive_hz, load_nm=target.load, channel=channel, fmax=fmax, settle=settle)
     except ValueError as exc:
-        raise MeasurementError(f"record {rec.name!r}: {exc}") from None
+        raise MeasurementError(str(source or "<measurements>"), rec.name, f"{exc} (calibration.mesh_form: fit)") from None
 
 
 def _block(scenario, modes_from: str | None, pairing: str | None = None, foundation_from: str | None = None,
@@ -297,7 +297,7 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
         form = None
         if rec is not None and spec.get("mesh_form", "none") == "fit":
             form = _mesh_form(scenario, spectrum_fmu, {**fixed, **chosen}, rec, channel, target, settle,
-                              min(band[1], 0.45 * rec.sample_rate))
+                              min(band[1], 0.45 * rec.sample_rate), source)
             chosen.update(form.parameters)
             if progress:
                 print(form.describe())
