@@ -21,7 +21,8 @@ each test (pitting: 6 stages at 20 Hz / 20 N.m; wear: 4 stages at 10 Hz / 5 N.m)
    records are assessed by the trained ensemble (``extra``).  Arm ``path``: the hammer tests are
    healthy records too and measure the path to the sensor (``path_from``: the pinion's support for
    ``bearing_force_input_y``, the gear's for ``bearing_force_output_y``), so the archive is simulated
-   through the rig's measured path; arm ``calibrated``: the modelled path;
+   through the rig's measured path; arm ``path_form``: the same with the pinion's profile fitted to
+   the mesh lines (``calibration.mesh_form: fit``); arm ``calibrated``: the modelled path;
 3. **retrainings**: the ensemble trained again ``retrainings - 1`` times with disjoint seeds on the
    same archive, for the spread of the ensemble's accuracy (the calibrated arms);
 4. **ablation**: the same pipeline with the default (uncalibrated) twin, one ensemble; every
@@ -60,7 +61,8 @@ HAMMER_SEEDS = (103, 104)
 #: Where the path's blows strike each rig (its bearing supports) and the twin's bearing force each stands for.
 PATH_BLOWS = {"pedestal": ("pinion_pedestal", "gear_pedestal"), "beam": ("pinion_housing", "gear_housing")}
 PATH_FORCES = ("bearing_force_input_y", "bearing_force_output_y")
-ARMS = {"path": "calibrated, measured path", "calibrated": "calibrated", "default": "default"}
+ARMS = {"path_form": "calibrated, measured path, fitted profile", "path": "calibrated, measured path",
+        "calibrated": "calibrated", "default": "default"}
 CHANNEL = "accel_pinion_casing"
 
 
@@ -167,12 +169,14 @@ def run_arm(name: str, task: str, arm: str, args, out: Path) -> dict:
     rig_file, test_file = rig_data(name, task, args.per_stage, out / "data")
     test = labelled(test_file)
     d = out / f"{name}_{task}_{arm}"
-    healthy, path_from = ("runup", "steady"), {}
-    if arm == "path":
+    healthy, path_from, scenario = ("runup", "steady"), {}, REPO / TESTS[task][0]
+    if arm in ("path", "path_form"):
         rig_file, path_from = path_data(name, task, args.per_stage, out / "data")
         healthy += tuple(path_from)
+    if arm == "path_form":
+        scenario = _with_mesh_form(scenario, out / "scenarios")
     t = time.perf_counter()
-    run_pipeline(PipelinePlan(rig_file, healthy, REPO / TESTS[task][0], d, members=args.members,
+    run_pipeline(PipelinePlan(rig_file, healthy, scenario, d, members=args.members,
                               epochs=args.epochs, jobs=args.jobs, calibrate=arm != "default", time_ordered=True,
                               path_from=path_from),
                  progress=False, log=lambda m: print(f"  [{name} {task} {arm}] {m}", flush=True))
@@ -187,6 +191,19 @@ def run_arm(name: str, task: str, arm: str, args, out: Path) -> dict:
             runs.append(score(ens, test))
     stages = json.loads((d / "pipeline.json").read_text())["stages"]
     return {"runs": runs, "wall_time": wall, "stage_seconds": {k: v.get("seconds") for k, v in stages.items()}}
+
+
+def _with_mesh_form(scenario: Path, where: Path) -> Path:
+    """A copy of ``scenario`` whose calibration block is the pipeline's with ``mesh_form: fit``."""
+    import yaml
+
+    from twin.pipeline.run import CALIBRATION
+    raw = yaml.safe_load(scenario.read_text())
+    raw["calibration"] = {**CALIBRATION, "mesh_form": "fit"}
+    where.mkdir(parents=True, exist_ok=True)
+    path = where / f"{scenario.stem}_mesh_form.yaml"
+    path.write_text(yaml.safe_dump(raw, sort_keys=False))
+    return path
 
 
 def _unlabelled(records):
@@ -274,8 +291,9 @@ def main() -> None:
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--out", default=str(REPO / "bench_out" / "pipeline_rigs"))
     ap.add_argument("--arms", default="path,calibrated,default",
-                    help="comma-separated, in this order: path (calibrated, measured path), calibrated (modelled "
-                         "path), default (uncalibrated)")
+                    help="comma-separated, in this order: path_form (measured path and the profile fitted to the "
+                         "mesh lines), path (calibrated, measured path), calibrated (modelled path), default "
+                         "(uncalibrated)")
     ap.add_argument("--no-ablation", action="store_true", help="leave out the default arm")
     ap.add_argument("--no-reversal", action="store_true")
     args = ap.parse_args()
