@@ -103,9 +103,12 @@ def path_data(name: str, task: str, per_stage: int, data: Path) -> tuple[Path, d
     """(the rig file of :func:`rig_data` with two hammer tests of the healthy rig added, path_from); cached."""
     from twin.measurements import load_measurements
     rig_file, _ = rig_data(name, task, per_stage, data)
-    path_file = data / f"{name}_{task}_path.h5"
+    path_file, key = data / f"{name}_{task}_path.h5", data / f"{name}_{task}_path.json"
     path_from = {f"hammer_{loc}": force for loc, force in zip(PATH_BLOWS[name], PATH_FORCES)}
-    if path_file.exists() and path_file.stat().st_mtime >= rig_file.stat().st_mtime:
+    # the records of rig_file (its own key) and the blows' design
+    wanted = json.dumps({"rig_file": (data / f"{name}_{task}.json").read_text(), "blows": PATH_BLOWS[name],
+                         "seeds": HAMMER_SEEDS})
+    if path_file.exists() and key.exists() and key.read_text() == wanted:
         return path_file, path_from
     box, write = _rig(name)
     _, _, load = TESTS[task]
@@ -120,6 +123,7 @@ def path_data(name: str, task: str, per_stage: int, data: Path) -> tuple[Path, d
         if not np.array_equal(np.asarray(r[CHANNEL]), np.asarray(b[r.name][CHANNEL])):
             path_file.unlink()
             raise SystemExit(f"{path_file}: record {r.name} differs from {rig_file}'s; the rig is not repeatable")
+    key.write_text(wanted)
     return path_file, path_from
 
 
