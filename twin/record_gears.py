@@ -190,6 +190,9 @@ def pinion_parameters(pinion: PinionDraw, healthy: dict, damaged: dict) -> dict[
     offset = pinion.pitch_deviation + runout_deviation(pinion.runout, pinion.runout_phase, teeth)
     factor = tooth_compliance_factors(_profile(healthy, "k_pair"), _profile(damaged, "k_pair"), c)
     depth = _profile(damaged, "profile_deviation")
+    as_made = _profile(healthy, "profile_deviation")
+    if as_made.size == depth.size:
+        depth = depth - as_made      # the wear alone, not the flanks' as-manufactured profile (mesh_form)
     mean_depth = float(depth.mean()) if depth.size else 0.0
     if mean_depth > 0:
         offset = offset + (c - 1.0) * mean_depth
@@ -217,7 +220,7 @@ def tooth_errors(draw: np.random.Generator, spec, teeth: int, healthy: dict, dam
       one ``tooth_stiffness_factor[i]`` per tooth on top of the uniform ``k_pair``, chosen to keep
       the tooth's mean compliance along the path (:func:`tooth_compliance_factors`).  Wear: tooth
       i is worn c_i times the mean depth, written as the extra offset (c_i - 1) x mean
-      ``profile_deviation``.  Either way one number per tooth stands in for the damage's shape
+      ``profile_deviation`` beyond the healthy flank's (its as-manufactured profile is not wear).  Either way one number per tooth stands in for the damage's shape
       along that tooth's flank, which is taken to be the uniform damage's.
 
     The offsets are ``tooth_deviation_offset[1..teeth]`` [m], shifted so that the least-cut tooth

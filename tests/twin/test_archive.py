@@ -123,6 +123,16 @@ def test_tooth_errors_by_hand():
     np.testing.assert_allclose([out[f"tooth_deviation_offset[{i}]"] for i in range(1, 5)],
                                [10e-6, 20e-6, 0.0, 10e-6], atol=1e-18)                # (c - 1) 20 um, min 0
     assert all(out[f"tooth_stiffness_factor[{i}]"] == 1.0 for i in range(1, 5))
+    # a healthy flank with an as-manufactured profile: only the wear beyond it is spread over the teeth
+    made = {**healthy, "profile_deviation[1]": 4e-6, "profile_deviation[2]": 8e-6}
+    on_made = {**made, "profile_deviation[1]": 14e-6, "profile_deviation[2]": 38e-6}     # mean wear 20 um
+    out = tooth_errors(_FixedDraw([0.0] * 4, [1.0, 1.5, 0.5, 1.0]), {"tooth_damage_scatter": 0.5}, teeth,
+                       made, on_made)
+    np.testing.assert_allclose([out[f"tooth_deviation_offset[{i}]"] for i in range(1, 5)],
+                               [10e-6, 20e-6, 0.0, 10e-6], atol=1e-18)
+    out = tooth_errors(_FixedDraw([0.0] * 4, [1.0, 1.5, 0.5, 1.0]), {"tooth_damage_scatter": 0.5}, teeth,
+                       made, made)
+    assert all(out[f"tooth_deviation_offset[{i}]"] == 0.0 for i in range(1, 5))        # new flanks: no wear
 
 
 def test_tooth_compliance_factors_keep_the_mean_deflection_by_hand():
