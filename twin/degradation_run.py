@@ -112,11 +112,11 @@ def manufactured_form(state, parameters, n_nodes: int):
     pinion flank's form, so the wear runs it in: a wear run rewrites ``profile_deviation`` from the
     flanks at every update, which would otherwise drop it after the first."""
     from twin.degradation import WearState
-    from twin.degradation._nodes import hat_matrix
-    nodes = np.array([float(parameters.get(f"profile_deviation[{i}]", 0.0)) for i in range(1, n_nodes + 1)])
-    if not np.any(nodes):
+    from twin.degradation._nodes import interp_nodes
+    nodes = [float(parameters.get(f"profile_deviation[{i}]", 0.0)) for i in range(1, n_nodes + 1)]
+    if not any(nodes):
         return state
-    e = hat_matrix(state.xi, n_nodes) @ nodes
+    e = interp_nodes(nodes, state.xi)
     return WearState(state.cycles, state.xi, state.depth, state.geometry, state.gear_depth,
                      state.pinion_form + (e.max() - e), state.gear_form)
 

@@ -48,7 +48,8 @@ PARAMETER = "profile_deviation"
 
 def profile(slope: float, crowning: float, n_nodes: int) -> np.ndarray:
     """Material missing from the pinion flank at the ``n_nodes`` roll positions [m], (n_nodes,), >= 0."""
-    xi = np.linspace(0.0, 1.0, n_nodes)
+    from twin.degradation._nodes import node_xi
+    xi = node_xi(n_nodes)
     e = slope * xi + crowning * (2.0 * xi - 1.0) ** 2
     return e - e.min()
 
@@ -110,15 +111,22 @@ def fit_mesh_form(fmu_path, parameters: Mapping[str, float], measured, fs: float
         raise ValueError("no gear-mesh harmonic stands out of the measured spectrum: the profile cannot be fitted")
     base = {**parameters, f"{sensor}.gain": 1.0, ROUGHNESS[0]: 0.0, ROUGHNESS[1]: 0.0, PROCESS: 0.0}
     g = 20 * math.log10(gain)
-    cache: dict[tuple[float, float], tuple[float, float]] = {}
+    cache: dict[tuple[int, int], tuple[float, float]] = {}
+
+    def point(q) -> tuple[float, float, tuple[int, int]]:
+        """(slope, crowning [m], cache key in nm: the simplex revisits points) of a scaled point q."""
+        s, c = (float(np.clip(v, -1.0, 1.0)) * BOUND for v in q)
+        return s, c, (round(s * 1e9), round(c * 1e9))
+
+    def nodes(s: float, c: float) -> dict[str, float]:
+        return {f"{PARAMETER}[{i}]": float(v) for i, v in enumerate(profile(s, c, n_nodes), 1)}
 
     def score(q) -> float:
-        s, c = (float(np.clip(v, -1.0, 1.0)) * BOUND for v in q)
-        key = (round(s * 1e9), round(c * 1e9))        # nm: the simplex revisits points
+        s, c, key = point(q)
         if key not in cache:
-            values = {**base, **{f"{PARAMETER}[{i}]": float(v) for i, v in enumerate(profile(s, c, n_nodes), 1)}}
-            y = simulate_operating_point(fmu_path, speed_hz, load_nm, parameters=values, settle=settle,
-                                         duration=duration, channels=[channel], output_interval=1.0 / fs)[:, 0]
+            y = simulate_operating_point(fmu_path, speed_hz, load_nm, parameters={**base, **nodes(s, c)},
+                                         settle=settle, duration=duration, channels=[channel],
+                                         output_interval=1.0 / fs)[:, 0]
             line, _ = mesh_lines(y, fs, speed_hz, fmax=fmax)
             ok = usable & (line > 0)
             if not ok.any():
@@ -137,9 +145,7 @@ def fit_mesh_form(fmu_path, parameters: Mapping[str, float], measured, fs: float
     res = minimize(score, best, method="Nelder-Mead",
                    options={"initial_simplex": [best, best + [step[0], 0.0], best + [0.0, step[1]]], "maxfev": 24,
                             "xatol": 0.01, "fatol": 0.05})
-    q = res.x if res.fun <= min(scores) else best
-    s, c = (float(np.clip(v, -1.0, 1.0)) * BOUND for v in q)
-    after, gain_after = cache[(round(s * 1e9), round(c * 1e9))]
-    values = {f"{PARAMETER}[{i}]": float(v) for i, v in enumerate(profile(s, c, n_nodes), 1)}
-    return MeshFormFit(s, c, values, before, after, gain_before, gain_after,
+    s, c, key = point(res.x if res.fun <= min(scores) else best)
+    after, gain_after = cache[key]
+    return MeshFormFit(s, c, nodes(s, c), before, after, gain_before, gain_after,
                        tuple(int(k) + 1 for k in np.flatnonzero(usable)), len(cache))
