@@ -300,28 +300,25 @@ def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str, p
     base_fmu = build_fmu("GearTwin.Gearbox21", REPO / "modelica", REPO / "build")
     sims = {"default twin (Gearbox21)": (base_fmu, {}),
             "calibrated twin": (fmu, dict(calibrated.parameters))}
+
+    def refitted(model_fmu, params):
+        """``params`` without their levels, the levels fitted again on ``model_fmu`` as `twin calibrate` fits them."""
+        from levels_rigs import without_levels
+
+        from twin.calibration.levels import fit_levels_and_panels
+        params = without_levels(params)
+        _, updates = fit_levels_and_panels(model_fmu, params, x, fs, speed_hz=float(meas.nominal_speed),
+                                           load_nm=float(meas.load), channel=CHANNEL, fmin=BAND[0],
+                                           fmax=min(BAND[1], 0.45 * fs), settle=0.1)
+        return model_fmu, {**params, **updates}
+
     if path:
-        # the same calibrated gearbox with its modelled casing path, levels fitted as `twin
-        # calibrate` without path_from fits them: the control of the measured path
-        from levels_rigs import without_levels
-
-        from twin.calibration.levels import fit_levels_and_panels
-        params = without_levels(mech_params)
-        _, updates = fit_levels_and_panels(mech_fmu, params, x, fs, speed_hz=float(meas.nominal_speed),
-                                           load_nm=float(meas.load), channel=CHANNEL, fmin=BAND[0],
-                                           fmax=min(BAND[1], 0.45 * fs), settle=0.1)
-        sims["calibrated twin, modelled path"] = (mech_fmu, {**params, **updates})
+        # the same calibrated gearbox with its modelled casing path: the control of the measured path
+        sims["calibrated twin, modelled path"] = refitted(mech_fmu, mech_params)
     if mesh_form:
-        # the same calibrated gearbox with perfect involutes, levels refitted: the control of the profile fit
-        from levels_rigs import without_levels
-
-        from twin.calibration.levels import fit_levels_and_panels
-        params = {k: (0.0 if k.startswith("profile_deviation[") else v)
-                  for k, v in without_levels(dict(calibrated.parameters)).items()}
-        _, updates = fit_levels_and_panels(fmu, params, x, fs, speed_hz=float(meas.nominal_speed),
-                                           load_nm=float(meas.load), channel=CHANNEL, fmin=BAND[0],
-                                           fmax=min(BAND[1], 0.45 * fs), settle=0.1)
-        sims["calibrated twin, perfect involutes"] = (fmu, {**params, **updates})
+        # the same calibrated gearbox with perfect involutes: the control of the profile fit
+        sims["calibrated twin, perfect involutes"] = refitted(
+            fmu, {k: (0.0 if k.startswith("profile_deviation[") else v) for k, v in calibrated.parameters.items()})
     spectrum = {}
     for label, (path, params) in sims.items():
         y = simulate_operating_point(path, float(meas.nominal_speed), float(meas.load), parameters=params,
