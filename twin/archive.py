@@ -12,7 +12,9 @@
 3. optionally gives each record its own pinion (``pitch_error``, ``runout``,
    ``tooth_damage_scatter``; :func:`twin.record_gears.tooth_errors`): random manufacturing errors and an uneven
    spread of the damage over the teeth, drawn from a stream of its own, so an archive without
-   these keys is unchanged by them.  Each record keeps its drawn pinion as ``gear_*`` record
+   these keys is unchanged by them.  A worn record's teeth are worn from the drawn pinion under
+   the record's quasi-static load sharing (:mod:`twin.degradation.tooth_wear`), so its pitch
+   errors and run-out wear in as the depth grows.  Each record keeps its drawn pinion as ``gear_*`` record
    attributes (:func:`twin.record_gears.gear_attributes`), so a record names the gear it was simulated with;
    likewise each record can get a gear (wheel) of its own (``wheel_pitch_error``,
    ``wheel_runout``; :func:`twin.record_gears.draw_wheel`), from a third stream, kept as ``gear_wheel_*``;
@@ -188,6 +190,22 @@ def simulate_records(tasks: list[RecordTask], scenario: Scenario, *, executor=No
     return results
 
 
+def _load_sharing(run, mesh: dict, load_torque: float):
+    """The quasi-static mesh of a worn record (its pair stiffness, worn profile and brake torque
+    [N.m]), under which its pinion's teeth are worn (twin.record_gears.pinion_parameters); None
+    for a pitting run, whose teeth do not wear."""
+    from twin.degradation._nodes import node_array
+    from twin.degradation.tooth_wear import ToothLoadSharing
+
+    if run.model != "wear" or run.geometry is None:
+        return None
+    if not load_torque > 0:
+        raise SimulationError(f"a worn record needs a brake torque > 0 N.m to wear its teeth, got {load_torque!r}")
+    k = run.mesh_stiffness_scale * node_array(mesh, "k_pair")
+    return ToothLoadSharing.for_gears(run.geometry, k, load_torque / run.geometry.base_radius_gear,
+                                      node_array(mesh, "profile_deviation"))
+
+
 def build_archive(scenario: Scenario, output: str | Path | None = None, *, progress: bool = True,
                   fmu_path: Path | None = None, executor=None) -> Archive:
     """Build the archive described by ``scenario.archive`` (see the module docstring)."""
@@ -247,7 +265,7 @@ def build_archive(scenario: Scenario, output: str | Path | None = None, *, progr
             p = {**scenario.parameters, **mesh, **start}
             if teeth:
                 pinion = draw_pinion(gear_draw, spec, teeth)
-                gear = pinion_parameters(pinion, params[0], mesh)
+                gear = pinion_parameters(pinion, params[0], mesh, _load_sharing(run, mesh, t_load))
                 # on top of any per-tooth damage the scenario itself sets
                 gear = {n: v * scenario.parameters.get(n, 1.0) if n.startswith("tooth_stiffness")
                         else v + scenario.parameters.get(n, 0.0) for n, v in gear.items()}

@@ -79,6 +79,8 @@ class DegradationRun:
     stages: tuple[Stage, ...]
     complete: bool
     sample_rate: float
+    geometry: Any = None                # the GearPair the run wore or pitted (twin.degradation.GearPair)
+    mesh_stiffness_scale: float = 1.0   # the FMU's factor on k_pair in the run
 
     @property
     def damage(self) -> np.ndarray:
@@ -296,7 +298,8 @@ def run_degradation(scenario: Scenario, output: str | Path | None = None, *, fmu
             complete = False
         finally:
             bar.close()
-    run = DegradationRun(scenario, model_name, tuple(stages), complete, scenario.sample_rate)
+    run = DegradationRun(scenario, model_name, tuple(stages), complete, scenario.sample_rate, geometry,
+                         float(geometry_values.get("mesh_stiffness_scale", 1.0)))
     if path is not None and stages:
         if complete:
             _write(path, scenario, model_name, stages, dt, complete=True, state=None, identity=identity)

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from twin.errors import ScenarioError
+from twin.errors import ParameterError, ScenarioError
 from twin.scenario import Scenario
 
 TOOTH_ERROR_KEYS = ("pitch_error", "runout", "tooth_damage_scatter")
@@ -183,8 +183,11 @@ def tooth_compliance_factors(k_healthy: np.ndarray, k_damaged: np.ndarray, damag
     return np.mean(1.0 / common_k) / np.mean(1.0 / tooth_k, axis=1)
 
 
-def pinion_parameters(pinion: PinionDraw, healthy: dict, damaged: dict) -> dict[str, float]:
-    """Per-tooth FMU parameters of a drawn pinion at a record's damage (see :func:`tooth_errors`)."""
+def pinion_parameters(pinion: PinionDraw, healthy: dict, damaged: dict, sharing=None) -> dict[str, float]:
+    """Per-tooth FMU parameters of a drawn pinion at a record's damage (see :func:`tooth_errors`).
+
+    ``sharing`` (:class:`~twin.degradation.tooth_wear.ToothLoadSharing`, the record's mesh) is
+    needed when the record is worn: the teeth are worn under it from their drawn offsets."""
     teeth = pinion.pitch_deviation.size
     c = pinion.damage_factors
     offset = pinion.pitch_deviation + runout_deviation(pinion.runout, pinion.runout_phase, teeth)
@@ -195,14 +198,19 @@ def pinion_parameters(pinion: PinionDraw, healthy: dict, damaged: dict) -> dict[
         depth = depth - as_made      # the wear alone, not the flanks' as-manufactured profile (mesh_form)
     mean_depth = float(depth.mean()) if depth.size else 0.0
     if mean_depth > 0:
-        offset = offset + (c - 1.0) * mean_depth
+        if sharing is None:
+            raise ParameterError(f"a worn record ({1e6 * mean_depth:.3g} um mean depth) needs the mesh's load "
+                                 "sharing (sharing=ToothLoadSharing) to wear its teeth")
+        # a gamma draw can come out near zero: no tooth is wear-free, the floor keeps the rates finite
+        offset = sharing.level(offset, np.clip(c, 0.05, None), mean_depth)
     offset = offset - offset.min()
     out = {f"tooth_deviation_offset[{i + 1}]": float(v) for i, v in enumerate(offset)}
     out.update({f"tooth_stiffness_factor[{i + 1}]": float(v) for i, v in enumerate(factor)})
     return out
 
 
-def tooth_errors(draw: np.random.Generator, spec, teeth: int, healthy: dict, damaged: dict) -> dict[str, float]:
+def tooth_errors(draw: np.random.Generator, spec, teeth: int, healthy: dict, damaged: dict,
+                 sharing=None) -> dict[str, float]:
     """Per-pinion-tooth FMU parameters of one record's gear: manufacturing errors and uneven damage.
 
     Every real pinion has pitch errors and some run-out, and its damage is not the same on every
@@ -218,10 +226,15 @@ def tooth_errors(draw: np.random.Generator, spec, teeth: int, healthy: dict, dam
       (gamma distributed, mean 1, so the stage's mean damage is kept).  Pitting: where the uniform
       damage loses d(u) of the pair stiffness, tooth i loses min(c_i d(u), 0.95); the FMU takes
       one ``tooth_stiffness_factor[i]`` per tooth on top of the uniform ``k_pair``, chosen to keep
-      the tooth's mean compliance along the path (:func:`tooth_compliance_factors`).  Wear: tooth
-      i is worn c_i times the mean depth, written as the extra offset (c_i - 1) x mean
-      ``profile_deviation`` beyond the healthy flank's (its as-manufactured profile is not wear).  Either way one number per tooth stands in for the damage's shape
-      along that tooth's flank, which is taken to be the uniform damage's.
+      the tooth's mean compliance along the path (:func:`tooth_compliance_factors`).  Wear: c_i
+      is tooth i's wear coefficient over the mean's, and the teeth are worn from their drawn
+      offsets by the mean depth of ``profile_deviation`` beyond the healthy flank's (its
+      as-manufactured profile is not wear) under the mesh's load sharing
+      (:mod:`twin.degradation.tooth_wear`): a proud tooth carries more and wears faster, so the
+      pitch errors and run-out wear in and the teeth end level to a fraction of the static
+      deflection, a tooth of larger c_i a little recessed.  Either way one number per tooth
+      stands in for the damage's shape along that tooth's flank, which is taken to be the uniform
+      damage's.
 
     The offsets are ``tooth_deviation_offset[1..teeth]`` [m], shifted so that the least-cut tooth
     has zero (a common offset only moves the static deflection).
@@ -233,12 +246,14 @@ def tooth_errors(draw: np.random.Generator, spec, teeth: int, healthy: dict, dam
     teeth : pinion tooth count (the FMU's ``tooth_deviation_offset`` array size).
     healthy, damaged : FMU mesh parameters (``k_pair[j]``, ``profile_deviation[j]``) of the healthy
         flank and at the record's damage.
+    sharing : :class:`~twin.degradation.tooth_wear.ToothLoadSharing` of the record's mesh; needed
+        when ``damaged`` is worn (ParameterError otherwise).
 
     Returns
     -------
     dict: ``tooth_deviation_offset[i]`` [m] and ``tooth_stiffness_factor[i]`` [-], i = 1..teeth.
     """
-    return pinion_parameters(draw_pinion(draw, spec, teeth), healthy, damaged)
+    return pinion_parameters(draw_pinion(draw, spec, teeth), healthy, damaged, sharing)
 
 
 GEAR_ARRAYS = ("tooth_deviation_offset", "tooth_stiffness_factor")
