@@ -63,7 +63,7 @@ def test_wear_levels_the_teeth_to_a_fraction_of_the_static_deflection():
     # the tooth of largest wear coefficient stands recessed, the smallest proud
     assert level[np.argmax(factors)] > level[np.argmin(factors)]
     # identical material: the teeth end level
-    assert np.ptp(sh.level(offsets, np.ones(19), 240e-6)) < 0.01 * band
+    assert np.ptp(sh.level(offsets, np.ones(19), 240e-6)) < 0.05 * band
 
 
 def test_levelling_converges_with_the_step(monkeypatch):
