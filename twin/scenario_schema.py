@@ -219,8 +219,10 @@ SCHEMA: dict[str, Any] = {
                                                          "an sd drawn uniformly up to this (default 0)"},
                 "runout": {**_NONNEG, "description": "m: each record's pinion has a run-out, peak to peak, drawn "
                                                     "uniformly up to this (default 0)"},
-                "tooth_damage_scatter": {**_NONNEG, "description": "relative sd of the damage from tooth to tooth, "
-                                                                  "drawn per record uniformly up to this (default 0)"},
+                "tooth_damage_scatter": {**_NONNEG, "description": "relative sd of the damage from tooth to tooth "
+                                                                  "(pitting: its depth; wear: the wear coefficient, the "
+                                                                  "teeth worn under load sharing), drawn per record "
+                                                                  "uniformly up to this (default 0)"},
                 "wheel_pitch_error": {**_NONNEG, "description": "m: each record's gear (wheel) has single pitch "
                                                                "deviations with an sd drawn uniformly up to this; "
                                                                "its teeth sit at their cumulative sum (default 0)"},
