@@ -10,7 +10,8 @@
 ``wear``: an 18/35 module-3 pair at 15 Hz / 10 N.m (light load), profile form deviation of
 ISO 1328-1 class 7, coupled wear run to about 1 mm of mean pinion wear depth on 41 profile
 nodes, the pairs' stiffness the LTCA's at the load (``pair_stiffness: contact``); at every stage
-the casing RMS of 0.4 s records.  Prints the RMS against depth, the Spearman rank correlation
+the casing RMS of 0.4 s records of a pinion with class-6 pitch deviations and run-out, worn in
+under the load sharing as the flanks wear (:func:`worn_in`; so in ``rigs``).  Prints the RMS against depth, the Spearman rank correlation
 after run-in (from the RMS minimum on), the worn/healthy ratio, and the contact-loss check at
 eight stages: which pairs the FMU leaves unloaded against the LTCA of the same worn flanks at
 each sample's elastic mesh force and roll positions
@@ -91,6 +92,20 @@ def pinion_errors(seed: int, teeth: int) -> dict:
     errors = 2e-6 * rng.standard_normal(teeth) + 5e-6 * (1 + np.cos(2 * np.pi * j / teeth + rng.uniform(0, 2 * np.pi)))
     errors -= errors.min()
     return {f"tooth_deviation_offset[{k + 1}]": float(v) for k, v in enumerate(errors)}
+
+
+def worn_in(manufacturing: dict, run, stage, load: float) -> dict:
+    """``manufacturing``'s tooth offsets after ``stage``'s mean wear depth, worn under the record's
+    quasi-static load sharing at the brake torque ``load`` [N.m] (as the twin's archive wears a
+    pinion, twin.archive.load_sharing); unchanged at zero depth or for a pitting run."""
+    from twin.archive import load_sharing
+    sharing = load_sharing(run, stage.parameters, load)
+    if sharing is None or stage.damage <= 0:
+        return manufacturing
+    teeth = len(manufacturing)
+    offsets = np.array([manufacturing[f"tooth_deviation_offset[{k + 1}]"] for k in range(teeth)])
+    worn = sharing.level(offsets, np.ones(teeth), stage.damage)
+    return {f"tooth_deviation_offset[{k + 1}]": float(v) for k, v in enumerate(worn)}
 
 
 # ---- build -----------------------------------------------------------------------------------
@@ -184,14 +199,15 @@ def part_wear(args) -> dict:
     force = 10.0 * 18 / 35 / geometry.base_radius_pinion
     check = set(np.unique(np.linspace(0, len(run.stages) - 1, 8).astype(int)))
     # the RMS records are of a real pinion: its pitch deviations and run-out (as in ``pitting``
-    # and ``rigs``) make the teeth lose contact one by one rather than all alike; the contact
+    # and ``rigs``), worn in as the flanks wear (the load sharing levels the teeth); the contact
     # check keeps the teeth alike, as the LTCA has them
     manufacturing = pinion_errors(args.seed, 18)
     for i, s in enumerate(run.stages):
+        teeth = worn_in(manufacturing, run, s, 10.0)
         row = {"cycles": s.cycles, "depth": s.damage, "max_depth": s.max_damage,
                "gear_max_depth": float(np.max(s.gear_field)) if s.gear_field is not None else 0.0,
                # as an inspection would: several records at slightly different speed and load
-               "rms": float(np.mean([steady_rms(fmu, {**s.parameters, **manufacturing}, 15.0 * (1 + ds),
+               "rms": float(np.mean([steady_rms(fmu, {**s.parameters, **teeth}, 15.0 * (1 + ds),
                                                 10.0 * (1 + dl))
                                      for ds, dl in ((0.0, 0.0), (0.01, -0.05), (-0.01, 0.05))]))}
         if i in check:
@@ -218,7 +234,8 @@ def part_wear(args) -> dict:
     print(f"Machine: {machine()}\n")
     print(f"18/35, module 3, 15 Hz / 10 N.m, form deviation {form * 1e6:.1f} um (ISO 1328-1 class 7), "
           f"{len(rows)} stages in {wall:.0f} s (coupled run); RMS: mean of three 0.4 s records (6 pinion "
-          f"revolutions) at 15 Hz / 10 N.m, +1 % / -5 %, -1 % / +5 %, pinion with class-6 pitch deviations and run-out\n")
+          f"revolutions) at 15 Hz / 10 N.m, +1 % / -5 %, -1 % / +5 %, pinion with class-6 pitch deviations and run-out "
+          f"worn in under load sharing\n")
     print("Pairs unloaded: share of pair-in-path samples with load; FMU / LTCA at each sample's elastic mesh "
           "force and roll positions / FMU unloaded where that LTCA loads (unexplained)\n")
     print("| mean depth [um] | max depth pinion / gear [um] | casing RMS [m/s2] | 15 Hz: no pair touching | "
@@ -401,7 +418,7 @@ def _twin_stage_records(kind: str, damages, speed: float, load: float, scenario:
     out = []
     for dmg in damages:
         i = int(np.argmin(np.abs(run.damage - dmg)))
-        params = {**run.stages[i].parameters, **manufacturing}
+        params = {**run.stages[i].parameters, **worn_in(manufacturing, run, run.stages[i], load)}
         with FMU(fmu) as f:
             f.setup(0.0, parameters=consistent_start(params, inputs, [v.name for v in f.parameters]),
                     inputs=inputs)

@@ -190,7 +190,7 @@ def simulate_records(tasks: list[RecordTask], scenario: Scenario, *, executor=No
     return results
 
 
-def _load_sharing(run, mesh: dict, load_torque: float):
+def load_sharing(run, mesh: dict, load_torque: float):
     """The quasi-static mesh of a worn record (its pair stiffness, worn profile and brake torque
     [N.m]), under which its pinion's teeth are worn (twin.record_gears.pinion_parameters); None
     for a pitting run, whose teeth do not wear."""
@@ -265,7 +265,7 @@ def build_archive(scenario: Scenario, output: str | Path | None = None, *, progr
             p = {**scenario.parameters, **mesh, **start}
             if teeth:
                 pinion = draw_pinion(gear_draw, spec, teeth)
-                gear = pinion_parameters(pinion, params[0], mesh, _load_sharing(run, mesh, t_load))
+                gear = pinion_parameters(pinion, params[0], mesh, load_sharing(run, mesh, t_load))
                 # on top of any per-tooth damage the scenario itself sets
                 gear = {n: v * scenario.parameters.get(n, 1.0) if n.startswith("tooth_stiffness")
                         else v + scenario.parameters.get(n, 0.0) for n, v in gear.items()}
