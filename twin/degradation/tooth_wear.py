@@ -125,15 +125,18 @@ class ToothLoadSharing:
         """W / k of one pair at its mean stiffness [m]: the width of the elastic band."""
         return self.mesh_force / float(np.mean(self.k_pair))
 
-    def _positions(self, teeth: int):
-        """(P, 3) tooth indices, roll positions and engagement mask of the pairs at P mesh positions."""
+    def _mesh(self, teeth: int):
+        """What does not change as the teeth wear, at the pairs of P mesh positions, each (P, 3):
+        the tooth index, the pair stiffness (0 out of mesh), the common profile there (inf out of
+        mesh) and the sliding speed."""
         phi = np.arange(teeth * SAMPLES_PER_PITCH) / SAMPLES_PER_PITCH + 0.5 / SAMPLES_PER_PITCH
         base = np.floor(phi).astype(int)
         tooth = (base[:, None] - np.arange(3)[None, :]) % teeth        # the tooth that entered last first
         travel = (phi - base)[:, None] + np.arange(3)[None, :]           # pitches since each entered
         engaged = travel < self.contact_ratio
         xi = np.clip(travel / self.contact_ratio, 0.0, 1.0)
-        return tooth, xi, engaged
+        return (tooth, np.where(engaged, interp_nodes(self.k_pair, xi), 0.0),
+                np.where(engaged, interp_nodes(self.profile, xi), np.inf), interp_nodes(self.sliding, xi))
 
     def wear_rates(self, offsets, wear_factors) -> np.ndarray:
         """(z,) relative mean wear rate of each tooth, Eq. (1) normalised to mean 1.
@@ -142,13 +145,12 @@ class ToothLoadSharing:
         ``wear_factors`` (z,) [-]: c_j, > 0.
         """
         e = np.asarray(offsets, dtype=float)
-        c = np.asarray(wear_factors, dtype=float)
-        tooth, xi, engaged = self._positions(e.size)
-        k = np.where(engaged, interp_nodes(self.k_pair, xi), 0.0)
-        dev = np.where(engaged, e[tooth] + interp_nodes(self.profile, xi), np.inf)
-        force = _share(k, dev, self.mesh_force)
-        work = force * interp_nodes(self.sliding, xi)
-        rate = c * np.bincount(tooth.ravel(), weights=work.ravel(), minlength=e.size)
+        return self._rates(e, np.asarray(wear_factors, dtype=float), self._mesh(e.size))
+
+    def _rates(self, e: np.ndarray, c: np.ndarray, mesh) -> np.ndarray:
+        tooth, k, profile, sliding = mesh
+        force = _share(k, e[tooth] + profile, self.mesh_force)
+        rate = c * np.bincount(tooth.ravel(), weights=(force * sliding).ravel(), minlength=e.size)
         mean = float(rate.mean())
         if mean <= 0:
             raise ParameterError("no tooth slides under load along this path of contact (sliding is zero)")
@@ -170,8 +172,9 @@ class ToothLoadSharing:
         if not (math.isfinite(depth) and depth >= 0):
             raise ParameterError(f"mean_depth must be a finite depth >= 0 m, got {mean_depth!r}")
         steps = min(MAX_STEPS, math.ceil(depth / (STEP_FRACTION * self.static_deflection)))
+        mesh = self._mesh(e.size)
         for _ in range(steps):
-            rate = self.wear_rates(e, c)
+            rate = self._rates(e, c, mesh)
             if float(np.ptp(rate)) < EQUAL_RATES:
                 break                       # level: the rest of the depth moves every tooth alike
             e += (depth / steps) * rate
