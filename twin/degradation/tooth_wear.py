@@ -43,7 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from twin.degradation._nodes import interp_nodes
+from twin.degradation._nodes import interp_nodes, node_xi
 from twin.errors import ParameterError
 
 #: Integration step of the mean depth as a fraction of the static deflection W / k.  The explicit
@@ -115,8 +115,7 @@ class ToothLoadSharing:
     def for_gears(cls, geometry, k_pair, mesh_force: float, profile=None) -> "ToothLoadSharing":
         """From a :class:`~twin.degradation.geometry.GearPair`: its contact ratio and sliding speed."""
         k = np.asarray(k_pair, dtype=float).ravel()
-        xi = np.linspace(0.0, 1.0, k.size)
-        sliding = geometry.sliding_speed(xi, 1.0)
+        sliding = geometry.sliding_speed(node_xi(k.size), 1.0)
         return cls(k, geometry.contact_ratio, mesh_force, sliding,
                    np.zeros(k.size) if profile is None else np.asarray(profile, dtype=float))
 
@@ -188,7 +187,7 @@ def _share(k: np.ndarray, dev: np.ndarray, force: float) -> np.ndarray:
     ks = np.take_along_axis(k, order, axis=1)
     ds = np.take_along_axis(dev, order, axis=1)
     finite = np.isfinite(ds)
-    kd = np.where(finite, ks * np.where(finite, ds, 0.0), 0.0)
+    kd = ks * np.where(finite, ds, 0.0)             # out of mesh: k = 0 (and 0 x inf would be nan)
     ksum, kdsum = np.cumsum(ks, axis=1), np.cumsum(kd, axis=1)
     with np.errstate(divide="ignore", invalid="ignore"):
         delta = (force + kdsum) / ksum                               # the first m pairs loaded
