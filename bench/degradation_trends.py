@@ -97,15 +97,18 @@ def pinion_errors(seed: int, teeth: int) -> dict:
 def worn_in(manufacturing: dict, run, stage, load: float) -> dict:
     """``manufacturing``'s tooth offsets after ``stage``'s mean wear depth, worn under the record's
     quasi-static load sharing at the brake torque ``load`` [N.m] (as the twin's archive wears a
-    pinion, twin.archive.load_sharing); unchanged at zero depth or for a pitting run."""
+    pinion, twin.archive.load_sharing): each tooth's rigid part and its flank along the path
+    (``tooth_pit_field``); unchanged at zero depth or for a pitting run."""
     from twin.archive import load_sharing
     sharing = load_sharing(run, stage.parameters, load)
     if sharing is None or stage.damage <= 0:
         return manufacturing
     teeth = len(manufacturing)
     offsets = np.array([manufacturing[f"tooth_deviation_offset[{k + 1}]"] for k in range(teeth)])
-    worn = sharing.level(offsets, np.ones(teeth), stage.damage)
-    return {f"tooth_deviation_offset[{k + 1}]": float(v) for k, v in enumerate(worn)}
+    field = sharing.wear(offsets, np.ones(teeth), stage.damage)             # (teeth, nodes)
+    rigid = field.mean(axis=1)
+    return {**{f"tooth_deviation_offset[{k + 1}]": float(v) for k, v in enumerate(rigid - rigid.min())},
+            **{f"tooth_pit_field[{m + 1}]": float(v) for m, v in enumerate((field - rigid[:, None]).ravel())}}
 
 
 # ---- build -----------------------------------------------------------------------------------

@@ -197,15 +197,23 @@ def pinion_parameters(pinion: PinionDraw, healthy: dict, damaged: dict, sharing=
     if as_made.size == depth.size:
         depth = depth - as_made      # the wear alone, not the flanks' as-manufactured profile (mesh_form)
     mean_depth = float(depth.mean()) if depth.size else 0.0
+    shape = None
     if mean_depth > 0:
         if sharing is None:
             raise ParameterError(f"a worn record ({1e6 * mean_depth:.3g} um mean depth) needs the mesh's load "
                                  "sharing (sharing=ToothLoadSharing) to wear its teeth")
         # a gamma draw can come out near zero: no tooth is wear-free, the floor keeps the rates finite
-        offset = sharing.level(offset, np.clip(c, 0.05, None), mean_depth)
+        field = sharing.wear(offset, np.clip(c, 0.05, None), mean_depth)
+        offset = field.mean(axis=1)                 # each tooth's rigid part ...
+        shape = field - offset[:, None]             # ... and its own flank along the path
     offset = offset - offset.min()
     out = {f"tooth_deviation_offset[{i + 1}]": float(v) for i, v in enumerate(offset)}
     out.update({f"tooth_stiffness_factor[{i + 1}]": float(v) for i, v in enumerate(factor)})
+    if shape is not None:
+        # the FMU's per-tooth field along the path (tooth-major), on top of any the record already has
+        pits = _profile(damaged, "tooth_pit_field")
+        flat = shape.ravel() + (pits if pits.size == shape.size else 0.0)
+        out.update({f"tooth_pit_field[{i + 1}]": float(v) for i, v in enumerate(flat)})
     return out
 
 
@@ -230,11 +238,14 @@ def tooth_errors(draw: np.random.Generator, spec, teeth: int, healthy: dict, dam
       is tooth i's wear coefficient over the mean's, and the teeth are worn from their drawn
       offsets by the mean depth of ``profile_deviation`` beyond the healthy flank's (its
       as-manufactured profile is not wear) under the mesh's load sharing
-      (:mod:`twin.degradation.tooth_wear`): a proud tooth carries more and wears faster, so the
-      pitch errors and run-out wear in and the teeth end level to a fraction of the static
-      deflection, a tooth of larger c_i a little recessed.  Either way one number per tooth
-      stands in for the damage's shape along that tooth's flank, which is taken to be the uniform
-      damage's.
+      (:mod:`twin.degradation.tooth_wear`), node by node along the path: where a tooth shares the
+      force (the double-contact zones) a proud spot carries more and wears faster, so the pitch
+      errors and run-out wear in there; in the single-contact zone every tooth carries the whole
+      force, so what a tooth's c_i adds there stays and grows with the depth.  Each worn tooth's
+      field is written as its rigid part (``tooth_deviation_offset``) and the rest along the path
+      (``tooth_pit_field[(i - 1) n + k]``, added to any pit field the record has).  Pitting: one
+      number per tooth stands in for the damage's shape along that tooth's flank, which is taken
+      to be the uniform damage's.
 
     The offsets are ``tooth_deviation_offset[1..teeth]`` [m], shifted so that the least-cut tooth
     has zero (a common offset only moves the static deflection).
@@ -251,7 +262,8 @@ def tooth_errors(draw: np.random.Generator, spec, teeth: int, healthy: dict, dam
 
     Returns
     -------
-    dict: ``tooth_deviation_offset[i]`` [m] and ``tooth_stiffness_factor[i]`` [-], i = 1..teeth.
+    dict: ``tooth_deviation_offset[i]`` [m] and ``tooth_stiffness_factor[i]`` [-], i = 1..teeth;
+    for a worn record also ``tooth_pit_field[m]`` [m], m = 1..teeth x n (n: the ``k_pair`` nodes).
     """
     return pinion_parameters(draw_pinion(draw, spec, teeth), healthy, damaged, sharing)
 

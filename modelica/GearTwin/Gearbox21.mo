@@ -26,7 +26,7 @@ model Gearbox21 "21-DOF lumped model of the UNSW spur-gear test rig (Feng et al.
   parameter Real profile_deviation[n_profile](each unit = "m", each nominal = 1e-6) = fill(0.0, n_profile) "Material missing from the pinion flank (wear depth, relief) at the same nodes, common to all teeth";
   parameter Real tooth_stiffness_factor[z1] = fill(1.0, z1) "Per-pinion-tooth multiplier of the pair stiffness (crack, spall, pitting of one tooth)";
   parameter Real tooth_deviation_offset[z1](each unit = "m") = fill(0.0, z1) "Per-pinion-tooth extra material loss, added to profile_deviation";
-  parameter Real tooth_pit_field[z1 * n_profile](each unit = "m", each nominal = 1e-6) = fill(0.0, z1 * n_profile) "Equivalent material loss of pitting of each pinion tooth at the profile nodes, tooth-major: element (j - 1) * n_profile + n is tooth j at node n (pits at different places on different teeth)";
+  parameter Real tooth_pit_field[z1 * n_profile](each unit = "m", each nominal = 1e-6) = fill(0.0, z1 * n_profile) "Equivalent material loss of each pinion tooth at the profile nodes beyond the common profile, tooth-major: element (j - 1) * n_profile + n is tooth j at node n (pits at different places on different teeth; uneven wear)";
   parameter Real mesh_stiffness_scale(min = 0) = 1.0 "Calibration multiplier of all pair stiffnesses";
   parameter Real c_mesh(unit = "N.s/m", min = 0) = 1.1e3 "Mesh damping along the line of action";
   parameter Real contact_damping_width(unit = "m", min = 0) = 1e-8 "Approach over which the mesh damping engages when the flanks touch";

@@ -117,29 +117,33 @@ def test_tooth_errors_by_hand():
     # a loss the same all along the path: (1 - min(c L, 0.95)) / (1 - L); c = 6 is capped at 95 %
     np.testing.assert_allclose(factors, [1.0, 0.4 / 0.8, 0.05 / 0.8, 0.9 / 0.8])
 
-    # a worn record needs the mesh's load sharing; under it the teeth wear level, a tooth of
-    # larger wear coefficient a little recessed (by far less than (c - 1) x the mean depth)
+    # a worn record needs the mesh's load sharing; under it each tooth is worn node by node: its
+    # rigid part is the offset, the rest along the path the FMU's per-tooth field
     from twin.degradation.tooth_wear import ToothLoadSharing
     worn = {**healthy, "profile_deviation[1]": 10e-6, "profile_deviation[2]": 30e-6}  # mean 20 um
     with pytest.raises(ParameterError, match="20 um mean depth"):
         tooth_errors(_FixedDraw([0.0] * 4, [1.0, 1.5, 0.5, 1.0]), {"tooth_damage_scatter": 0.5}, teeth, healthy, worn)
     sharing = ToothLoadSharing(np.array([2e8, 2e8]), 1.6, 200.0, np.ones(2), np.zeros(2))   # 1 um deflection
-    out = tooth_errors(_FixedDraw([0.0] * 4, [1.0, 1.1, 0.9, 1.0]), {"tooth_damage_scatter": 0.1}, teeth,
-                       healthy, worn, sharing)
+    c = np.array([1.0, 1.1, 0.9, 1.0])
+    out = tooth_errors(_FixedDraw([0.0] * 4, c), {"tooth_damage_scatter": 0.1}, teeth, healthy, worn, sharing)
     worn_offsets = np.array([out[f"tooth_deviation_offset[{i}]"] for i in range(1, 5)])
+    field = np.array([out[f"tooth_pit_field[{m}]"] for m in range(1, 9)]).reshape(4, 2)
+    np.testing.assert_allclose(field.mean(axis=1), 0.0, atol=1e-18)           # the rigid part is the offset
+    expected = sharing.wear(np.zeros(4), c, 20e-6)
+    np.testing.assert_allclose(worn_offsets[:, None] + field, expected - expected.mean(axis=1).min(), atol=1e-15)
+    # the tooth of larger wear coefficient is worn deeper, by less than (c - 1) x the mean depth
     assert worn_offsets.min() == 0.0 and worn_offsets[2] == 0.0 and worn_offsets[1] == worn_offsets.max()
-    assert worn_offsets.max() < 1e-6
+    assert 0.0 < worn_offsets.max() < 0.2 * 20e-6
     assert all(out[f"tooth_stiffness_factor[{i}]"] == 1.0 for i in range(1, 5))
-    # a pinion with a proud tooth: worn in
-    proud = tooth_errors(_FixedDraw([0.0, -5.0, 0.0, 0.0], [1.0] * 4), {"pitch_error": 1e-6}, teeth, healthy, worn,
-                         sharing)
-    assert max(v for n, v in proud.items() if n.startswith("tooth_deviation_offset")) < 0.01e-6
+    # no wear coefficient scatter, no pitch errors: the teeth stay alike
+    alike = tooth_errors(_FixedDraw([0.0] * 4, [1.0] * 4), {"pitch_error": 1e-6}, teeth, healthy, worn, sharing)
+    assert max(abs(v) for n, v in alike.items() if n.startswith(("tooth_deviation_offset", "tooth_pit_field"))) < 1e-15
     # a healthy flank with an as-manufactured profile: only the wear beyond it is wear
     made = {**healthy, "profile_deviation[1]": 4e-6, "profile_deviation[2]": 8e-6}
     on_made = {**made, "profile_deviation[1]": 14e-6, "profile_deviation[2]": 38e-6}     # mean wear 20 um
     out = tooth_errors(_FixedDraw([0.0] * 4, [1.0, 1.1, 0.9, 1.0]), {"tooth_damage_scatter": 0.1}, teeth,
                        made, on_made, sharing)
-    np.testing.assert_allclose([out[f"tooth_deviation_offset[{i}]"] for i in range(1, 5)], worn_offsets, rtol=0.05)
+    np.testing.assert_allclose([out[f"tooth_deviation_offset[{i}]"] for i in range(1, 5)], worn_offsets, rtol=1e-9)
     out = tooth_errors(_FixedDraw([0.0] * 4, [1.0, 1.5, 0.5, 1.0]), {"tooth_damage_scatter": 0.5}, teeth,
                        made, made)
     assert all(out[f"tooth_deviation_offset[{i}]"] == 0.0 for i in range(1, 5))        # new flanks: no wear

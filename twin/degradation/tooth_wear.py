@@ -1,40 +1,41 @@
-"""Wear from tooth to tooth: Archard's law under the mesh's load sharing levels the pinion's teeth.
+"""Wear from tooth to tooth: Archard's law under the mesh's load sharing, along each tooth's flank.
 
 A pinion's teeth do not start alike (pitch deviations, run-out) and do not wear alike (hardness
 and roughness scatter: a wear coefficient factor c_j per tooth).  The deviations that remain
 decide the shaft-order sidebands of a worn gearbox.  Spreading the mean depth over the teeth by
 c_j alone (tooth j worn c_j times the mean; the archive's rule before 2026-11-28) lets the
-tooth-to-tooth differences grow in proportion to the depth, to tens of um at 200 um of wear,
-far beyond the mesh's elastic deflection, and ignores what decides how hard each tooth is
-pressed: its neighbours.
+tooth-to-tooth differences grow in proportion to the depth and ignores what decides how hard each
+tooth is pressed: its neighbours.
 
 Under the FMU's pair law (``pair_force = k_pair(xi) max(0, delta - deviation)`` for each pair in
 contact at the common approach delta) a tooth that stands proud of its neighbours by more than the
-static deflection delta_s = W / k carries the whole mesh force W in both double-contact zones of
-its engagement, one that is recessed carries it only in its single-contact zone.  By Archard the
-volume a tooth loses per engagement is K x (force x sliding distance), i.e. proportional to
+static deflection delta_s = W / k carries the whole mesh force W in the double-contact zones of
+its engagement, one that is recessed carries less there.  By Archard the depth a flank point loses
+in one engagement is K x contact pressure x sliding distance; the contact band 2b passes the
+point at the pinion flank's rolling speed v1 while the flanks slide at v_s, so per engagement
 
-    R_j = c_j  integral over its engagement of  F_j(xi) v_s(xi) dxi                    (1)
+    dh_j(xi) = K c_j  F_j(xi) / L  x  v_s(xi) / v1(xi)  (x a constant)                   (1)
 
-with v_s the sliding speed (zero at the pitch point) and xi the roll position along the path of
-contact.  So a proud tooth wears faster than the mean, a recessed one slower, and the differences
-shrink: at contact ratio eps a deviation far outside the elastic band closes at up to (eps - 1)
-per unit of mean depth, and inside it relaxes over a depth of the order of delta_s (0.2-1 um
-here).  Once levelled, the teeth stand where every tooth wears at the mean rate: a tooth of
-higher c_j a little recessed, c_j R_j equal for all j, deviations a fraction of delta_s.
-Running-in thereby removes the pitch errors and run-out of the pinion (the conformity of worn
-gears; e.g. Flodin & Andersson, Wear 207, 1997, who compute the same feedback on a single
-profile).
+with F_j(xi) the force on tooth j when its contact is at roll position xi along the path and
+v_s / v1 the pinion's slide-to-roll ratio (zero at the pitch point, largest at the pinion root).
+In the **single-contact zone** F_j = W whatever the tooth's offset: there nothing levels, and a
+tooth of c_j > 1 loses (c_j - 1) x the local depth more than the mean tooth, for ever.  In the
+**double-contact zones** the share decides: a proud spot carries more and wears faster, a recessed
+one less.  So rigid differences (pitch errors, run-out) wear in, while differences of wear
+coefficient reshape each tooth's flank: deeper in its single zone, shallower at its ends, a
+transmission error from tooth to tooth that grows with the depth.  (Before 2026-11-28 a tooth was
+one rigid offset, its rate the mean of (1) over the engagement; that levelled every difference,
+because the single zone's share of the volume was met by a shift of the whole tooth.)
 
 :class:`ToothLoadSharing` solves the quasi-static load sharing of one pinion revolution (every
-mesh position, all pairs in contact, each with the common worn profile and its tooth's offset)
-and integrates the per-tooth mean depths of (1) over the mean depth in steps of delta_s / 2.
-Once every tooth wears at the mean rate (within :data:`EQUAL_RATES`) further depth moves the
-teeth together, which changes no difference, and the integration stops.  A deviation smooth over
-the revolution (run-out) levels slowest, as only neighbouring teeth share load: on the rig's 19/52
-pair from 8 um of run-out and 2 um pitch errors, the teeth are level to 0.13 um sd after about
-60 um of wear at 5 N.m, to 0.5 um after about 150 um at 20 N.m.  Left out: the gear's (wheel's) tooth-to-tooth wear, the change of the pair stiffness and
-of the load along the history (the record's are used throughout), dynamic load.
+mesh position, all pairs in contact, each with the common worn profile plus its tooth's own field)
+and integrates each tooth's field at the ``k_pair`` nodes by (1), minus the mean tooth's, in steps
+of the mean depth small against delta_s, keeping the teeth's mean shape the common profile's (the
+degradation run's).  On the rig's 19/52 pair at 5 N.m, from 8 um of run-out and 2 um pitch errors,
+the teeth's mean offsets are level to a fraction of delta_s after about 60 um of wear.  Left out:
+the gear's (wheel's) tooth-to-tooth wear (52 teeth meet every pinion tooth: a hunting ratio), the
+change of the pair stiffness and of the load along the history (the record's are used
+throughout), dynamic load, the Hertz band's smoothing (2b is 3-5 % of a node interval here).
 """
 from __future__ import annotations
 
@@ -46,13 +47,10 @@ import numpy as np
 from twin.degradation._nodes import interp_nodes, node_xi
 from twin.errors import ParameterError
 
-#: Integration step of the mean depth as a fraction of the static deflection W / k.  The explicit
-#: steps are stable up to about 1 (unstable at 2); 0.5 stays within 12 nm of 0.25 on the rig's
-#: pair at 5 and 20 N.m (offsets of 60-1400 nm), at half the cost.
-STEP_FRACTION = 0.5
-#: Spread of the teeth's relative wear rates below which they are taken to wear alike: the
-#: remaining spread decays over a few um of depth, so it moves the teeth by some nm more.
-EQUAL_RATES = 1e-3
+#: Integration step of the fastest node's depth as a fraction of the static deflection W / k.
+#: On the rig's pair (60 um of wear, c_j sd 0.1, 5 and 20 N.m) 1 stays within 2 nm of 0.125;
+#: 2 is unstable (0.4-1.4 um off).
+STEP_FRACTION = 1.0
 #: Mesh positions per base pitch in the load-sharing sum of one revolution.
 SAMPLES_PER_PITCH = 32
 #: Largest number of integration steps (a guard; the defaults need a few hundred).
@@ -80,7 +78,8 @@ class ToothLoadSharing:
     mesh_force : float
         Transmitted normal mesh force W [N] (brake torque / gear base radius), > 0.
     sliding : ndarray (n,)
-        Sliding speed along the path at the same nodes [any unit; only its shape matters], >= 0.
+        Sliding per unit of the pinion flank's rolling, v_s / v1, at the same nodes [-; only its
+        shape matters], >= 0: the depth a pass wears per unit force (1).
     profile : ndarray (n,)
         Material missing along the path common to all teeth [m] (the worn ``profile_deviation``),
         or all zeros.
@@ -113,9 +112,9 @@ class ToothLoadSharing:
 
     @classmethod
     def for_gears(cls, geometry, k_pair, mesh_force: float, profile=None) -> "ToothLoadSharing":
-        """From a :class:`~twin.degradation.geometry.GearPair`: its contact ratio and sliding speed."""
+        """From a :class:`~twin.degradation.geometry.GearPair`: its contact ratio and slide-to-roll ratio."""
         k = np.asarray(k_pair, dtype=float).ravel()
-        sliding = geometry.sliding_speed(node_xi(k.size), 1.0)
+        sliding = geometry.slide_to_roll_ratio(node_xi(k.size))
         return cls(k, geometry.contact_ratio, mesh_force, sliding,
                    np.zeros(k.size) if profile is None else np.asarray(profile, dtype=float))
 
@@ -127,56 +126,86 @@ class ToothLoadSharing:
     def _mesh(self, teeth: int):
         """What does not change as the teeth wear, at the pairs of P mesh positions, each (P, 3):
         the tooth index, the pair stiffness (0 out of mesh), the common profile there (inf out of
-        mesh) and the sliding speed."""
+        mesh), the sliding (1), the lower node of the contact point and its hat weight there."""
         phi = np.arange(teeth * SAMPLES_PER_PITCH) / SAMPLES_PER_PITCH + 0.5 / SAMPLES_PER_PITCH
         base = np.floor(phi).astype(int)
         tooth = (base[:, None] - np.arange(3)[None, :]) % teeth        # the tooth that entered last first
         travel = (phi - base)[:, None] + np.arange(3)[None, :]           # pitches since each entered
         engaged = travel < self.contact_ratio
         xi = np.clip(travel / self.contact_ratio, 0.0, 1.0)
+        n = self.k_pair.size
+        lower = np.minimum(np.floor(xi * (n - 1)).astype(int), n - 2)
+        weight = 1.0 - (xi * (n - 1) - lower)                            # of the lower node
         return (tooth, np.where(engaged, interp_nodes(self.k_pair, xi), 0.0),
-                np.where(engaged, interp_nodes(self.profile, xi), np.inf), interp_nodes(self.sliding, xi))
+                np.where(engaged, interp_nodes(self.profile, xi), np.inf), interp_nodes(self.sliding, xi),
+                lower, weight)
 
-    def wear_rates(self, offsets, wear_factors) -> np.ndarray:
-        """(z,) relative mean wear rate of each tooth, Eq. (1) normalised to mean 1.
+    def node_rates(self, field, wear_factors) -> np.ndarray:
+        """(z, n) depth each tooth loses per engagement at each node, Eq. (1), relative to the mean
+        over teeth and nodes of a pinion with identical teeth (c_j = 1, no field).
 
-        ``offsets`` (z,) [m]: each tooth's extra material loss (positive = recessed);
-        ``wear_factors`` (z,) [-]: c_j, > 0.
+        ``field`` (z, n) [m]: each tooth's material loss beyond the common profile at the nodes
+        (positive = recessed), or (z,) rigid offsets; ``wear_factors`` (z,) [-]: c_j, > 0.
         """
-        e = np.asarray(offsets, dtype=float)
-        return self._rates(e, np.asarray(wear_factors, dtype=float), self._mesh(e.size))
+        f, c = self._field(field), np.asarray(wear_factors, dtype=float).ravel()
+        mesh = self._mesh(f.shape[0])
+        return self._node_rates(f, c, mesh) / self._reference(mesh).mean()
 
-    def _rates(self, e: np.ndarray, c: np.ndarray, mesh) -> np.ndarray:
-        tooth, k, profile, sliding = mesh
-        force = _share(k, e[tooth] + profile, self.mesh_force)
-        rate = c * np.bincount(tooth.ravel(), weights=(force * sliding).ravel(), minlength=e.size)
-        mean = float(rate.mean())
-        if mean <= 0:
+    def _field(self, field) -> np.ndarray:
+        f = np.asarray(field, dtype=float)
+        if f.ndim == 1:
+            f = np.repeat(f[:, None], self.k_pair.size, axis=1)
+        return f
+
+    def _node_rates(self, field: np.ndarray, c: np.ndarray, mesh) -> np.ndarray:
+        tooth, k, profile, sliding, lower, weight = mesh
+        z, n = field.shape
+        own = field[tooth, lower] * weight + field[tooth, lower + 1] * (1.0 - weight)
+        work = c[tooth] * _share(k, own + profile, self.mesh_force) * sliding
+        cell = (tooth * n + lower).ravel()
+        acc = (np.bincount(cell, weights=(work * weight).ravel(), minlength=z * n)
+               + np.bincount(cell + 1, weights=(work * (1.0 - weight)).ravel(), minlength=z * n))
+        hats = (np.bincount(cell, weights=np.where(np.isfinite(profile), weight, 0.0).ravel(), minlength=z * n)
+                + np.bincount(cell + 1, weights=np.where(np.isfinite(profile), 1.0 - weight, 0.0).ravel(),
+                              minlength=z * n))
+        return (acc / np.maximum(hats, 1e-300)).reshape(z, n)      # a local mean of (1) at each node
+
+    def _reference(self, mesh) -> np.ndarray:
+        """(n,) the identical teeth's depth per engagement at the nodes, Eq. (1)."""
+        z = mesh[0].max() + 1
+        ref = self._node_rates(np.zeros((z, self.k_pair.size)), np.ones(z), mesh).mean(axis=0)
+        if float(ref.mean()) <= 0:
             raise ParameterError("no tooth slides under load along this path of contact (sliding is zero)")
-        return rate / mean
+        return ref
 
-    def level(self, offsets, wear_factors, mean_depth: float) -> np.ndarray:
-        """(z,) tooth offsets [m] after ``mean_depth`` [m] of mean wear, shifted to a least-cut
-        tooth at zero (a common offset only moves the static deflection).
+    def wear(self, offsets, wear_factors, mean_depth: float) -> np.ndarray:
+        """(z, n) each tooth's material loss beyond the common profile [m] at the ``k_pair`` nodes
+        after ``mean_depth`` [m] of mean wear (the mean over the nodes of the common profile's
+        depth), shifted to a least-cut point at zero (a common offset only moves the static
+        deflection).
 
-        ``offsets`` (z,) [m]: the teeth before the wear (pitch deviations, run-out);
-        ``wear_factors`` (z,) [-]: c_j, > 0, each tooth's wear coefficient over the mean's.
+        ``offsets`` (z,) [m]: the teeth before the wear (pitch deviations, run-out), or (z, n)
+        fields; ``wear_factors`` (z,) [-]: c_j, > 0, each tooth's wear coefficient over the mean's.
+        The teeth's mean shape stays the common profile's: only differences from tooth to tooth
+        are integrated.
         """
-        e = np.asarray(offsets, dtype=float).ravel().copy()
+        e = self._field(offsets).copy()
         c = np.asarray(wear_factors, dtype=float).ravel()
-        if c.shape != e.shape or not np.all(np.isfinite(e)) or not (np.all(np.isfinite(c)) and np.all(c > 0)):
+        if (e.ndim != 2 or e.shape != (c.size, self.k_pair.size) or not np.all(np.isfinite(e))
+                or not (np.all(np.isfinite(c)) and np.all(c > 0))):
             raise ParameterError(f"offsets and wear_factors need one finite value per tooth (factors > 0), "
-                                 f"got {e.size} and {c.size}")
+                                 f"got {np.asarray(offsets).shape} and {c.size}")
         depth = float(mean_depth)
         if not (math.isfinite(depth) and depth >= 0):
             raise ParameterError(f"mean_depth must be a finite depth >= 0 m, got {mean_depth!r}")
-        steps = min(MAX_STEPS, math.ceil(depth / (STEP_FRACTION * self.static_deflection)))
-        mesh = self._mesh(e.size)
+        mesh = self._mesh(c.size)
+        ref = self._reference(mesh)
+        norm = float(ref.mean())
+        # the fastest node moves ref.max() / norm times the mean: its step stays STEP_FRACTION of delta_s
+        steps = min(MAX_STEPS, math.ceil(depth * float(ref.max()) / norm / (STEP_FRACTION * self.static_deflection)))
         for _ in range(steps):
-            rate = self._rates(e, c, mesh)
-            if float(np.ptp(rate)) < EQUAL_RATES:
-                break                       # level: the rest of the depth moves every tooth alike
-            e += (depth / steps) * rate
+            grow = (self._node_rates(e, c, mesh) - ref) / norm
+            e += (depth / steps) * (grow - grow.mean(axis=0))
         return e - e.min()
 
 

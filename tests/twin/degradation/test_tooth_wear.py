@@ -32,58 +32,75 @@ def test_load_sharing_by_hand():
     np.testing.assert_allclose(f.sum(axis=1), 4.0)
 
 
-def test_a_proud_tooth_wears_faster_and_the_mean_rate_is_one():
+MID = 5          # xi = 0.5: its hat [0.4, 0.6] lies inside the single-contact zone [0.395, 0.605]
+
+
+def test_a_proud_tooth_wears_faster_where_it_shares_and_alike_where_it_is_alone():
     sh = _sharing()
+    ref = sh.node_rates(np.zeros(19), np.ones(19))        # identical teeth
+    assert ref.mean() == pytest.approx(1.0)
+    np.testing.assert_allclose(ref, ref[0][None, :].repeat(19, axis=0), rtol=1e-12)
+    assert ref[0, 0] > 3 * ref[0, MID]                   # the pinion root slides most, the pitch point least
     e = np.zeros(19)
-    np.testing.assert_allclose(sh.wear_rates(e, np.ones(19)), 1.0, atol=1e-12)
     e[4] = -1e-6          # proud by ~4 static deflections
     e[9] = 1e-6           # recessed as much
-    r = sh.wear_rates(e, np.ones(19))
-    assert r.mean() == pytest.approx(1.0)
-    assert r[4] > 1.3 and r[9] < 0.7
-    # a tooth whose material wears twice as fast, at equal offsets, wears twice the others
+    r = sh.node_rates(e, np.ones(19))
+    assert r[4, 0] > 1.3 * ref[0, 0] and r[9, 0] < 0.7 * ref[0, 0]            # at the root: shared
+    assert r[4, MID] == pytest.approx(ref[0, MID]) and r[9, MID] == pytest.approx(ref[0, MID])   # alone
+    # a tooth whose material wears twice as fast, at equal offsets, wears twice as deep everywhere
     c = np.ones(19)
     c[2] = 2.0
-    r = sh.wear_rates(np.zeros(19), c)
-    assert r[2] / r[0] == pytest.approx(2.0)
+    np.testing.assert_allclose(sh.node_rates(np.zeros(19), c)[2], 2 * ref[0], rtol=1e-12)
 
 
-def test_wear_levels_the_teeth_to_a_fraction_of_the_static_deflection():
+def test_pitch_errors_wear_in_where_teeth_share_and_stay_where_one_carries_all():
     sh = _sharing()
-    offsets, factors = _rig_pinion()
-    band = sh.static_deflection
-    assert 0.2e-6 < band < 0.4e-6                    # 5 N.m on the rig's pair
-    sd = [np.std(sh.level(offsets, factors, d)) for d in (0.0, 5e-6, 20e-6, 60e-6, 240e-6)]
-    assert sd[0] == pytest.approx(np.std(offsets))
-    assert all(a > b for a, b in zip(sd[:3], sd[1:4]))  # the spread falls as the teeth wear in
-    assert sd[3] < band and sd[4] == pytest.approx(sd[3], rel=1e-2)   # then stays: all wear alike
-    level = sh.level(offsets, factors, 240e-6)
-    np.testing.assert_allclose(sh.wear_rates(level, factors), 1.0, atol=1e-3)
-    assert level.min() == 0.0
-    # the tooth of largest wear coefficient stands recessed, the smallest proud
-    assert level[np.argmax(factors)] > level[np.argmin(factors)]
-    # identical material: the teeth end level
-    assert np.ptp(sh.level(offsets, np.ones(19), 240e-6)) < 0.05 * band
+    offsets, _ = _rig_pinion()
+    worn = sh.wear(offsets, np.ones(19), 60e-6)
+    # the single-contact zone keeps the teeth's differences: every tooth carries the whole force there
+    mid = worn[:, MID] - worn[:, MID].mean()
+    np.testing.assert_allclose(mid, offsets - offsets.mean(), atol=0.02 * np.ptp(offsets))
+    # once worn in, every tooth wears like the identical teeth at every node: nothing more changes
+    ref = sh.node_rates(np.zeros(19), np.ones(19))[0]
+    np.testing.assert_allclose(sh.node_rates(worn, np.ones(19)), ref[None, :].repeat(19, axis=0),
+                               atol=0.01 * ref.max())
+    np.testing.assert_allclose(sh.wear(offsets, np.ones(19), 240e-6)[:, MID] - sh.wear(offsets, np.ones(19), 240e-6)[:, MID].mean(),
+                               mid, atol=0.02 * np.ptp(offsets))
+    assert worn.min() == 0.0
+    # identical teeth of identical material stay alike at any depth
+    assert np.ptp(sh.wear(np.zeros(19), np.ones(19), 240e-6)) < 1e-15
 
 
-def test_levelling_converges_with_the_step(monkeypatch):
+def test_a_wear_coefficient_above_the_mean_digs_the_single_contact_zone_by_hand():
+    sh = _sharing()
+    c = np.ones(19)
+    c[3] = 1.2
+    ref = sh.node_rates(np.zeros(19), np.ones(19))[0]    # depth per unit mean depth at each node
+    for depth in (20e-6, 80e-6):
+        worn = sh.wear(np.zeros(19), c, depth)
+        # alone in its single zone, tooth 4 loses 0.2 x the local depth more than the others
+        assert worn[3, MID] - worn[0, MID] == pytest.approx(0.2 * depth * ref[MID], rel=1e-9)
+        # where it shares, its neighbours take the load off it: less than 0.2 x the local depth
+        assert worn[3, 0] - worn[0, 0] < 0.2 * depth * ref[0]
+
+
+def test_wear_converges_with_the_step(monkeypatch):
     import twin.degradation.tooth_wear as tw
     sh = _sharing(20.0)
     offsets, factors = _rig_pinion(1)
-    coarse = sh.level(offsets, factors, 30e-6)
+    coarse = sh.wear(offsets, factors, 30e-6)
     monkeypatch.setattr(tw, "STEP_FRACTION", tw.STEP_FRACTION / 4)
-    fine = sh.level(offsets, factors, 30e-6)
-    assert np.max(np.abs(coarse - fine)) < 0.02 * np.ptp(fine)
+    fine = sh.wear(offsets, factors, 30e-6)
+    assert np.max(np.abs(coarse - fine)) < 0.01 * np.ptp(fine)
 
 
 def test_the_worn_profile_enters_the_sharing():
-    # a profile relieved at both ends (tip and root relief) moves load into the single-pair zone,
-    # where the sliding is small: the proud tooth's extra wear is smaller
+    # a profile relieved at both ends (tip and root relief) moves load off the double-contact
+    # ends into the single-pair zone: less wear there against the middle
     relief = 2e-6 * np.abs(np.linspace(-1, 1, 11)) ** 2
-    e = np.zeros(19)
-    e[4] = -1e-6
-    plain, relieved = _sharing().wear_rates(e, np.ones(19)), _sharing(profile=relief).wear_rates(e, np.ones(19))
-    assert relieved[4] < plain[4]
+    plain = _sharing().node_rates(np.zeros(19), np.ones(19))[0]
+    relieved = _sharing(profile=relief).node_rates(np.zeros(19), np.ones(19))[0]
+    assert relieved[1] / relieved[MID] < 0.5 * plain[1] / plain[MID]
 
 
 @pytest.mark.parametrize("field, value, match", [
@@ -100,8 +117,10 @@ def test_bad_mesh_is_refused_by_name(field, value, match):
 def test_bad_teeth_are_refused():
     sh = _sharing()
     with pytest.raises(ParameterError, match="mean_depth"):
-        sh.level(np.zeros(19), np.ones(19), -1e-6)
+        sh.wear(np.zeros(19), np.ones(19), -1e-6)
     with pytest.raises(ParameterError, match="one finite value per tooth"):
-        sh.level(np.zeros(19), np.ones(18), 1e-6)
+        sh.wear(np.zeros(19), np.ones(18), 1e-6)
     with pytest.raises(ParameterError, match="one finite value per tooth"):
-        sh.level(np.zeros(19), np.zeros(19), 1e-6)
+        sh.wear(np.zeros(19), np.zeros(19), 1e-6)
+    with pytest.raises(ParameterError, match="one finite value per tooth"):
+        sh.wear(np.zeros((19, 7)), np.ones(19), 1e-6)
