@@ -124,3 +124,7 @@ def test_bad_teeth_are_refused():
         sh.wear(np.zeros(19), np.zeros(19), 1e-6)
     with pytest.raises(ParameterError, match="one finite value per tooth"):
         sh.wear(np.zeros((19, 7)), np.ones(19), 1e-6)
+    with pytest.raises(ParameterError, match="one finite value per tooth"):
+        sh.wear(0.0, np.ones(19), 1e-6)
+    with pytest.raises(ParameterError, match="too deep for this load"):
+        sh.wear(np.zeros(19), np.ones(19), 1.0)
