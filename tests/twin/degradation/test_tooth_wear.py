@@ -128,3 +128,34 @@ def test_bad_teeth_are_refused():
         sh.wear(0.0, np.ones(19), 1e-6)
     with pytest.raises(ParameterError, match="too deep for this load"):
         sh.wear(np.zeros(19), np.ones(19), 1.0)
+
+
+def test_the_two_pair_share_is_the_general_one():
+    from twin.degradation.tooth_wear import _share_two
+    rng = np.random.default_rng(0)
+    dev = rng.normal(0.0, 1e-6, (4000, 2))
+    dev[rng.random(4000) < 0.3, 1] = np.inf                     # one pair in mesh
+    alone = rng.random(4000) < 0.2
+    dev[alone, 0] = np.inf
+    dev[alone, 1] = rng.normal(0.0, 1e-6, alone.sum())
+    k = np.where(np.isfinite(dev), rng.uniform(1e8, 3e8, (4000, 2)), 0.0)
+    np.testing.assert_allclose(_share_two(k, dev, 300.0), _share(k, dev, 300.0), atol=1e-9)
+
+
+def test_the_compiled_integration_is_the_numpy_one():
+    import math
+
+    import twin.degradation.tooth_wear as tw
+    sh = _sharing()
+    offsets, factors = _rig_pinion(2)
+    got = sh.wear(offsets, factors, 20e-6)
+    mesh = sh._mesh(19)
+    ref = sh._reference(mesh)
+    norm = ref.mean()
+    e = np.repeat(offsets[:, None], 11, axis=1)
+    steps = math.ceil(20e-6 * factors.max() * sh.mesh_force * sh.sliding.max() / norm
+                      / (tw.STEP_FRACTION * sh.static_deflection))
+    for _ in range(steps):
+        grow = (sh._node_rates(e, factors, mesh) - ref) / norm
+        e += (20e-6 / steps) * (grow - grow.mean(axis=0))
+    np.testing.assert_allclose(got, e - e.min(), atol=1e-15)
