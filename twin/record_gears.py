@@ -273,10 +273,15 @@ GEAR_ARRAYS = ("tooth_deviation_offset", "tooth_stiffness_factor")
 
 def gear_attributes(pinion: PinionDraw, parameters: dict, teeth: int) -> dict:
     """A record's ``gear_*`` attributes: the drawn magnitudes and the (teeth,) arrays set in the FMU
-    (``gear_tooth_deviation_offset`` [m], ``gear_tooth_stiffness_factor`` [-])."""
+    (``gear_tooth_deviation_offset`` [m], ``gear_tooth_stiffness_factor`` [-]); for a worn record
+    also each tooth's own worn flank beyond its rigid part, ``gear_tooth_flank_field`` (teeth, n) [m]
+    at the ``k_pair`` nodes (what :func:`pinion_parameters` wrote to ``tooth_pit_field``)."""
     out = pinion.attributes()
     for name in GEAR_ARRAYS:
         out[f"gear_{name}"] = np.array([parameters[f"{name}[{i}]"] for i in range(1, teeth + 1)])
+    field = _profile(parameters, "tooth_pit_field")
+    if field.size:
+        out["gear_tooth_flank_field"] = field.reshape(teeth, -1)
     return out
 
 

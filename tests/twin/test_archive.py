@@ -362,3 +362,24 @@ def test_bad_tooth_error_bounds_set_in_code_are_named_before_any_simulation(tmp_
         build_archive(sc.with_overrides(archive=arc), out, fmu_path=gearbox_fmu, progress=False)
     assert "archive.wheel_pitch_error" in str(err.value)
     assert out.read_bytes() == b"kept"
+
+
+def test_a_worn_archive_records_each_tooths_own_flank(gearbox_fmu, tmp_path):
+    sc = load_scenario(REPO / "scenarios" / "dry.yaml")
+    deg = {**sc.degradation, "stop": {"wear_depth": 4.5e-5}, "record_duration": 0.0}
+    arc = {**sc.archive, "stages": [0.0, 2e-5, 4e-5], "records_per_stage": 2, "record_duration": 0.01,
+           "settle_time": 0.01, "damage_sampling": "snapshot"}
+    sc = sc.with_overrides(degradation=deg, archive=arc, executor={"type": "local", "workers": 1})
+    a = build_archive(sc, tmp_path / "w.h5", fmu_path=gearbox_fmu, progress=False)
+    back = read_archive(tmp_path / "w.h5")
+    worn = [(d, g) for d, g in zip(a.damage, a.gears) if d > 0]
+    assert worn and all(g["gear_tooth_flank_field"].shape == (19, 11) for _, g in worn)
+    for (_, g), h in zip(worn, [g for d, g in zip(back.damage, back.gears) if d > 0]):
+        field = g["gear_tooth_flank_field"]
+        np.testing.assert_allclose(field.mean(axis=1), 0.0, atol=1e-15)        # the rigid part is the offset
+        assert np.ptp(field) > 0.1e-6          # drawn pitch errors and wear rates: the teeth differ along the path
+        np.testing.assert_array_equal(h["gear_tooth_flank_field"], field)
+    assert all("gear_tooth_flank_field" not in g for d, g in zip(a.damage, a.gears) if d == 0)
+    from twin.measurements import load_measurements
+    meta = [r.metadata for r in load_measurements(tmp_path / "w.h5")]
+    assert any(np.shape(m.get("gear_tooth_flank_field")) == (19, 11) for m in meta)
