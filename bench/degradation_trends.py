@@ -100,15 +100,13 @@ def worn_in(manufacturing: dict, run, stage, load: float) -> dict:
     pinion, twin.archive.load_sharing): each tooth's rigid part and its flank along the path
     (``tooth_pit_field``); unchanged at zero depth or for a pitting run."""
     from twin.archive import load_sharing
+    from twin.record_gears import tooth_field_parameters
     sharing = load_sharing(run, stage.parameters, load)
     if sharing is None or stage.damage <= 0:
         return manufacturing
     teeth = len(manufacturing)
     offsets = np.array([manufacturing[f"tooth_deviation_offset[{k + 1}]"] for k in range(teeth)])
-    field = sharing.wear(offsets, np.ones(teeth), stage.damage)             # (teeth, nodes)
-    rigid = field.mean(axis=1)
-    return {**{f"tooth_deviation_offset[{k + 1}]": float(v) for k, v in enumerate(rigid - rigid.min())},
-            **{f"tooth_pit_field[{m + 1}]": float(v) for m, v in enumerate((field - rigid[:, None]).ravel())}}
+    return tooth_field_parameters(sharing.wear(offsets, np.ones(teeth), stage.damage))
 
 
 # ---- build -----------------------------------------------------------------------------------

@@ -197,23 +197,30 @@ def pinion_parameters(pinion: PinionDraw, healthy: dict, damaged: dict, sharing=
     if as_made.size == depth.size:
         depth = depth - as_made      # the wear alone, not the flanks' as-manufactured profile (mesh_form)
     mean_depth = float(depth.mean()) if depth.size else 0.0
-    shape = None
     if mean_depth > 0:
         if sharing is None:
             raise ParameterError(f"a worn record ({1e6 * mean_depth:.3g} um mean depth) needs the mesh's load "
                                  "sharing (sharing=ToothLoadSharing) to wear its teeth")
         # a gamma draw can come out near zero: no tooth is wear-free, the floor keeps the rates finite
         field = sharing.wear(offset, np.clip(c, 0.05, None), mean_depth)
-        offset = field.mean(axis=1)                 # each tooth's rigid part ...
-        shape = field - offset[:, None]             # ... and its own flank along the path
-    offset = offset - offset.min()
-    out = {f"tooth_deviation_offset[{i + 1}]": float(v) for i, v in enumerate(offset)}
+        out = tooth_field_parameters(field, _profile(damaged, "tooth_pit_field"))
+    else:
+        out = {f"tooth_deviation_offset[{i + 1}]": float(v) for i, v in enumerate(offset - offset.min())}
     out.update({f"tooth_stiffness_factor[{i + 1}]": float(v) for i, v in enumerate(factor)})
-    if shape is not None:
-        # the FMU's per-tooth field along the path (tooth-major), on top of any the record already has
-        pits = _profile(damaged, "tooth_pit_field")
-        flat = shape.ravel() + (pits if pits.size == shape.size else 0.0)
-        out.update({f"tooth_pit_field[{i + 1}]": float(v) for i, v in enumerate(flat)})
+    return out
+
+
+def tooth_field_parameters(field: np.ndarray, pits: np.ndarray | None = None) -> dict[str, float]:
+    """The FMU parameters of worn teeth (``ToothLoadSharing.wear``'s (z, n) field [m]): each tooth's
+    rigid part ``tooth_deviation_offset[1..z]`` (its mean over the nodes, least-cut tooth at zero) and
+    the rest along the path ``tooth_pit_field[1..z n]`` (tooth-major), plus ``pits`` (z n,) [m] when
+    the record already has a pit field of that size."""
+    rigid = field.mean(axis=1)
+    flat = (field - rigid[:, None]).ravel()
+    if pits is not None and np.size(pits) == flat.size:
+        flat = flat + pits
+    out = {f"tooth_deviation_offset[{i + 1}]": float(v) for i, v in enumerate(rigid - rigid.min())}
+    out.update({f"tooth_pit_field[{m + 1}]": float(v) for m, v in enumerate(flat)})
     return out
 
 
