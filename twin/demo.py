@@ -292,10 +292,12 @@ def _wear_in_line() -> str:
     sharing = ToothLoadSharing.for_gears(gears, HEALTHY_K_PAIR, 5.0 / gears.base_radius_gear)
     rng = np.random.default_rng(0)
     teeth = 2e-6 * rng.standard_normal(gears.z1) + runout_deviation(10e-6, 1.0, gears.z1)
-    mid = HEALTHY_K_PAIR.__len__() // 2                                  # the single-contact zone
-    alike = [1e6 * np.ptp(sharing.wear(teeth, np.ones(gears.z1), d)[:, mid]) for d in (0.0, 60e-6)]
+    mid = len(HEALTHY_K_PAIR) // 2                                       # the single-contact zone
+    alike = [1e6 * np.ptp(teeth), 1e6 * np.ptp(sharing.wear(teeth, np.ones(gears.z1), 60e-6)[:, mid])]
     factors = rng.gamma(100.0, 0.01, gears.z1)                           # wear coefficients, sd 0.1
-    apart = [1e6 * np.ptp(sharing.wear(teeth, factors, d)[:, mid]) for d in (60e-6, 240e-6)]
+    at_60 = sharing.wear(teeth, factors, 60e-6)
+    at_240 = sharing.wear(at_60, factors, 180e-6)                        # the next 180 um from there
+    apart = [1e6 * np.ptp(at_60[:, mid]), 1e6 * np.ptp(at_240[:, mid])]
     return ("Dry wear tooth by tooth (twin.degradation.tooth_wear, 5 N.m): where one tooth carries the whole "
             f"force nothing levels, so a pinion's pitch errors (2 um) and run-out (10 um) stay {alike[0]:.2f} -> "
             f"{alike[1]:.2f} um apart there after 60 um of mean wear; wear coefficients 10 % apart spread them to "

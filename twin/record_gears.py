@@ -213,12 +213,15 @@ def pinion_parameters(pinion: PinionDraw, healthy: dict, damaged: dict, sharing=
 def tooth_field_parameters(field: np.ndarray, pits: np.ndarray | None = None) -> dict[str, float]:
     """The FMU parameters of worn teeth (``ToothLoadSharing.wear``'s (z, n) field [m]): each tooth's
     rigid part ``tooth_deviation_offset[1..z]`` (its mean over the nodes, least-cut tooth at zero) and
-    the rest along the path ``tooth_pit_field[1..z n]`` (tooth-major), plus ``pits`` (z n,) [m] when
-    the record already has a pit field of that size."""
+    the rest along the path ``tooth_pit_field[1..z n]`` (tooth-major), plus ``pits`` (z n,) [m], the
+    pit field the record already has (none: empty or None)."""
     rigid = field.mean(axis=1)
     flat = (field - rigid[:, None]).ravel()
-    if pits is not None and np.size(pits) == flat.size:
-        flat = flat + pits
+    if pits is not None and np.size(pits):
+        if np.size(pits) != flat.size:
+            raise ParameterError(f"tooth_pit_field has {np.size(pits)} values where the worn teeth need "
+                                 f"{flat.size} ({field.shape[0]} teeth x {field.shape[1]} nodes)")
+        flat = flat + np.asarray(pits, dtype=float)
     out = {f"tooth_deviation_offset[{i + 1}]": float(v) for i, v in enumerate(rigid - rigid.min())}
     out.update({f"tooth_pit_field[{m + 1}]": float(v) for m, v in enumerate(flat)})
     return out

@@ -383,3 +383,12 @@ def test_a_worn_archive_records_each_tooths_own_flank(gearbox_fmu, tmp_path):
     from twin.measurements import load_measurements
     meta = [r.metadata for r in load_measurements(tmp_path / "w.h5")]
     assert any(np.shape(m.get("gear_tooth_flank_field")) == (19, 11) for m in meta)
+
+
+def test_worn_teeth_refuse_a_pit_field_of_another_size():
+    from twin.record_gears import tooth_field_parameters
+    field = np.arange(8.0).reshape(4, 2) * 1e-6
+    out = tooth_field_parameters(field, np.full(8, 1e-6))
+    assert out["tooth_pit_field[1]"] == pytest.approx(-0.5e-6 + 1e-6)
+    with pytest.raises(ParameterError, match="tooth_pit_field has 6 values where the worn teeth need 8"):
+        tooth_field_parameters(field, np.zeros(6))
