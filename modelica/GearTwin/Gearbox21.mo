@@ -198,7 +198,7 @@ model Gearbox21 "21-DOF lumped model of the UNSW spur-gear test rig (Feng et al.
   parameter Real effect_tooth_offset[z1](each unit = "m") = fill(0.0, z1) "Per-pinion-tooth material loss from an effect (spall); added to tooth_deviation_offset";
   parameter Real effect_profile_deviation[n_profile](each unit = "m") = fill(0.0, n_profile) "Material missing along the profile from an effect (distributed wear); added to profile_deviation";
   Real effect_pair_deviation[3](each unit = "m") = {0, 0, 0} "Extra material loss at the contact of each pair (leading, current, next): the gear's tooth errors (GearTwin.Variants.Gearbox21WheelErrors); added to pair_deviation";
-  Real effect_mesh_displacement(unit = "m") = 0 "Extra approach of the flanks along the line of action (run-out)";
+  Real effect_mesh_displacement(unit = "m") = 0 "Rigid move of a gear along the line of action (run-out): extra approach of the flanks, and contact starting that much earlier along the path";
   Real effect_mesh_displacement_rate(unit = "m/s") = 0 "Time derivative of effect_mesh_displacement";
   Real effect_mesh_force(unit = "N") = 0 "Extra force along the line of action (back-flank contact)";
   Real effect_drive_torque(unit = "N.m") = 0 "Extra motor torque (torque ripple)";
@@ -248,7 +248,12 @@ equation
   cycle_fraction = atan2(sin(mesh_angle - GearTwin.pi), cos(mesh_angle - GearTwin.pi)) / (2 * GearTwin.pi) + 0.5;
   tooth_angle = (mesh_angle - 2 * GearTwin.pi * cycle_fraction) / z1;
   roll = {(cycle_fraction + 1) / contact_ratio, cycle_fraction / contact_ratio, (cycle_fraction - 1) / contact_ratio};
-  window = {noEvent(min(1.0, max(0.0, (roll[i] + contact_smoothing) / (2 * contact_smoothing)))) ^ 2 * (3 - 2 * noEvent(min(1.0, max(0.0, (roll[i] + contact_smoothing) / (2 * contact_smoothing))))) * noEvent(min(1.0, max(0.0, (1 - roll[i] + contact_smoothing) / (2 * contact_smoothing)))) ^ 2 * (3 - 2 * noEvent(min(1.0, max(0.0, (1 - roll[i] + contact_smoothing) / (2 * contact_smoothing))))) for i in 1:3};
+  // Either gear moved bodily along the line of action by u (run-out: effect_mesh_displacement)
+  // moves its base circle along that line: the pinion's flank crosses the line where it did (the
+  // pair's roll, k_pair and the pinion's profile deviation stay), but the gear's tip reaches the
+  // line u sooner, so contact starts u earlier along the path; the pinion's tip, which ends it,
+  // stays at its roll. Elastic approach is local deformation, not a rigid move: it does not count.
+  window = {noEvent(min(1.0, max(0.0, (roll[i] + effect_mesh_displacement / contact_path_length + contact_smoothing) / (2 * contact_smoothing)))) ^ 2 * (3 - 2 * noEvent(min(1.0, max(0.0, (roll[i] + effect_mesh_displacement / contact_path_length + contact_smoothing) / (2 * contact_smoothing))))) * noEvent(min(1.0, max(0.0, (1 - roll[i] + contact_smoothing) / (2 * contact_smoothing)))) ^ 2 * (3 - 2 * noEvent(min(1.0, max(0.0, (1 - roll[i] + contact_smoothing) / (2 * contact_smoothing))))) for i in 1:3};
   // Each pair reads the entries of the tooth it holds (array indices computed without events:
   // a lookup, whatever z1 and n_profile), the leading pair the tooth ahead, the next pair the
   // tooth behind.
