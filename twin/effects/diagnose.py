@@ -154,7 +154,7 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
              min_cut: float = MIN_CUT, min_db: float = MIN_DB, solver_step: float | None = 1e-5,
              related_leaders: int = 2, anchors: Mapping[str, float] | None = None,
              held_out_runup: float = HELD_OUT_RUNUP_S, search: float | None = SEARCH_S,
-             search_step: float | None = SEARCH_STEP, progress: bool = False) -> Diagnosis:
+             search_step: float | None = SEARCH_STEP, baseline=None, progress: bool = False) -> Diagnosis:
     """Diagnose one record, or several records of the same gearbox (see the module docstring).
 
     Parameters
@@ -180,6 +180,11 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
     search, search_step : the candidates' search runs on the last ``search`` s of the record at
         the RK4 step ``search_step`` [s] (None: on the whole record, at the operating point's
         step); the values found are scored on the whole record at the operating point's step.
+    baseline : records of the same gearbox as it was calibrated, without the effect sought (a
+        sequence of :class:`~twin.effects.records.Record`, matched to the records by name, else
+        by kind): the model's discrepancy on them is learned and taken out of every record
+        before anything is fitted or judged (:mod:`twin.effects.baseline`), so the candidates
+        meet what changed since, not what the calibrated model never matched.
 
     Raises :class:`~twin.errors.ParameterError` for records that hold no steady record (a
     run-up alone cannot be fitted) or a run-up without a shaft speed.
@@ -211,6 +216,17 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
     # the trials start from the drive command that gave the base model the measured speed: without
     # it a model whose slip differs from the estimate runs every trial twice (simulate_at)
     op, base_model = simulate_settled(fmu_path, parameters, op, measured.size, channel)
+    ex = executor or LocalExecutor()
+    discrepancy: dict = {}
+    if baseline is not None:
+        from twin.effects.baseline import learn_all
+        discrepancy = learn_all(fmu_path, parameters, recs, as_records(baseline), channel, duration=duration,
+                                solver_step=solver_step, held_out_runup=held_out_runup,
+                                slip_hz=op.drive_hz - op.shaft_hz, fit_load=op.load, executor=ex, progress=progress)
+        conds = {name: replace(c, measured=discrepancy[name].remove(c.measured, c.operating.sample_rate,
+                                                                         c.operating.shaft_hz))
+                 for name, c in conds.items()}
+        measured = conds[fit_rec.name].measured
     before = compare_signals(base_model, measured, sample_rate, shaft, z1=z1, z2=z2)
 
     if candidates_fmu is None:
@@ -231,7 +247,6 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
              for e in ids]
     # the candidates with the most trials first, so that no worker is left with a long one at the end
     specs.sort(key=lambda sp: -_trials(CATALOGUE[sp.effect]))
-    ex = executor or LocalExecutor()
     results = ex.map(_guarded_fit, specs, progress=progress, desc="candidate effects")
 
     cands = []
@@ -279,7 +294,10 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
                 raise ParameterError(f"run-up {r.name} has no tachometer, encoder or speed channel: its speed "
                                      "profile is needed to simulate it")
             m = int(round(min(held_out_runup, r.signal.size / r.sample_rate) * r.sample_rate))
-            held.append((r.name, dict(measured=r.signal[-m:], sample_rate=r.sample_rate, load=r.load,
+            stretch = r.signal[-m:]
+            if discrepancy:
+                stretch = discrepancy[r.name].remove(stretch, r.sample_rate, float(np.mean(r.shaft_hz[-m:])))
+            held.append((r.name, dict(measured=stretch, sample_rate=r.sample_rate, load=r.load,
                                       shaft_hz=r.shaft_hz[-m:], slip_hz=slip * r.load / op.load if op.load else slip)))
         fitting = [c for c in cands if fits(before, c, min_cut, min_db)]
         # nothing to test when no candidate fits: the base model is not run on the held-out records
@@ -307,4 +325,5 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
 
     verdict, missing, unexplained, msg, tied = judge(before, cands, min_cut=min_cut, min_db=min_db)
     return Diagnosis(fit_rec.name, before.lsd_db, before.findings, tuple(cands), verdict, missing, unexplained, msg,
-                     op, time.perf_counter() - t0, held_names, runup_name, tied)
+                     op, time.perf_counter() - t0, held_names, runup_name, tied,
+                     tuple(sorted({d.record for d in discrepancy.values()})))

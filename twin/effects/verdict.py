@@ -72,9 +72,11 @@ class Diagnosis:
     held_out_records: tuple[str, ...] = ()   # records scored but not fitted on
     runup: str | None = None                 # the run-up the signatures were read from
     tied: tuple[str, ...] = ()               # verdict "tie": the effects that explain the same thing
+    baseline: tuple[str, ...] = ()           # baseline records whose model discrepancy was taken out
 
     def to_dict(self) -> dict:
         return {"record": self.record, "held_out_records": list(self.held_out_records), "runup": self.runup,
+                "baseline": list(self.baseline),
                 "verdict": self.verdict, "missing": self.missing, "tied": list(self.tied),
                 "message": self.message, "headline": {"log_spectral_distance_db": self.lsd_db},
                 "operating": asdict(self.operating),
@@ -92,7 +94,9 @@ class Diagnosis:
     def table(self) -> str:
         """Plain-text ranking for the terminal."""
         rows = [f"baseline log-spectral distance {self.lsd_db:.2f} dB on {self.record}, {len(self.findings)} findings"
-                + (f"; held out: {', '.join(self.held_out_records)}" if self.held_out_records else ""),
+                + (f"; held out: {', '.join(self.held_out_records)}" if self.held_out_records else "")
+                + (f"; the model's discrepancy on baseline {', '.join(self.baseline)} taken out" if self.baseline
+                   else ""),
                 f"{'rank':>4}  {'effect':<24} {'score':>6}  {'LSD after':>9}  {'held-out cut':>12}  signature  explains"]
         for i, c in enumerate(self.candidates):
             ex = "; ".join(e.kind for e in c.evidence) or ("failed: " + c.error if c.error else "-")
