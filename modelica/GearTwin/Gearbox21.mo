@@ -30,6 +30,7 @@ model Gearbox21 "21-DOF lumped model of the UNSW spur-gear test rig (Feng et al.
   parameter Real mesh_stiffness_scale(min = 0) = 1.0 "Calibration multiplier of all pair stiffnesses";
   parameter Real c_mesh(unit = "N.s/m", min = 0) = 1.1e3 "Mesh damping along the line of action";
   parameter Real contact_damping_width(unit = "m", min = 0) = 1e-8 "Approach over which the mesh damping engages when the flanks touch";
+  parameter Real lead_mismatch(unit = "m") = 0 "Lead mismatch of the flanks across the face (misalignment): the gap at one face end while the other touches";
   parameter Real mesh_phase0(unit = "rad") = 0.0 "Mesh phase at theta5 = 0";
   parameter Real contact_smoothing = 0.01 "Half-width of the entry/exit ramp of a tooth pair, as a fraction of the path of contact";
 
@@ -175,6 +176,7 @@ model Gearbox21 "21-DOF lumped model of the UNSW spur-gear test rig (Feng et al.
   Real pair_stiffness[3](each unit = "N/m") "Stiffness of each tooth pair";
   Real pair_deviation[3](each unit = "m") "Profile deviation at the contact point of each pair";
   output Real pair_force[3](each unit = "N", each min = 0) "Elastic force carried by each pair";
+  Real face_mismatch(unit = "m", min = 0) "Lead mismatch across the face in force: |lead_mismatch + effect_lead_mismatch|";
   Real mesh_deflection(unit = "m") "Approach of the flanks along the line of action";
   Real mesh_deflection_rate(unit = "m/s") "Time derivative of mesh_deflection";
   output Real mesh_force(unit = "N") "Dynamic mesh force along the line of action";
@@ -200,6 +202,7 @@ model Gearbox21 "21-DOF lumped model of the UNSW spur-gear test rig (Feng et al.
   Real effect_pair_deviation[3](each unit = "m") = {0, 0, 0} "Extra material loss at the contact of each pair (leading, current, next): the gear's tooth errors (GearTwin.Variants.Gearbox21WheelErrors); added to pair_deviation";
   Real effect_mesh_displacement(unit = "m") = 0 "Rigid move of a gear along the line of action (run-out): extra approach of the flanks, and contact starting that much earlier along the path";
   Real effect_mesh_displacement_rate(unit = "m/s") = 0 "Time derivative of effect_mesh_displacement";
+  Real effect_lead_mismatch(unit = "m") = 0 "Extra lead mismatch across the face (the wobble of a gear tilted on its shaft); added to lead_mismatch";
   Real effect_mesh_force(unit = "N") = 0 "Extra force along the line of action (back-flank contact)";
   Real effect_drive_torque(unit = "N.m") = 0 "Extra motor torque (torque ripple)";
   Real effect_load_torque(unit = "N.m") = 0 "Extra brake torque (load fluctuation)";
@@ -271,7 +274,12 @@ equation
   mesh_deflection = rb1 * theta5 - rb2 * theta10 + (x5 - x10) * sin(alpha) + (y5 - y10) * cos(alpha) + effect_mesh_displacement + excitation_mesh_displacement;
   mesh_deflection_rate = rb1 * omega5 - rb2 * omega10 + (vx5 - vx10) * sin(alpha) + (vy5 - vy10) * cos(alpha) + effect_mesh_displacement_rate + excitation_mesh_displacement_rate;
   // A pair whose flanks are apart (deviation larger than the approach) carries no load.
-  pair_force = {pair_stiffness[i] * noEvent(max(0.0, mesh_deflection - pair_deviation[i])) for i in 1:3};
+  // Across the face the flanks touch first at one end when their leads differ by face_mismatch
+  // (D): with a uniform stiffness per unit face width and an approach a at that end, the pair
+  // carries k (a - D/2) while the whole face touches (a >= D) and k a^2 / (2 D) while only the
+  // length a/D of it does; with D = 0 it is the line contact k max(0, a).
+  face_mismatch = abs(lead_mismatch + effect_lead_mismatch);
+  pair_force = {pair_stiffness[i] * noEvent(if face_mismatch > 0 then min(max(mesh_deflection - pair_deviation[i], 0.0), face_mismatch) ^ 2 / (2 * max(face_mismatch, 1e-12)) + max(mesh_deflection - pair_deviation[i] - face_mismatch, 0.0) else max(0.0, mesh_deflection - pair_deviation[i])) for i in 1:3};
   // The flanks damp each other only while they touch (oil film, material damping); apart, the
   // gears fly freely across the clearance.
   mesh_contact = noEvent(min(1.0, sum(window[i] * noEvent(min(1.0, max(0.0, (mesh_deflection - pair_deviation[i]) / contact_damping_width))) for i in 1:3)));

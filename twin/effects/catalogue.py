@@ -70,15 +70,20 @@ def _eccentricity(gear: str) -> Effect:
         f"{gear}_eccentricity", "GearTwin.Effects.ShaftEccentricity", f"{gear.capitalize()} run-out",
         inputs={"shaft_angle": shaft[0], "shaft_speed": shaft[1]},
         hooks={"effect_mesh_displacement": "mesh_displacement",
-               "effect_mesh_displacement_rate": "mesh_displacement_rate"},
-        fit=(FitParameter("eccentricity", 2e-7, 2e-4, log=True),),
+               "effect_mesh_displacement_rate": "mesh_displacement_rate",
+               "effect_lead_mismatch": "lead_mismatch"},
+        # a gear bored off-centre is usually bored off-square too: its tilt sweeps the lead
+        # across the face once per turn (wobble), which at light load shrinks the contact
+        fit=(FitParameter("eccentricity", 2e-7, 2e-4, log=True), FitParameter("wobble", 1e-7, 2e-4, log=True)),
         # the mesh force of a run-out approach scales with the mesh stiffness
         related=("mesh_stiffness_scale",),
-        neutral={"eccentricity": 0.0},
+        neutral={"eccentricity": 0.0, "wobble": 0.0},
         evidence={"sideband": f"run-out of the {gear} modulates the mesh approach once per {gear} revolution, "
                               f"which puts sidebands at {gear}-speed spacing around the mesh harmonics",
                   "shaft_order": f"the once-per-revolution approach change excites the first {gear} orders",
-                  "mesh_harmonic": "the modulation moves energy between the mesh harmonics and their sidebands",
+                  "mesh_harmonic": "the modulation moves energy between the mesh harmonics and their sidebands; "
+                                   "a tilted gear's wobble shrinks the face contact, which softens the mesh "
+                                   "and raises its harmonics",
                   "resonance": "sideband families fill the region around resonances"})
 
 

@@ -3,6 +3,7 @@ model Gearbox21CasingCandidates "GearTwin.Gearbox21Casing with every catalogue e
   extends GearTwin.Gearbox21Casing(
     effect_mesh_displacement = pinion_eccentricity.mesh_displacement + gear_eccentricity.mesh_displacement,
     effect_mesh_displacement_rate = pinion_eccentricity.mesh_displacement_rate + gear_eccentricity.mesh_displacement_rate,
+    effect_lead_mismatch = pinion_eccentricity.lead_mismatch + gear_eccentricity.lead_mismatch,
     effect_drive_torque = motor_torque_ripple.torque,
     effect_load_torque = load_torque_fluctuation.torque,
     effect_sensor_acceleration_pinion = housing_mode.extra_acceleration,
@@ -16,11 +17,13 @@ model Gearbox21CasingCandidates "GearTwin.Gearbox21Casing with every catalogue e
   GearTwin.Effects.ShaftEccentricity pinion_eccentricity(
     shaft_angle = theta5,
     shaft_speed = omega5,
-    eccentricity = 0.0) "Pinion run-out";
+    eccentricity = 0.0,
+    wobble = 0.0) "Pinion run-out";
   GearTwin.Effects.ShaftEccentricity gear_eccentricity(
     shaft_angle = theta10,
     shaft_speed = omega10,
-    eccentricity = 0.0) "Gear run-out";
+    eccentricity = 0.0,
+    wobble = 0.0) "Gear run-out";
   GearTwin.Effects.MotorTorqueRipple motor_torque_ripple(
     amplitude = 0.0) "Drive motor torque ripple";
   GearTwin.Effects.LoadTorqueFluctuation load_torque_fluctuation(

@@ -155,3 +155,23 @@ def test_a_run_out_moves_the_start_of_contact_by_hand(candidates_fmu):
         ahead = np.sin(angle) > 0
         shares[e] = float(np.mean(double[ahead]) - np.mean(double[~ahead]))
     assert shares[1e-4] - shares[0.0] == pytest.approx(4 * 1e-4 / (np.pi * p_b), rel=0.15)
+
+
+def test_a_lead_mismatch_shrinks_the_face_contact_by_hand(gearbox_fmu):
+    """Leads that differ by D across the face: each pair carries k (a - D/2) with the whole face
+    in contact and k a^2 / (2 D) with the length a/D of it. At light load (a << D) the mean
+    approach is then about sqrt(2 D F / k_mean) instead of F / k_mean; the shafts' lateral give
+    under the same force is the same, so the transmission error moves by the difference."""
+    from twin.operating import simulate_operating_point
+
+    kw = dict(settle=0.1, duration=0.1, channels=["transmission_error", "mesh_force", "mesh_stiffness",
+                                                  "pair_force[1]", "pair_force[2]", "pair_force[3]"],
+              output_interval=1e-5)
+    mean = {}
+    for d in (0.0, 20e-6):
+        y = simulate_operating_point(str(gearbox_fmu), 20.0, 20.0, parameters={"lead_mismatch": d}, **kw)
+        assert np.all(y[:, 3:6] >= 0.0)
+        mean[d] = [float(np.mean(v)) for v in (y[:, 0], y[:, 3:6].sum(axis=1), y[:, 2])]
+    (te0, f0, k0), (te1, f1, k1) = mean[0.0], mean[20e-6]
+    assert f1 == pytest.approx(f0, rel=0.02)              # the same torque is carried
+    assert te1 - te0 == pytest.approx(np.sqrt(2 * 20e-6 * f1 / k1) - f0 / k0, rel=0.15)

@@ -116,4 +116,6 @@ def test_a_search_on_a_shorter_coarser_run_is_scored_on_the_whole_record(candida
                                                op, _neutral(), {}, search_samples=5000, search_step=2e-5))
     assert sim.shape == x.shape and lsd == pytest.approx(_Objective(x, 20000.0)(sim))
     assert fitted["pinion_eccentricity.eccentricity"] == pytest.approx(2e-5, rel=0.3)
-    assert n <= 16                      # 7 grid points, at most 8 polishing runs, one scoring run
+    # per amplitude (eccentricity, wobble) 7 grid points and at most 8 polishing runs, then at most
+    # max_evals - those (at least 4) together, and one scoring run
+    assert n <= 2 * (7 + 8) + 4 + 1
