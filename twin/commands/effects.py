@@ -54,11 +54,20 @@ def _effect_ids(text: str | None) -> list[str] | None:
     return ids
 
 
+def _baseline(args: argparse.Namespace, scenario):
+    """``--baseline FILE [--baseline-record NAME ...]``: the baseline records, or None."""
+    if args.baseline is None:
+        return None
+    return lib("twin.effects.loop").read_baseline(args.baseline, scenario, args.baseline_record, args.record)
+
+
 def _cmd_diagnose(args: argparse.Namespace) -> int:
     scenario = lib("twin.scenario").load_scenario(Path(args.scenario))
-    diag = lib("twin.effects.loop").diagnose_scenario(scenario, Path(args.measurements), record=args.record,
-                                                       all_records=args.all_records, json_path=args.json, executor=local_executor(args.workers),
-                                                       duration=args.duration, effects=_effect_ids(args.effects))
+    loop = lib("twin.effects.loop")
+    diag = loop.diagnose_scenario(scenario, Path(args.measurements), record=args.record,
+                                  all_records=args.all_records, json_path=args.json, executor=local_executor(args.workers),
+                                  duration=args.duration, effects=_effect_ids(args.effects),
+                                  baseline=_baseline(args, scenario))
     print(diag.table())
     for c in diag.candidates[:1]:
         for e in c.evidence:
@@ -72,7 +81,7 @@ def _cmd_add_effect(args: argparse.Namespace) -> int:
     scenario = lib("twin.scenario").load_scenario(Path(args.scenario))
     add = lib("twin.effects.loop").add_effect(scenario, Path(args.measurements), args.effect, Path(args.out),
                                                record=args.record, modelica_dir=args.modelica_dir,
-                                               duration=args.duration)
+                                               duration=args.duration, baseline=_baseline(args, scenario))
     print(f"variant {add.model} -> {add.modelica_file}")
     print(f"FMU -> {add.fmu}")
     print("fitted: " + ", ".join(f"{k} = {v:.4g}" for k, v in add.fitted.items()))
@@ -90,7 +99,7 @@ def _cmd_improve(args: argparse.Namespace) -> int:
     history = loop.improve(scenario, Path(args.measurements), Path(args.out), record=args.record,
                            all_records=args.all_records, diagnosis=args.from_diagnosis, max_steps=args.max_steps, executor=local_executor(args.workers),
                            modelica_dir=args.modelica_dir, duration=args.duration,
-                           effects=_effect_ids(args.effects))
+                           effects=_effect_ids(args.effects), baseline=_baseline(args, scenario))
     print(loop.history_table(history))
     print(f"history -> {Path(args.out) / 'history.csv'}, plot -> {Path(args.out) / 'history.png'}")
     return 0
@@ -120,6 +129,11 @@ def _loop_arguments(p: argparse.ArgumentParser, *, out: bool, several: bool = Fa
     else:
         p.add_argument("--record", help="record name (default: the first)")
     p.add_argument("--duration", type=float, default=2.0, help="seconds of the record compared (default: 2)")
+    p.add_argument("--baseline", type=Path, metavar="FILE",
+                   help="measurement file of the gearbox as the scenario's model was calibrated on it (before the "
+                        "effect sought): the model's discrepancy on it is taken out of the records first")
+    p.add_argument("--baseline-record", action="append", metavar="NAME",
+                   help="record of --baseline, repeatable (default: those named like --record)")
     if out:
         p.add_argument("--out", required=True, help="output directory")
         p.add_argument("--modelica-dir", type=Path, default=None,

@@ -122,9 +122,18 @@ def guarded_learn(spec: DiscrepancySpec):
         return exc
 
 
+#: A baseline record stands for a record taken within this relative distance of its drive speed
+#: and load: the discrepancy is carried in shaft orders, which holds for a few per cent of speed
+#: (a resonance moves by as much), not for another operating point.
+SPEED_TOL = 0.05
+LOAD_TOL = 0.10
+
+
 def pair(records: Sequence, baseline: Sequence) -> dict[str, object]:
     """Each record's baseline: the baseline record of the same name, else the first of the same
-    kind (steady or run-up). Raises :class:`~twin.errors.ParameterError` naming a record without one."""
+    kind (steady or run-up). Raises :class:`~twin.errors.ParameterError` naming a record without
+    one, a baseline at another operating point (drive speed beyond +-``SPEED_TOL``, load beyond
+    +-``LOAD_TOL``), or a record that is its own baseline (nothing could change)."""
     from twin.errors import ParameterError
     by_name = {b.name: b for b in baseline}
     out = {}
@@ -136,18 +145,35 @@ def pair(records: Sequence, baseline: Sequence) -> dict[str, object]:
             kind = "run-up" if r.runup else "steady record"
             raise ParameterError(f"no baseline for record {r.name}: the baseline records "
                                  f"({', '.join(c.name for c in baseline) or 'none'}) hold no {kind}")
+        if abs(r.nominal_speed / b.nominal_speed - 1) > SPEED_TOL or abs(r.load - b.load) > LOAD_TOL * max(b.load, 1e-9):
+            raise ParameterError(f"baseline {b.name} was taken at {b.nominal_speed:g} Hz, {b.load:g} N.m and record "
+                                 f"{r.name} at {r.nominal_speed:g} Hz, {r.load:g} N.m: a baseline stands for records "
+                                 f"within {100 * SPEED_TOL:.0f} % of its speed and {100 * LOAD_TOL:.0f} % of its load")
+        if r.signal.shape == b.signal.shape and r.sample_rate == b.sample_rate and np.array_equal(r.signal, b.signal):
+            raise ParameterError(f"record {r.name} is its own baseline {b.name}: the model's discrepancy on it would "
+                                 "take out everything; give a record taken later, or no baseline")
         out[r.name] = b
     return out
 
 
 def learn_all(fmu_path, parameters: Mapping[str, float], records: Sequence, baseline: Sequence, channel: str, *,
-              duration: float, solver_step: float | None, held_out_runup: float, slip_hz: float, fit_load: float,
-              executor, progress: bool = False) -> dict[str, Discrepancy]:
+              duration: float, solver_step: float | None = 1e-5, held_out_runup: float = 2.0, slip_hz: float = 0.0,
+              fit_load: float = 0.0, executor=None, progress: bool = False) -> dict[str, Discrepancy]:
     """The model's :class:`Discrepancy` on each record's baseline, by record name (the steady
-    baselines over their last ``duration`` s, run-ups over their last ``held_out_runup`` s)."""
+    baselines over their last ``duration`` s, run-ups over their last ``held_out_runup`` s,
+    driven with the loaded motor's ``slip_hz`` at ``fit_load`` [N.m], scaled to their load).
+    ``baseline`` may also be a mapping of record name to :class:`Discrepancy` already learned
+    (:func:`twin.effects.loop.improve` learns it once, on the calibrated model, and keeps it
+    while effects are added): it is then checked to cover every record and returned."""
     from twin.effects.diagnose import record_conditions
     from twin.errors import ParameterError
 
+    if isinstance(baseline, Mapping):
+        missing = [r.name for r in records if not isinstance(baseline.get(r.name), Discrepancy)]
+        if missing:
+            raise ParameterError(f"no learned discrepancy for record {missing[0]} (it has "
+                                 f"{', '.join(baseline) or 'none'})")
+        return {r.name: baseline[r.name] for r in records}
     pairs = pair(records, baseline)
     specs, names = [], {}
     for b in {id(b): b for b in pairs.values()}.values():
@@ -165,7 +191,8 @@ def learn_all(fmu_path, parameters: Mapping[str, float], records: Sequence, base
                                    b.load, operating=c.operating, solver_step=solver_step)
         names[b.name] = len(specs)
         specs.append(spec)
-    out = executor.map(guarded_learn, specs, progress=progress, desc="baseline records")
+    out = (executor.map(guarded_learn, specs, progress=progress, desc="baseline records") if executor is not None
+           else [guarded_learn(sp) for sp in specs])
     bad = [(s.record, v) for s, v in zip(specs, out) if isinstance(v, Exception)]
     if bad:
         raise ParameterError(f"baseline record {bad[0][0]}: {bad[0][1]}")

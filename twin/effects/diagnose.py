@@ -182,9 +182,11 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
         step); the values found are scored on the whole record at the operating point's step.
     baseline : records of the same gearbox as it was calibrated, without the effect sought (a
         sequence of :class:`~twin.effects.records.Record`, matched to the records by name, else
-        by kind): the model's discrepancy on them is learned and taken out of every record
-        before anything is fitted or judged (:mod:`twin.effects.baseline`), so the candidates
-        meet what changed since, not what the calibrated model never matched.
+        by kind, at the same operating point): the model's discrepancy on them is learned and
+        taken out of every record before anything is fitted or judged
+        (:mod:`twin.effects.baseline`), so the candidates meet what changed since, not what the
+        calibrated model never matched. Or a mapping of record name to an already learned
+        :class:`~twin.effects.baseline.Discrepancy`.
 
     Raises :class:`~twin.errors.ParameterError` for records that hold no steady record (a
     run-up alone cannot be fitted) or a run-up without a shaft speed.
@@ -203,6 +205,9 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
         raise ParameterError(f"records {', '.join(r.name for r in recs)} are all run-ups; the candidates are "
                              "fitted on a steady record: give one too")
     fit_rec = steady[0]
+    if baseline is not None and not isinstance(baseline, Mapping):
+        from twin.effects.baseline import pair
+        pair(recs, as_records(baseline))          # a record without a fitting baseline is refused first
     conds = {r.name: record_conditions(fmu_path, r.signal, r.sample_rate, r.nominal_speed, r.load, parameters,
                                        record=r.name, duration=duration, solver_step=solver_step) for r in steady}
     cond = conds[fit_rec.name]
@@ -220,7 +225,8 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
     discrepancy: dict = {}
     if baseline is not None:
         from twin.effects.baseline import learn_all
-        discrepancy = learn_all(fmu_path, parameters, recs, as_records(baseline), channel, duration=duration,
+        known = baseline if isinstance(baseline, Mapping) else as_records(baseline)
+        discrepancy = learn_all(fmu_path, parameters, recs, known, channel, duration=duration,
                                 solver_step=solver_step, held_out_runup=held_out_runup,
                                 slip_hz=op.drive_hz - op.shaft_hz, fit_load=op.load, executor=ex, progress=progress)
         conds = {name: replace(c, measured=discrepancy[name].remove(c.measured, c.operating.sample_rate,

@@ -54,13 +54,15 @@ def _record_names(record) -> list[str] | None:
 
 def diagnose_scenario(scenario, measurements, *, record: str | Sequence[str] | None = None, all_records: bool = False,
                       json_path=None, executor=None, duration: float = 2.0, progress: bool = True,
-                      candidates_fmu=None, effects: Sequence[str] | None = None) -> Diagnosis:
+                      candidates_fmu=None, effects: Sequence[str] | None = None, baseline=None) -> Diagnosis:
     """``twin diagnose``: the scenario's model against one or several records; writes ``json_path`` if given.
 
     ``record``: a record name or several (``--record steady --record runup``); ``all_records``:
     every record of the file; default: the first. With several, the candidates are fitted on the
     first steady record and must hold on the others (:func:`twin.effects.diagnose.diagnose`).
     ``effects``: the candidate ids tried (default: every catalogue effect the model lacks).
+    ``baseline``: records of the gearbox as the scenario's model was calibrated on it, or their
+    learned discrepancies (:func:`twin.effects.diagnose.diagnose`).
     """
     from twin.effects.records import read_records
     from twin.errors import OutputPathError
@@ -70,13 +72,56 @@ def diagnose_scenario(scenario, measurements, *, record: str | Sequence[str] | N
     recs = read_records(measurements, channel, _record_names(record), every=all_records)
     diag = diagnose(scenario.fmu_path(), recs, parameters=dict(scenario.parameters), channel=channel,
                     executor=executor, duration=duration, progress=progress, candidates_fmu=candidates_fmu,
-                    effects=effects, anchors=(scenario.raw or {}).get("diagnosis", {}).get("calibrated", {}))
+                    effects=effects, anchors=(scenario.raw or {}).get("diagnosis", {}).get("calibrated", {}),
+                    baseline=baseline)
     if json_path is not None:
         _write_json(Path(json_path), {"scenario": scenario.name, "fmu": str(scenario.fmu),
                                       "measurements": str(Path(measurements).resolve()),
                                       "records": [r.name for r in recs], "duration": duration,
                                       "effects": list(effects) if effects else None, **diag.to_dict()})
     return diag
+
+
+def read_baseline(path, scenario, names: Sequence[str] | None = None, record=None) -> list:
+    """Baseline records (:class:`~twin.effects.records.Record`) from measurement file ``path``:
+    those ``names`` gives, else the records of the same names as ``record`` (the records
+    diagnosed) that the file holds. Raises :class:`~twin.errors.MeasurementError` when the file
+    holds none of them (naming what it has)."""
+    from twin.effects.records import read_records
+    from twin.errors import MeasurementError
+    from twin.measurements import load_measurements
+    channel = (scenario.outputs or ("accel_pinion_casing",))[0]
+    if not names:
+        held = load_measurements(path).names
+        wanted = _record_names(record) or [held[0]]
+        names = [n for n in wanted if n in held]
+        if not names:
+            raise MeasurementError(str(path), ", ".join(wanted), f"no baseline record of these names; the file has "
+                                                                  f"{', '.join(held)} (name them with --baseline-record)")
+    return read_records(path, channel, list(names))
+
+
+def learn_discrepancy(scenario, measurements, baseline, *, record=None, all_records: bool = False,
+                      duration: float = 2.0, executor=None) -> dict:
+    """The scenario's model's discrepancy on ``baseline`` (records of the gearbox as the model was
+    calibrated on it), for each record of ``measurements`` that ``record``/``all_records`` name:
+    {record name: :class:`~twin.effects.baseline.Discrepancy`}. A run-up's baseline is driven with
+    the loaded motor's slip that the first steady record gives the model."""
+    from twin.effects.baseline import learn_all
+    from twin.effects.records import as_records, read_records
+    from twin.operating import simulate_settled
+    channel = (scenario.outputs or ("accel_pinion_casing",))[0]
+    recs = read_records(measurements, channel, _record_names(record), every=all_records)
+    fmu, params = scenario.fmu_path(), dict(scenario.parameters)
+    steady = [r for r in recs if not r.runup]
+    slip = load = 0.0
+    if steady and len(steady) < len(recs):
+        c = record_conditions(fmu, steady[0].signal, steady[0].sample_rate, steady[0].nominal_speed, steady[0].load,
+                              params, record=steady[0].name, duration=duration)
+        op, _ = simulate_settled(fmu, params, c.operating, c.measured.size, channel)
+        slip, load = op.drive_hz - op.shaft_hz, op.load
+    return learn_all(fmu, params, recs, as_records(baseline), channel, duration=duration, slip_hz=slip,
+                     fit_load=load, executor=executor)
 
 
 def load_diagnosis(path, scenario, measurements, *, duration: float = 2.0) -> dict:
@@ -157,8 +202,13 @@ def portable_scenario(scenario, name: str, fmu: str, parameter_file: str, anchor
 
 def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str | None = None,
                start: dict | None = None, refit: bool = True, modelica_dir=None, build_dir=None,
-               candidates_fmu=None, duration: float = 2.0, max_evals: int = 30) -> Addition:
+               candidates_fmu=None, duration: float = 2.0, max_evals: int = 30, baseline=None) -> Addition:
     """``twin add-effect``: fit -> variant .mo -> FMU -> before/after report -> scenario.
+
+    ``baseline``: records of the gearbox as the scenario's (calibrated) model was fitted to it,
+    or their learned discrepancies: the model's discrepancy on them is taken out of the record
+    before the effect is fitted and the before/after distances are taken
+    (:mod:`twin.effects.baseline`).
 
     The effect is fitted in the candidate model (the current model's effects at their values,
     the new one switched on), together with its related base parameters (within
@@ -191,6 +241,15 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
                              record=rec.name, duration=duration)
     measured, current, z1, z2, op = cond.measured, cond.current, cond.z1, cond.z2, cond.operating
     shaft = op.shaft_hz
+    if baseline is not None:
+        from collections.abc import Mapping
+
+        from twin.effects.baseline import learn_all
+        from twin.effects.records import as_records, read_records
+        this = read_records(measurements, channel, [rec.name])
+        known = baseline if isinstance(baseline, Mapping) else as_records(baseline)
+        measured = learn_all(current_fmu, base_params, this, known, channel,
+                             duration=duration)[rec.name].remove(measured, rec.sample_rate, shaft)
     active = active_effects(current)
     if effect_id in active:
         raise ParameterError(f"the model {scenario.fmu} already has {effect_id}")
@@ -265,8 +324,13 @@ class Step:
 
 def improve(scenario, measurements, out_dir, *, record: str | Sequence[str] | None = None, all_records: bool = False,
             max_steps: int = 4, executor=None, modelica_dir=None, build_dir=None, duration: float = 2.0,
-            progress: bool = True, effects: Sequence[str] | None = None, diagnosis=None) -> tuple[Step, ...]:
+            progress: bool = True, effects: Sequence[str] | None = None, diagnosis=None,
+            baseline=None) -> tuple[Step, ...]:
     """``twin improve``: diagnose -> add -> recalibrate until no candidate improves the fit.
+
+    ``baseline``: records of the gearbox as the scenario's model was calibrated on it. Their
+    discrepancy is learned once, on the scenario's model, and kept while effects are added: a
+    variant with an effect must not learn it again on records that lack the effect.
 
     ``effects``: the candidate ids tried at each step (default: the whole catalogue).
     ``diagnosis``: a diagnosis of this scenario already made (a ``diagnosis.json`` path, see
@@ -276,6 +340,9 @@ def improve(scenario, measurements, out_dir, *, record: str | Sequence[str] | No
     from twin.scenario import load_scenario
     for e in effects or ():
         get_effect(e)                   # an unknown id is refused before anything is written
+    if baseline is not None and not isinstance(baseline, dict):
+        baseline = learn_discrepancy(scenario, measurements, baseline, record=record, all_records=all_records,
+                                     duration=duration, executor=executor)
     first = None
     if isinstance(diagnosis, Diagnosis):
         first = {"verdict": diagnosis.verdict, "missing": diagnosis.missing, "record": diagnosis.record,
@@ -300,7 +367,7 @@ def improve(scenario, measurements, out_dir, *, record: str | Sequence[str] | No
         else:
             diag = diagnose_scenario(scenario, measurements, record=record, all_records=all_records,
                                      executor=executor, duration=duration, progress=progress,
-                                     json_path=out / f"diagnosis_{k}.json", effects=effects)
+                                     json_path=out / f"diagnosis_{k}.json", effects=effects, baseline=baseline)
             verdict, missing, fit_record, lsd = diag.verdict, diag.missing, diag.record, diag.lsd_db
             fitted = _fitted_of(diag)
         if verdict != "missing_effect":
@@ -308,7 +375,7 @@ def improve(scenario, measurements, out_dir, *, record: str | Sequence[str] | No
             break
         # the diagnosis fitted the effect already: add it with those values, without a refit
         add = add_effect(scenario, measurements, missing, out, record=fit_record, start=fitted, refit=False,
-                         modelica_dir=modelica_dir, build_dir=build_dir, duration=duration)
+                         modelica_dir=modelica_dir, build_dir=build_dir, duration=duration, baseline=baseline)
         history.append(Step(k, add.effect, add.lsd_before_db, add.lsd_after_db, add.model, verdict))
         if add.lsd_after_db >= add.lsd_before_db:
             break

@@ -35,8 +35,10 @@ def test_records_are_paired_with_their_baseline_by_name_then_by_kind():
     speed = np.full(100, 20.0)
     sweep = np.linspace(5.0, 20.0, 100)
 
+    rng = np.random.default_rng(0)
+
     def rec(name, shaft=speed):
-        return Record(name, np.zeros(100), 1000.0, 20.0, 20.0, shaft)
+        return Record(name, rng.standard_normal(100), 1000.0, 20.0, 20.0, shaft)
 
     steady, runup, other = rec("steady"), rec("runup", sweep), rec("steady_2")
     base = [rec("steady"), rec("healthy_runup", sweep)]
@@ -80,3 +82,29 @@ def test_a_path_error_in_every_record_is_not_blamed_on_an_effect_with_a_baseline
     assert (d.verdict, d.missing) == ("missing_effect", "motor_torque_ripple"), d.table()
     fitted = d.candidates[0].fitted["motor_torque_ripple.frequency"]
     assert fitted == pytest.approx(now.truth_parameters["motor_torque_ripple.frequency"], rel=0.01)
+
+
+def test_the_cli_refuses_a_baseline_it_cannot_use_by_name(tmp_path, gearbox_fmu, capsys):
+    """No record of the diagnosed names, the record itself, another operating point: each a
+    one-line error naming the values, before any simulation."""
+    import yaml
+
+    from twin.cli import main
+    from twin.measurements import Record as MRecord, write_measurements
+    from tests.twin.effects.test_records import _write
+
+    meas = _write(tmp_path / "now.h5", runout=0.1)
+    scen = tmp_path / "s.yaml"
+    scen.write_text(yaml.safe_dump({"version": 1, "name": "s", "fmu": str(gearbox_fmu), "stop_time": 1.0}))
+    other = tmp_path / "other.h5"
+    write_measurements([MRecord("healthy", {"accel_pinion_casing": np.zeros(20000)}, {"accel_pinion_casing": "m/s2"},
+                                10000.0, nominal_speed=10.0, load=20.0)], other)
+    cmd = ["diagnose", str(scen), "--measurements", str(meas), "--record", "steady", "--record", "runup"]
+    assert main([*cmd, "--baseline", str(other)]) == 2
+    err = capsys.readouterr().err
+    assert "healthy" in err and "--baseline-record" in err and len(err.strip().splitlines()) == 1
+    assert main([*cmd, "--baseline", str(meas)]) == 2
+    assert "record steady is its own baseline" in capsys.readouterr().err
+    assert main([*cmd, "--baseline", str(other), "--baseline-record", "healthy"]) == 2
+    err = capsys.readouterr().err
+    assert "baseline healthy was taken at 10 Hz" in err and "record steady at 20 Hz" in err
