@@ -54,8 +54,30 @@ def correct(expected: str, d) -> bool:
     return d.verdict == "missing_effect" and d.missing == expected
 
 
-def one_case(rig_name: str, seed: int, effect: str, calibrated, out: Path, ex, search: dict | None = None) -> dict:
-    from spectral_distance import spectral_distance_report
+def encoder_speed(h5: Path, record: str, n: int) -> float:
+    """Mean pinion speed [Hz] over the last ``n`` samples of a record, from its encoder angle [rad]
+    (read with h5py and numpy alone, for the independent distance)."""
+    import h5py
+    with h5py.File(h5, "r") as f:
+        g = f["records"][record]
+        angle = np.asarray(g["encoder"][...], float)[-n:]
+        fs = float(g.attrs["sample_rate"])
+    return float(np.polyfit(np.arange(angle.size) / fs, angle, 1)[0] / (2 * np.pi))
+
+
+def calibration_records(calibrated_dir: Path, rig_name: str, seed: int) -> Path:
+    """The measurement file the gearbox was calibrated on (bench/calibration_rigs.py wrote it
+    beside its ``<rig>_<seed>_cal``): the diagnosis's baseline."""
+    found = sorted(p for p in calibrated_dir.glob(f"{rig_name}_{seed}*.h5"))
+    if len(found) != 1:
+        raise SystemExit(f"expected one calibration record file {rig_name}_{seed}*.h5 in {calibrated_dir}, "
+                         f"found {[p.name for p in found]}")
+    return found[0]
+
+
+def one_case(rig_name: str, seed: int, effect: str, calibrated, out: Path, ex, search: dict | None = None,
+             baseline: Path | None = None) -> dict:
+    from spectral_distance import change_distance_report, spectral_distance_report
 
     from twin.effects.catalogue import CATALOGUE
     from twin.effects.diagnose import diagnose
@@ -79,13 +101,28 @@ def one_case(rig_name: str, seed: int, effect: str, calibrated, out: Path, ex, s
     x = np.asarray(rec[CHANNEL], float)
     fmu, params = calibrated.fmu_path(), dict(calibrated.parameters)
     t0 = time.perf_counter()
+    base_recs = read_records(baseline, CHANNEL, ["steady", "runup"]) if baseline else None
     d = diagnose(fmu, read_records(h5, CHANNEL, ["steady", "runup"]), parameters=params, executor=ex,
-                 duration=2.0, **(search or {}))
+                 duration=2.0, baseline=base_recs, **(search or {}))
     wall = time.perf_counter() - t0
     n = int(round(2.0 * fs))
     xm = x[-n:]
     base = simulate_at(fmu, params, d.operating, n, [CHANNEL])[:, 0]
     dist0 = spectral_distance_report(base, xm, fs)["distance_db"]
+    change0 = change1 = None
+    if baseline:
+        from twin.effects.diagnose import record_conditions
+        b = base_recs[0]
+        op_ref = record_conditions(fmu, b.signal, b.sample_rate, b.nominal_speed, b.load, params,
+                                   duration=2.0).operating
+        model_ref = simulate_at(fmu, params, op_ref, n, [CHANNEL])[:, 0]
+        ref = b.signal[-n:]
+        speeds_x = (encoder_speed(h5, "steady", n), encoder_speed(baseline, "steady", n))
+
+        def change(y):
+            return change_distance_report(y, model_ref, xm, ref, fs, (d.operating.shaft_hz, op_ref.shaft_hz,
+                                                                      *speeds_x))
+        change0 = change(base)
     # the effect named (or the first of a tie), else the best-fitting candidate
     top = next((c for c in d.candidates if c.effect == (d.missing or (d.tied[0] if d.tied else None))),
                d.candidates[0])
@@ -101,6 +138,8 @@ def one_case(rig_name: str, seed: int, effect: str, calibrated, out: Path, ex, s
         try:
             y = simulate_at(cand, probe, d.operating, n, [CHANNEL])[:, 0]
             dist1 = spectral_distance_report(y, xm, fs)["distance_db"]
+            if baseline:
+                change1 = change(y)
         except Exception as exc:  # reported in the table, never ends the benchmark
             dist1 = f"{type(exc).__name__}: {exc}"
     truth = json.loads(Path(str(h5) + ".truth.json").read_text())
@@ -109,7 +148,8 @@ def one_case(rig_name: str, seed: int, effect: str, calibrated, out: Path, ex, s
            "top_score": top.score, "top_held_out": top.held_out, "top_signature": [top.signature_present, top.signature],
            "message": d.message, "top_fitted": top.fitted, "unexplained": list(d.unexplained),
            "twin_lsd_before": d.lsd_db, "twin_lsd_after_top": top.lsd_after_db,
-           "distance_before_db": dist0, "distance_after_top_db": dist1, "diagnose_s": wall, "rig_s": rig_s,
+           "distance_before_db": dist0, "distance_after_top_db": dist1, "baseline": str(baseline or ""),
+           "change_before": change0, "change_after_top": change1, "diagnose_s": wall, "rig_s": rig_s,
            "search": search or "default", "load_average": os.getloadavg()[0],
            "truth_effect": next((r.get("effect") for r in truth.get("records", [truth]) if isinstance(r, dict)
                                  and r.get("effect")), None) if isinstance(truth, dict) else None}
@@ -148,6 +188,9 @@ def main() -> None:
                          "twin.effects.diagnose.SEARCH_S)")
     ap.add_argument("--search-step", type=float, default=None,
                     help="RK4 step [s] of the search (0: the operating point's; default: SEARCH_STEP)")
+    ap.add_argument("--baseline", action="store_true",
+                    help="give the diagnosis the records the gearbox was calibrated on as its baseline "
+                         "(twin diagnose --baseline), and score the change since them")
     ap.add_argument("--out", type=Path, default=REPO / "bench_out" / "diagnosis_rigs")
     args = ap.parse_args()
 
@@ -167,7 +210,8 @@ def main() -> None:
         for rig in args.rigs:
             calibrated = load_scenario(args.calibrated / f"{rig}_{args.seed}_cal" / "calibrated.yaml")
             for effect in args.effects:
-                rows.append(one_case(rig, args.seed, effect, calibrated, args.out, ex, search))
+                rows.append(one_case(rig, args.seed, effect, calibrated, args.out, ex, search,
+                                     calibration_records(args.calibrated, rig, args.seed) if args.baseline else None))
                 print(json.dumps({k: v for k, v in rows[-1].items() if k != "top_fitted"}), flush=True)
                 (args.out / "results.json").write_text(json.dumps(rows, indent=1, default=str))
     print(f"Machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, {args.workers} workers, "

@@ -77,6 +77,70 @@ def log_spectral_distance(model, measured, fs: float, **kwargs) -> float:
     return spectral_distance_report(model, measured, fs, **kwargs)["distance_db"]
 
 
+def _levels_on_orders(x: np.ndarray, fs: float, speed: float, orders: np.ndarray, resolution: float
+                      ) -> np.ndarray:
+    """PSD level [dB] of ``x`` at ``orders`` of a shaft turning at ``speed`` [Hz] (linear in dB
+    between Welch bins)."""
+    f, p = _psd(x, fs, resolution)
+    return np.interp(orders * speed, f, 10 * np.log10(np.maximum(p, 1e-300)))
+
+
+def _floor_db(x: np.ndarray, fs: float, resolution: float, fmin: float, fmax: float) -> float:
+    """3 dB above the lowest third-octave running median of the PSD over the band [dB]."""
+    f, p = _psd(x, fs, resolution)
+    band = (f >= fmin) & (f <= min(fmax, fs / 2))
+    return 10 * np.log10(2.0 * max(float(np.min(_running_median_third_octave(f[band], p[band]))), 1e-300))
+
+
+def change_distance_report(model, model_ref, measured, measured_ref, fs: float, speeds, *, fmin: float = 20.0,
+                           fmax: float = 5000.0, resolution: float = 4.0) -> dict:
+    """Distance [dB] between the change a model shows and the change measured.
+
+    ``measured`` and ``measured_ref``: a record and a reference record of the same gearbox (the
+    one before the change); ``model`` and ``model_ref``: the model at the same two operating
+    points; ``speeds``: their pinion speeds (model, model_ref, measured, measured_ref) [Hz]. A
+    model-form error common to both records (a missing mode, a wrong path) cancels in each
+    change; what is left is the change the model does not show.
+
+    1. Each signal's PSD level on a common grid of shaft orders (the records turn at speeds a
+       few 0.1 % apart, which would set their high mesh harmonics bins apart), over the orders
+       of [fmin, fmax] at the measured record's speed.
+    2. Floor-aware: the measured levels floored at the higher of the two records' floors (3 dB
+       above the lowest third-octave running median); the model's at that floor less the
+       model's gain (the median level difference of model_ref to measured_ref above it).
+    3. Gain-free: each change less its median over the bins where either level stands above
+       its floor (a sensor gain that differs between two records is not a change); bins at the
+       floor in both stay 0.
+    4. The RMS over the grid of measured change minus model change.
+    Returns ``distance_db``, ``measured_change_db`` (the RMS of the measured change itself:
+    the distance of a model that shows no change) and ``bins``.
+    """
+    s_m, s_mr, s_x, s_xr = (float(v) for v in speeds)
+    df = resolution / 2.0
+    orders = np.arange(fmin, min(fmax, fs / 2) + df, df) / s_x
+    sig = {k: np.asarray(v, float) for k, v in
+           dict(model=model, model_ref=model_ref, measured=measured, measured_ref=measured_ref).items()}
+    lev = {"model": _levels_on_orders(sig["model"], fs, s_m, orders, resolution),
+           "model_ref": _levels_on_orders(sig["model_ref"], fs, s_mr, orders, resolution),
+           "measured": _levels_on_orders(sig["measured"], fs, s_x, orders, resolution),
+           "measured_ref": _levels_on_orders(sig["measured_ref"], fs, s_xr, orders, resolution)}
+    floor = max(_floor_db(sig["measured"], fs, resolution, fmin, fmax),
+                _floor_db(sig["measured_ref"], fs, resolution, fmin, fmax))
+    above_ref = lev["measured_ref"] > floor
+    gain = float(np.median((lev["measured_ref"] - lev["model_ref"])[above_ref])) if above_ref.any() else 0.0
+    m_floor = floor - gain
+    xm, xr = np.maximum(lev["measured"], floor), np.maximum(lev["measured_ref"], floor)
+    sm, sr = np.maximum(lev["model"], m_floor), np.maximum(lev["model_ref"], m_floor)
+    live_x = (xm > floor) | (xr > floor)
+    live_s = (sm > m_floor) | (sr > m_floor)
+    dx, ds = xm - xr, sm - sr
+    # bins at the floor in both records of a pair stay unchanged whatever the gain
+    dx = np.where(live_x, dx - (float(np.median(dx[live_x])) if live_x.any() else 0.0), 0.0)
+    ds = np.where(live_s, ds - (float(np.median(ds[live_s])) if live_s.any() else 0.0), 0.0)
+    return {"distance_db": float(np.sqrt(np.mean((dx - ds) ** 2))),
+            "measured_change_db": float(np.sqrt(np.mean(dx ** 2))), "bins": int(orders.size)}
+
+
 def _read(path: str, channel: str) -> list[tuple[str, np.ndarray, float]]:
     """(record name, channel samples, sample rate [Hz]) of every record of a measurement file
     (the HDF5 layout of ``docs/measurements.md``, read with h5py alone)."""

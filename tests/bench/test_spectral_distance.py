@@ -62,3 +62,43 @@ def test_the_command_line_scores_each_model_against_the_end_of_the_record(tmp_pa
     assert out[-1].startswith(f"change: {rows['after'] - rows['before']:+.2f} dB")
     with pytest.raises(SystemExit):
         sd.main([str(tmp_path / "rig.h5"), "--record", "runup", "--models", str(tmp_path / "models.h5")])
+
+
+def _geared(seed, speed, sideband=0.0, n=40000):
+    """Noise, a resonance at 1500 Hz and mesh lines (orders 19, 38) of a shaft at ``speed`` [Hz],
+    with first sidebands of relative size ``sideband``."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) / FS
+    b, a = sps.iirpeak(1500.0, 10.0, FS)
+    x = 0.3 * rng.standard_normal(n) + 5 * sps.lfilter(b, a, rng.standard_normal(n))
+    for k in (19, 38):
+        x += 3 * np.sin(2 * np.pi * k * speed * t)
+        for s in (-1, 1):
+            x += 3 * sideband * np.sin(2 * np.pi * (k + s) * speed * t)
+    return x
+
+
+def test_the_change_distance_counts_what_changed_and_not_what_both_records_share():
+    """A model-form error common to both records (the model has no resonance, its lines are 20 dB
+    off) cancels; sidebands that appeared count until the model shows them too; records at speeds
+    0.5 % apart are compared in shaft orders."""
+    then, now = _geared(1, 20.0), _geared(2, 20.1, sideband=0.3)
+    t = np.arange(40000) / FS
+
+    def model(seed, speed, sideband=0.0):      # broadband excitation, no resonance, lines 20 dB down
+        x = 0.03 * np.random.default_rng(seed).standard_normal(t.size)
+        for k in (19, 38):
+            x += 0.3 * np.sin(2 * np.pi * k * speed * t)
+            for s in (-1, 1):
+                x += 0.3 * sideband * np.sin(2 * np.pi * (k + s) * speed * t)
+        return x
+
+    model_then, model_now, showing = model(5, 20.0), model(6, 20.1), model(6, 20.1, sideband=0.3)
+    speeds = (20.1, 20.0, 20.1, 20.0)
+    quiet = sd.change_distance_report(model_then, model_then, _geared(4, 20.0), then, FS, (20.0,) * 4)
+    blind = sd.change_distance_report(model_now, model_then, now, then, FS, speeds)
+    shows = sd.change_distance_report(showing, model_then, now, then, FS, speeds)
+    assert quiet["distance_db"] < 2.0                      # estimation scatter only
+    assert blind["distance_db"] == pytest.approx(blind["measured_change_db"], rel=0.05)
+    assert blind["distance_db"] > 2 * quiet["distance_db"]
+    assert shows["distance_db"] < 0.5 * blind["distance_db"]
