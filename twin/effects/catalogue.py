@@ -110,7 +110,10 @@ CATALOGUE: dict[str, Effect] = {e.id: e for e in (
                      "sideband": "the mesh-force modulation gives sidebands around the mesh harmonics",
                      "mesh_harmonic": "the modulation moves energy out of the mesh harmonics"}),
     Effect("housing_mode", "GearTwin.Effects.SensorMountMode", "Casing or sensor-mount mode",
-           inputs={"base_acceleration": "casing_acceleration_pinion"},
+           # the mode filters what reaches the sensor: on a model with a transfer path and sensor
+           # (Gearbox21Measured, Gearbox21Casing and those extending it) that is the path's
+           # output, not the pedestal's motion (sensor_path_acceleration_pinion is 0 without one)
+           inputs={"base_acceleration": "casing_acceleration_pinion + sensor_path_acceleration_pinion"},
            hooks={"effect_sensor_acceleration_pinion": "extra_acceleration"},
            fit=(FitParameter("frequency", 300.0, 4800.0, guess="resonance"),
                 FitParameter("participation", 0.02, 3.0, log=True),

@@ -29,7 +29,7 @@ model Gearbox21TiltingWallsCandidates "GearTwin.Gearbox21TiltingWalls with every
   GearTwin.Effects.LoadTorqueFluctuation load_torque_fluctuation(
     amplitude = 0.0) "Brake torque fluctuation";
   GearTwin.Effects.SensorMountMode housing_mode(
-    base_acceleration = casing_acceleration_pinion,
+    base_acceleration = casing_acceleration_pinion + sensor_path_acceleration_pinion,
     participation = 0.0) "Casing or sensor-mount mode";
   GearTwin.Effects.LocalToothDamage local_tooth_damage(
     z1 = z1,

@@ -175,3 +175,24 @@ def test_a_lead_mismatch_shrinks_the_face_contact_by_hand(gearbox_fmu):
     (te0, f0, k0), (te1, f1, k1) = mean[0.0], mean[20e-6]
     assert f1 == pytest.approx(f0, rel=0.02)              # the same torque is carried
     assert te1 - te0 == pytest.approx(np.sqrt(2 * 20e-6 * f1 / k1) - f0 / k0, rel=0.15)
+
+
+def test_a_housing_mode_filters_what_reaches_the_sensor(shafts_fmu, fmu_dir, shared_build):
+    """On a model with a sensor (GearTwin.Gearbox21Shafts) the mode is driven by the sensor's
+    reading, not by the pedestal: what it adds scales with the sensor's gain, as the rest does."""
+    from twin.effects import base_of, candidates_model
+    from twin.fmu import FMU
+    from twin.operating import simulate_operating_point
+
+    with FMU(shafts_fmu) as f:
+        cand = shared_build(candidates_model(base_of(f.parameter_values())), fmu_dir)
+    kw = dict(settle=0.02, duration=0.05, channels=["accel_pinion_casing"], output_interval=1e-5)
+    mode = {"housing_mode.participation": 1.0, "housing_mode.frequency": 2000.0}
+    added, offs = [], []
+    for gain in (1.0, 3.0):
+        off = simulate_operating_point(str(cand), 20, 20, parameters={"sensor_pinion.gain": gain}, **kw)[:, 0]
+        on = simulate_operating_point(str(cand), 20, 20, parameters={"sensor_pinion.gain": gain, **mode}, **kw)[:, 0]
+        added.append(on - off)
+        offs.append(off)
+    assert np.std(added[0]) > 0.01 * np.std(offs[0])
+    assert np.allclose(added[1], 3.0 * added[0], rtol=1e-6, atol=1e-6 * np.max(np.abs(added[1])))
