@@ -61,9 +61,10 @@ def _resonance(x: np.ndarray, fs: float, f0: float = 1500.0, gain_db: float = 20
 
 @pytest.mark.slow
 def test_a_path_error_in_every_record_is_not_blamed_on_an_effect_with_a_baseline(gearbox_fmu, candidates_fmu,
-                                                                                   executor):
+                                                                                   executor, tmp_path):
     """The gearbox's path has a resonance the model lacks, in the baseline and in the record; a
-    motor ripple appeared since. With the baseline the diagnosis names the ripple."""
+    motor ripple appeared since. With the baseline the diagnosis names the ripple; the
+    discrepancy learned from files once (as twin improve does) gives the same diagnosis."""
     from twin.effects.diagnose import diagnose
     from twin.effects.synthetic import calibrate_base, make_case
 
@@ -82,6 +83,27 @@ def test_a_path_error_in_every_record_is_not_blamed_on_an_effect_with_a_baseline
     assert (d.verdict, d.missing) == ("missing_effect", "motor_torque_ripple"), d.table()
     fitted = d.candidates[0].fitted["motor_torque_ripple.frequency"]
     assert fitted == pytest.approx(now.truth_parameters["motor_torque_ripple.frequency"], rel=0.01)
+
+    from dataclasses import replace
+
+    import yaml
+
+    from twin.effects.loop import learn_discrepancy, read_baseline
+    from twin.effects.records import read_records
+    from twin.effects.synthetic import write_case
+    from twin.scenario import load_scenario
+    files = {name: write_case(replace(case, signal=_resonance(case.signal, case.sample_rate)), tmp_path / f"{name}.h5")
+             for name, case in (("then", then), ("now", now))}
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump({"version": 1, "name": "s", "fmu": str(gearbox_fmu),
+                                                      "stop_time": 1.0, "parameters": params}))
+    scenario = load_scenario(tmp_path / "s.yaml")
+    learned = learn_discrepancy(scenario, files["now"], read_baseline(files["then"], scenario))
+    assert list(learned) == ["record"]
+    again = diagnose(gearbox_fmu, read_records(files["now"]), parameters=params, candidates_fmu=candidates_fmu,
+                     executor=executor, duration=now.duration, baseline=learned,
+                     effects=["motor_torque_ripple", "housing_mode", "load_torque_fluctuation"])
+    assert (again.verdict, again.missing) == (d.verdict, d.missing)
+    assert again.lsd_db == pytest.approx(d.lsd_db, rel=1e-6)
 
 
 def test_the_cli_refuses_a_baseline_it_cannot_use_by_name(tmp_path, gearbox_fmu, capsys):
