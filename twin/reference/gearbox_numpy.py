@@ -117,6 +117,7 @@ class GearboxParams:
     mesh_stiffness_scale: float = 1.0
     c_mesh: float = 1.1e3                # N.s/m, along the line of action
     contact_damping_width: float = 1e-8  # m, approach over which the mesh damping engages
+    lead_mismatch: float = 0.0           # m, lead mismatch of the flanks across the face (misalignment)
     mesh_phase0: float = 0.0             # rad, mesh phase at theta5 = 0
     contact_smoothing: float = 0.01      # fraction of the path of contact
     # ---- inertias [kg.m2] and masses [kg]
@@ -438,8 +439,16 @@ def _mesh(c: _Constants, x: np.ndarray) -> dict[str, np.ndarray]:
     deflection_rate = (c.rb1 * omega5 - c.rb2 * omega10
                        + (x[_I["vx5"]] - x[_I["vx10"]]) * c.sin_a
                        + (x[_I["vy5"]] - x[_I["vy10"]]) * c.cos_a)
-    # A pair whose flanks are apart (deviation larger than the approach) carries no load.
-    pair_force = pair_stiffness * np.maximum(0.0, deflection - pair_deviation)
+    # A pair whose flanks are apart (deviation larger than the approach) carries no load. With
+    # leads that differ by D across the face, a pair touches first at one face end: k a^2 / (2 D)
+    # while the length a/D of the face touches, k (a - D/2) once all of it does.
+    gap = deflection - pair_deviation
+    mismatch = abs(p.lead_mismatch)
+    if mismatch > 0:
+        pair_force = pair_stiffness * (np.clip(gap, 0.0, mismatch) ** 2 / (2 * mismatch)
+                                       + np.maximum(gap - mismatch, 0.0))
+    else:
+        pair_force = pair_stiffness * np.maximum(0.0, gap)
     # The flanks damp each other only while they touch; apart, the gears fly across the clearance.
     contact = np.minimum(1.0, (window * _clip01((deflection - pair_deviation) / p.contact_damping_width)).sum(axis=0))
     force = pair_force.sum(axis=0) + contact * p.c_mesh * deflection_rate

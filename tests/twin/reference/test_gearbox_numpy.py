@@ -62,7 +62,7 @@ def degraded_params() -> tuple[GearboxParams, dict[str, float]]:
 
 
 # ---- numpy model vs compiled FMU ------------------------------------------------------------
-@pytest.mark.parametrize("case", ["default", "degraded", "gear errors"])
+@pytest.mark.parametrize("case", ["default", "degraded", "gear errors", "misaligned"])
 def test_matches_compiled_fmu(gearbox_fmu, wheel_fmu, case):
     """20 ms at 1e-5 s output: accelerations and mesh force agree with the FMU to 1e-3 relative.
 
@@ -81,6 +81,8 @@ def test_matches_compiled_fmu(gearbox_fmu, wheel_fmu, case):
         wheel = 0.5e-6 * (1 - np.cos(2 * np.pi * np.arange(52) / 52 + 0.4))
         wheel[5] += 1.5e-6
         p, fmu = p.replace(wheel_tooth_deviation_offset=wheel), wheel_fmu
+    if case == "misaligned":
+        p = p.replace(lead_mismatch=15e-6)          # a few um of approach: the face partly in contact
     t, out = gn.simulate_rk4(p, u, stop_time=0.02, step=5e-6, output_interval=1e-5)
     ref = simulate_compiled(fmu, 0.02, 1e-5, {**p.fmu_start_values(), **u})
     assert ref["time"].shape == t.shape
