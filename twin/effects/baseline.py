@@ -3,28 +3,24 @@
 A twin calibrated to a gearbox it did not generate keeps a model-form error: modes it lacks, a
 transfer path that is not the gearbox's, mesh lines at other levels. That error is in every
 record of the gearbox, and on a rig it dwarfs what one missing effect adds (the calibrated
-base stands 9-29 dB from the rigs' records, a run-out adds ~14 dB at a few sidebands), so a
+base stands 9-14 dB from the rigs' records, a run-out adds ~14 dB at a few sidebands), so a
 flexible candidate fitted to the whole discrepancy absorbs the base's error instead of finding
-the effect. Records of the same gearbox taken before the effect (the records the twin was
-calibrated on) measure that error:
+the effect. A record of the same gearbox taken before the effect (a record the twin was
+calibrated on) measures that error. For each record diagnosed, at its own operating point:
 
-    delta(f) = L_measured,baseline(f) - L_model,baseline(f)   [dB]
+    delta(f) = L_baseline(f s_b / s) - L_model(f)   [dB]
 
-with the model simulated at the baseline record's own operating point, the levels those the
-diagnosis compares (:func:`twin.compare.spectral_levels`: Welch PSDs floored 3 dB above the
-measured noise, the model with that noise added and its gain aligned): where the measurement is
-only noise, delta is 0. A later record is then
-read through the model's eyes: its spectrum less delta, so that what stands between it and the
-model is what changed since (the missing effect) plus the estimates' scatter, and the candidates
-are fitted and judged on that. This is a model-discrepancy term learned on reference data
-(Kennedy and O'Hagan, J. R. Stat. Soc. B 63, 2001, 425-464), kept fixed while the effect is
-sought.
-
-Speeds differ between records (a drive's speed scatters by a few 0.1 %, which moves the 10th
-mesh harmonic by several 2 Hz bins), so delta is carried in shaft orders: at frequency f of a
-record turning at s, the correction is delta(f s_baseline / s). Content fixed in frequency
-(resonances) then moves by the speed ratio, a few 0.1 %, well inside a resonance's half-power
-band.
+the baseline's measured level carried to the record's speed in shaft orders (records a few
+0.1 % apart in speed keep their mesh lines aligned; content fixed in frequency moves by as much,
+well inside a resonance's half-power band), against the model simulated at the record's own
+operating point, the levels those the diagnosis compares (:func:`twin.compare.spectral_levels`:
+Welch PSDs floored 3 dB above the measured noise, the model with that noise added and its gain
+aligned; where the measurement is only noise, delta is 0). The record less delta is then the
+model's prediction plus what the measurement changed since the baseline: the model's own
+dependence on the operating point cancels, and so does its form error; the candidates are fitted
+and judged on the rest. This is a model-discrepancy term learned on reference data (Kennedy and
+O'Hagan, J. R. Stat. Soc. B 63, 2001, 425-464), kept fixed while the effect is sought: learned
+on the calibrated model, it anchors every later model (an effect added) to the calibrated one.
 
 Frequencies in Hz, speeds in Hz (pinion), levels in dB.
 """
@@ -42,10 +38,11 @@ MAX_DB = 60.0
 
 @dataclass(frozen=True)
 class Discrepancy:
-    """The model's discrepancy on one baseline record (measured minus model level [dB]).
+    """The model's discrepancy for one record (baseline measured minus model level [dB]).
 
     ``frequencies`` (m,) [Hz] and ``level_db`` (m,) on the Welch grid of the diagnosis's
-    objective; ``shaft_hz`` the baseline stretch's mean pinion speed [Hz].
+    objective at the record's speed ``shaft_hz`` [Hz] (mean pinion speed of its stretch);
+    ``record`` names the baseline record it was learned from.
     """
 
     record: str
@@ -65,11 +62,12 @@ class Discrepancy:
 
 @dataclass(frozen=True)
 class DiscrepancySpec:
-    """One baseline record to simulate (picklable, runs in a worker).
+    """One record's discrepancy to learn (picklable, runs in a worker): the model simulated at
+    the record's operating point against the baseline's measured stretch.
 
-    ``operating`` for a steady stretch (simulated with :func:`twin.operating.simulate_settled`),
-    or ``shaft_hz`` (n,) [Hz] for a run-up stretch (:func:`twin.effects.records.simulate_runup`);
-    ``measured`` (n,) the stretch.
+    ``operating`` of a steady record (simulated with :func:`twin.operating.simulate_settled`),
+    or ``shaft_hz`` (n,) [Hz] of a run-up stretch (:func:`twin.effects.records.simulate_runup`);
+    ``measured`` (n,) the baseline's stretch and ``baseline_hz`` its mean pinion speed [Hz].
     """
 
     record: str
@@ -83,10 +81,12 @@ class DiscrepancySpec:
     shaft_hz: np.ndarray | None = field(default=None, repr=False)
     slip_hz: float = 0.0
     solver_step: float | None = 1e-5
+    baseline_hz: float = 0.0
 
 
 def learn(spec: DiscrepancySpec) -> Discrepancy:
-    """Simulate the model on the baseline stretch and return its :class:`Discrepancy`."""
+    """Simulate the model at the record's operating point and return its :class:`Discrepancy`
+    to the baseline's measured stretch carried there in shaft orders."""
     from twin.compare import spectral_levels
     from twin.effects.fit import _Objective
     from twin.effects.records import simulate_runup
@@ -94,21 +94,25 @@ def learn(spec: DiscrepancySpec) -> Discrepancy:
     from twin.operating import simulate_settled
     from twin.signals import welch_psd
 
+    n = spec.measured.size
     if spec.shaft_hz is not None:
-        model = simulate_runup(spec.fmu_path, spec.parameters, spec.shaft_hz, spec.load, spec.sample_rate,
+        model = simulate_runup(spec.fmu_path, spec.parameters, spec.shaft_hz[-n:], spec.load, spec.sample_rate,
                                spec.channel, slip_hz=spec.slip_hz, solver_step=spec.solver_step)
-        speed = float(np.mean(spec.shaft_hz))
+        speed = float(np.mean(spec.shaft_hz[-n:]))
     else:
-        _, model = simulate_settled(spec.fmu_path, spec.parameters, spec.operating, spec.measured.size, spec.channel)
+        _, model = simulate_settled(spec.fmu_path, spec.parameters, spec.operating, n, spec.channel)
         speed = float(spec.operating.shaft_hz)
     if not np.all(np.isfinite(model)):
-        raise ParameterError(f"the current model does not run on baseline record {spec.record}")
+        raise ParameterError(f"the current model does not run at the operating point of the record "
+                             f"diagnosed against baseline {spec.record}")
     # on the objective's grid, band and levels (floored at the measured noise, the gain aligned),
     # so that a bin where the measurement is only noise is left alone rather than pulled down to
     # the model's numerical silence
     objective = _Objective(spec.measured, spec.sample_rate)
     f, pp = welch_psd(spec.measured, spec.sample_rate, resolution=objective.resolution)
-    _, pm = welch_psd(model[: spec.measured.size], spec.sample_rate, resolution=objective.resolution)
+    _, pm = welch_psd(model[:n], spec.sample_rate, resolution=objective.resolution)
+    ratio = spec.baseline_hz / speed if spec.baseline_hz > 0 else 1.0
+    pp = np.interp(f * ratio, f, pp)                    # the baseline at the record's speed, in orders
     lp, lm, _ = spectral_levels(pm[objective.band], pp[objective.band])
     level = np.zeros(f.size)
     level[objective.band] = lp - lm
@@ -159,9 +163,10 @@ def pair(records: Sequence, baseline: Sequence) -> dict[str, object]:
 def learn_all(fmu_path, parameters: Mapping[str, float], records: Sequence, baseline: Sequence, channel: str, *,
               duration: float, solver_step: float | None = 1e-5, held_out_runup: float = 2.0, slip_hz: float = 0.0,
               fit_load: float = 0.0, executor=None, progress: bool = False) -> dict[str, Discrepancy]:
-    """The model's :class:`Discrepancy` on each record's baseline, by record name (the steady
-    baselines over their last ``duration`` s, run-ups over their last ``held_out_runup`` s,
-    driven with the loaded motor's ``slip_hz`` at ``fit_load`` [N.m], scaled to their load).
+    """Each record's :class:`Discrepancy` to its baseline, by record name: the model at the
+    record's operating point (a steady record's last ``duration`` s; a run-up's last
+    ``held_out_runup`` s along its measured speed, driven with the loaded motor's ``slip_hz`` at
+    ``fit_load`` [N.m], scaled to its load) against the baseline's stretch as long.
     ``baseline`` may also be a mapping of record name to :class:`Discrepancy` already learned
     (:func:`twin.effects.loop.improve` learns it once, on the calibrated model, and keeps it
     while effects are added): it is then checked to cover every record and returned."""
@@ -175,25 +180,33 @@ def learn_all(fmu_path, parameters: Mapping[str, float], records: Sequence, base
                                  f"{', '.join(baseline) or 'none'})")
         return {r.name: baseline[r.name] for r in records}
     pairs = pair(records, baseline)
-    specs, names = [], {}
-    for b in {id(b): b for b in pairs.values()}.values():
-        if b.runup:
-            if b.shaft_hz is None:
-                raise ParameterError(f"baseline run-up {b.name} has no tachometer, encoder or speed channel")
-            m = int(round(min(held_out_runup, b.signal.size / b.sample_rate) * b.sample_rate))
-            slip = slip_hz * b.load / fit_load if fit_load else slip_hz
-            spec = DiscrepancySpec(b.name, str(fmu_path), dict(parameters), channel, b.signal[-m:], b.sample_rate,
-                                   b.load, shaft_hz=b.shaft_hz[-m:], slip_hz=slip, solver_step=solver_step)
+    specs = []
+    for r in records:
+        b = pairs[r.name]
+        if r.runup:
+            for rec in (r, b):
+                if rec.shaft_hz is None:
+                    raise ParameterError(f"run-up {rec.name} has no tachometer, encoder or speed channel")
+            m = int(round(min(held_out_runup, r.signal.size / r.sample_rate, b.signal.size / b.sample_rate)
+                          * r.sample_rate))
+            slip = slip_hz * r.load / fit_load if fit_load else slip_hz
+            specs.append(DiscrepancySpec(b.name, str(fmu_path), dict(parameters), channel, b.signal[-m:], r.sample_rate,
+                                         r.load, shaft_hz=r.shaft_hz[-m:], slip_hz=slip, solver_step=solver_step,
+                                         baseline_hz=float(np.mean(b.shaft_hz[-m:]))))
         else:
-            c = record_conditions(fmu_path, b.signal, b.sample_rate, b.nominal_speed, b.load, parameters,
-                                  record=b.name, duration=duration, solver_step=solver_step)
-            spec = DiscrepancySpec(b.name, str(fmu_path), dict(parameters), channel, c.measured, b.sample_rate,
-                                   b.load, operating=c.operating, solver_step=solver_step)
-        names[b.name] = len(specs)
-        specs.append(spec)
+            if b.sample_rate != r.sample_rate:
+                raise ParameterError(f"baseline {b.name} is sampled at {b.sample_rate:g} Hz, record {r.name} at "
+                                     f"{r.sample_rate:g} Hz")
+            c = record_conditions(fmu_path, r.signal, r.sample_rate, r.nominal_speed, r.load, parameters,
+                                  record=r.name, duration=duration, solver_step=solver_step)
+            cb = record_conditions(fmu_path, b.signal, b.sample_rate, b.nominal_speed, b.load, parameters,
+                                   record=b.name, duration=duration, solver_step=solver_step)
+            specs.append(DiscrepancySpec(b.name, str(fmu_path), dict(parameters), channel, cb.measured, r.sample_rate,
+                                         r.load, operating=c.operating, solver_step=solver_step,
+                                         baseline_hz=float(cb.operating.shaft_hz)))
     out = (executor.map(guarded_learn, specs, progress=progress, desc="baseline records") if executor is not None
            else [guarded_learn(sp) for sp in specs])
     bad = [(s.record, v) for s, v in zip(specs, out) if isinstance(v, Exception)]
     if bad:
         raise ParameterError(f"baseline record {bad[0][0]}: {bad[0][1]}")
-    return {r: out[names[b.name]] for r, b in pairs.items()}
+    return {r.name: d for r, d in zip(records, out)}
