@@ -31,6 +31,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from twin.effects.records import HeldOutSpec
+
 #: Bound of the learned discrepancy [dB]: beyond it a bin holds no information the
 #: correction could use (a model line 60 dB under the measured floor, say).
 MAX_DB = 60.0
@@ -61,26 +63,14 @@ class Discrepancy:
 
 
 @dataclass(frozen=True)
-class DiscrepancySpec:
+class DiscrepancySpec(HeldOutSpec):
     """One record's discrepancy to learn (picklable, runs in a worker): the model simulated at
-    the record's operating point against the baseline's measured stretch.
-
-    ``operating`` of a steady record (simulated with :func:`twin.operating.simulate_settled`),
-    or ``shaft_hz`` (n,) [Hz] of a run-up stretch (:func:`twin.effects.records.simulate_runup`);
-    ``measured`` (n,) the baseline's stretch and ``baseline_hz`` its mean pinion speed [Hz].
+    the record's operating point against the baseline's measured stretch; the fields of a
+    held-out run (:class:`twin.effects.records.HeldOutSpec`: ``operating`` of a steady record,
+    or ``shaft_hz`` (n,) [Hz] of a run-up stretch), ``measured`` (n,) the baseline's stretch and
+    ``baseline_hz`` its mean pinion speed [Hz].
     """
 
-    record: str
-    fmu_path: str
-    parameters: dict
-    channel: str
-    measured: np.ndarray = field(repr=False)
-    sample_rate: float
-    load: float
-    operating: object = None
-    shaft_hz: np.ndarray | None = field(default=None, repr=False)
-    slip_hz: float = 0.0
-    solver_step: float | None = 1e-5
     baseline_hz: float = 0.0
 
 
