@@ -1,7 +1,7 @@
 """Benchmark: `twin diagnose` on gearboxes the twin did not generate (rigs/pedestal, rigs/beam).
 
     python bench/diagnosis_rigs.py --calibrated bench_out/calibration_rigs [--rigs pedestal beam]
-                                   [--seed 1] [--effects ...] [--out bench_out/diagnosis_rigs]
+                                   [--seed 1] [--effects ...] [--baseline] [--out bench_out/diagnosis_rigs]
 
 Per rig: the gearbox ``Rig().scattered(seed, 0.12)`` that ``bench/calibration_rigs.py`` calibrated
 (its ``<rig>_<seed>_cal/calibrated.yaml`` under ``--calibrated``: the twin as well calibrated as
@@ -18,6 +18,12 @@ to; ``none`` -> "nothing missing"; an effect outside the catalogue -> "unexplain
 floor-aware, gain-free spectral distance of ``bench/spectral_distance.py`` (written apart from
 ``twin.compare``) between the record and (a) the calibrated twin, (b) the twin with the top
 candidate at its fitted values, both simulated at the operating point the diagnosis measured.
+
+With ``--baseline`` the diagnosis is given the records the gearbox was calibrated on (the file
+``bench/calibration_rigs.py`` wrote beside ``<rig>_<seed>_cal``) as its baseline
+(``twin diagnose --baseline``), and the change distance of ``bench/spectral_distance.py`` (the
+change since the calibration's steady record against the change the model shows) is reported
+beside the distance to the record.
 
 Cases already in --out/results.json for other rigs or effects are kept. Run once per method change; every figure goes to BENCHMARKS.md as measured. Prints a Markdown
 table; writes results.json under --out.
