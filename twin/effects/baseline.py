@@ -139,7 +139,8 @@ def pair(records: Sequence, baseline: Sequence) -> dict[str, object]:
             kind = "run-up" if r.runup else "steady record"
             raise ParameterError(f"no baseline for record {r.name}: the baseline records "
                                  f"({', '.join(c.name for c in baseline) or 'none'}) hold no {kind}")
-        if abs(r.nominal_speed / b.nominal_speed - 1) > SPEED_TOL or abs(r.load - b.load) > LOAD_TOL * max(b.load, 1e-9):
+        if (b.nominal_speed <= 0 or abs(r.nominal_speed / b.nominal_speed - 1) > SPEED_TOL
+                or abs(r.load - b.load) > LOAD_TOL * max(b.load, 1e-9)):
             raise ParameterError(f"baseline {b.name} was taken at {b.nominal_speed:g} Hz, {b.load:g} N.m and record "
                                  f"{r.name} at {r.nominal_speed:g} Hz, {r.load:g} N.m: a baseline stands for records "
                                  f"within {100 * SPEED_TOL:.0f} % of its speed and {100 * LOAD_TOL:.0f} % of its load")

@@ -46,6 +46,9 @@ def test_records_are_paired_with_their_baseline_by_name_then_by_kind():
     assert got["steady"] is base[0] and got["steady_2"] is base[0] and got["runup"] is base[1]
     with pytest.raises(ParameterError, match="no baseline for record runup.*hold no run-up"):
         pair([steady, runup], [rec("steady")])
+    standstill = Record("steady", rng.standard_normal(100), 1000.0, 0.0, 20.0, speed)
+    with pytest.raises(ParameterError, match="baseline steady was taken at 0 Hz"):
+        pair([steady], [standstill])
 
 
 def _resonance(x: np.ndarray, fs: float, f0: float = 1500.0, gain_db: float = 20.0, q: float = 8.0) -> np.ndarray:
