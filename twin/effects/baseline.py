@@ -174,6 +174,9 @@ def learn_all(fmu_path, parameters: Mapping[str, float], records: Sequence, base
     specs = []
     for r in records:
         b = pairs[r.name]
+        if b.sample_rate != r.sample_rate:
+            raise ParameterError(f"baseline {b.name} is sampled at {b.sample_rate:g} Hz, record {r.name} at "
+                                 f"{r.sample_rate:g} Hz")
         if r.runup:
             for rec in (r, b):
                 if rec.shaft_hz is None:
@@ -185,9 +188,6 @@ def learn_all(fmu_path, parameters: Mapping[str, float], records: Sequence, base
                                          r.load, shaft_hz=r.shaft_hz[-m:], slip_hz=slip, solver_step=solver_step,
                                          baseline_hz=float(np.mean(b.shaft_hz[-m:]))))
         else:
-            if b.sample_rate != r.sample_rate:
-                raise ParameterError(f"baseline {b.name} is sampled at {b.sample_rate:g} Hz, record {r.name} at "
-                                     f"{r.sample_rate:g} Hz")
             c = record_conditions(fmu_path, r.signal, r.sample_rate, r.nominal_speed, r.load, parameters,
                                   record=r.name, duration=duration, solver_step=solver_step)
             cb = record_conditions(fmu_path, b.signal, b.sample_rate, b.nominal_speed, b.load, parameters,
