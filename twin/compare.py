@@ -102,8 +102,13 @@ class Comparison:
 def compare_signals(model: np.ndarray, measured: np.ndarray, fs: float, shaft_hz: float, *,
                     z1: int = 19, z2: int = 52, fmin: float = 10.0, fmax: float = 5000.0,
                     resolution: float = 2.0, line_db: float = 6.0, resonance_db: float = 6.0,
-                    max_shaft_order: int = 4, n_harmonics: int | None = None, n_sidebands: int = 3) -> Comparison:
+                    max_shaft_order: int = 4, n_harmonics: int | None = None, n_sidebands: int = 3,
+                    discrepancy=None) -> Comparison:
     """Compare a simulated and a measured signal (both (n,), same ``fs`` [Hz]) of the same operating point.
+
+    ``discrepancy``: a known model-form error taken out of the measured levels first (an object
+    with ``at(frequencies) -> dB``, :class:`twin.effects.baseline.Discrepancy`): the distance and
+    the findings are then of what differs beyond it.
 
     ``shaft_hz`` is the pinion (input shaft) speed [Hz]; the gear turns at shaft_hz * z1 / z2.
     ``n_harmonics`` defaults to every mesh harmonic in the band: a resonance in the transfer path
@@ -121,6 +126,8 @@ def compare_signals(model: np.ndarray, measured: np.ndarray, fs: float, shaft_hz
     band = (f >= fmin) & (f <= min(fmax, fs / 2))
     f, pm, pp = f[band], pm[band], pp[band]
     lp, lm, gain_db = spectral_levels(pm, pp)
+    if discrepancy is not None:
+        lp = lp - discrepancy.at(f)
     d = lp - lm                                   # measured minus model [dB]
     d2 = d ** 2
     total = float(np.sum(d2)) or 1.0

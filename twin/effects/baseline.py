@@ -15,10 +15,13 @@ the baseline's measured level carried to the record's speed in shaft orders (rec
 well inside a resonance's half-power band), against the model simulated at the record's own
 operating point, the levels those the diagnosis compares (:func:`twin.compare.spectral_levels`:
 Welch PSDs floored 3 dB above the measured noise, the model with that noise added and its gain
-aligned; where the measurement is only noise, delta is 0). The record less delta is then the
-model's prediction plus what the measurement changed since the baseline: the model's own
-dependence on the operating point cancels, and so does its form error; the candidates are fitted
-and judged on the rest. This is a model-discrepancy term learned on reference data (Kennedy and
+aligned; where the measurement is only noise, delta is 0). The diagnosis then compares the
+record's levels less delta with the model's (in the comparison's own level domain, so that a
+record no different from its baseline stands exactly at the model: taking delta out of the
+signal instead moved the median the noise floor is read from, and left the record 5-7 dB from the
+model in quiet bands where nothing had changed): what is left is what the measurement changed
+since the baseline, the model's form error and its own dependence on the operating point
+cancelling; the candidates are fitted and judged on that. This is a model-discrepancy term learned on reference data (Kennedy and
 O'Hagan, J. R. Stat. Soc. B 63, 2001, 425-464), kept fixed while the effect is sought: learned
 on the calibrated model, it anchors every later model (an effect added) to the calibrated one.
 
@@ -52,14 +55,10 @@ class Discrepancy:
     frequencies: np.ndarray = field(repr=False)
     level_db: np.ndarray = field(repr=False)
 
-    def remove(self, x: np.ndarray, sample_rate: float, shaft_hz: float) -> np.ndarray:
-        """``x`` (n,) [m/s2] of a record turning at ``shaft_hz`` [Hz] with the discrepancy taken
-        out (zero-phase, in shaft orders): what the model should show if only the effect is missing."""
-        x = np.asarray(x, float)
-        spectrum = np.fft.rfft(x)
-        f = np.fft.rfftfreq(x.size, 1.0 / sample_rate)
-        d = np.interp(f * self.shaft_hz / shaft_hz, self.frequencies, self.level_db)
-        return np.fft.irfft(spectrum * 10.0 ** (-d / 20.0), x.size)
+    def at(self, frequencies: np.ndarray) -> np.ndarray:
+        """The discrepancy [dB] at ``frequencies`` (m,) [Hz] of the record's analysis (linear
+        between the learned bins; a shorter stretch's coarser grid reads it there)."""
+        return np.interp(np.asarray(frequencies, float), self.frequencies, self.level_db)
 
 
 @dataclass(frozen=True)

@@ -225,15 +225,12 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
     discrepancy: dict = {}
     if baseline is not None:
         from twin.effects.baseline import learn_all
-        known = baseline if isinstance(baseline, Mapping) else as_records(baseline)
-        discrepancy = learn_all(fmu_path, parameters, recs, known, channel, duration=duration,
+        given = baseline if isinstance(baseline, Mapping) else as_records(baseline)
+        discrepancy = learn_all(fmu_path, parameters, recs, given, channel, duration=duration,
                                 solver_step=solver_step, held_out_runup=held_out_runup,
                                 slip_hz=op.drive_hz - op.shaft_hz, fit_load=op.load, executor=ex, progress=progress)
-        conds = {name: replace(c, measured=discrepancy[name].remove(c.measured, c.operating.sample_rate,
-                                                                         c.operating.shaft_hz))
-                 for name, c in conds.items()}
-        measured = conds[fit_rec.name].measured
-    before = compare_signals(base_model, measured, sample_rate, shaft, z1=z1, z2=z2)
+    known = discrepancy.get(fit_rec.name)
+    before = compare_signals(base_model, measured, sample_rate, shaft, z1=z1, z2=z2, discrepancy=known)
 
     if candidates_fmu is None:
         from twin.effects.variant import _REPO_MODELICA, base_of, build_like, candidates_model
@@ -249,7 +246,8 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
             probe.update({e.parameter(k): v for k, v in e.neutral.items()})
     guesses = starting_values(before, measured, base_model, sample_rate, shaft, z1, z2)
     short = dict(search_samples=int(round(search * sample_rate)) if search else None, search_step=search_step)
-    specs = [TrialSpec(e, str(candidates_fmu), channel, measured, op, probe, guesses.get(e, {}), max_evals, **short)
+    specs = [TrialSpec(e, str(candidates_fmu), channel, measured, op, probe, guesses.get(e, {}), max_evals, **short,
+                       discrepancy=known)
              for e in ids]
     # the candidates with the most trials first, so that no worker is left with a long one at the end
     specs.sort(key=lambda sp: -_trials(CATALOGUE[sp.effect]))
@@ -266,19 +264,20 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
             cands.append(Candidate(eff.id, eff.title, 0.0, before.lsd_db, fitted, (), (), n_eval,
                                    "every trial of this effect failed to simulate"))
             continue
-        cands.append(_candidate(eff, before, fitted, n_eval, sim, measured, op, z1, z2))
+        cands.append(_candidate(eff, before, fitted, n_eval, sim, measured, op, z1, z2, known))
     cands.sort(key=lambda c: -c.score)
     # the leading candidates are tried again with their related base parameters refitted too
     lead = [c for c in cands[:related_leaders] if c.error is None and c.score > 0 and CATALOGUE[c.effect].related]
     specs2 = [TrialSpec(c.effect, str(candidates_fmu), channel, measured, op, probe, split_fitted(c.effect, c.fitted)[0],
                         max_evals, related=related_values(CATALOGUE[c.effect], probe, current), polish_only=True,
-                        related_anchor=dict(anchors or {}), **short)
+                        related_anchor=dict(anchors or {}), **short, discrepancy=known)
               for c in lead]
     for c, r in zip(lead, ex.map(_guarded_fit, specs2, progress=progress, desc="related base parameters")
                     if specs2 else ()):
         if isinstance(r, Exception) or r[3] is None:
             continue
-        joint = _candidate(CATALOGUE[c.effect], before, r[0], c.n_evaluations + r[2], r[3], measured, op, z1, z2)
+        joint = _candidate(CATALOGUE[c.effect], before, r[0], c.n_evaluations + r[2], r[3], measured, op, z1, z2,
+                           known)
         if joint.lsd_after_db < c.lsd_after_db:
             cands[cands.index(c)] = joint
     cands.sort(key=lambda c: -c.score)
@@ -294,17 +293,15 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
         for r in steady[1:]:
             c2 = conds[r.name]
             held.append((r.name, dict(measured=c2.measured, sample_rate=r.sample_rate, load=r.load,
-                                      operating=c2.operating)))
+                                      operating=c2.operating, discrepancy=discrepancy.get(r.name))))
         for r in runups:
             if r.shaft_hz is None:
                 raise ParameterError(f"run-up {r.name} has no tachometer, encoder or speed channel: its speed "
                                      "profile is needed to simulate it")
             m = int(round(min(held_out_runup, r.signal.size / r.sample_rate) * r.sample_rate))
-            stretch = r.signal[-m:]
-            if discrepancy:
-                stretch = discrepancy[r.name].remove(stretch, r.sample_rate, float(np.mean(r.shaft_hz[-m:])))
-            held.append((r.name, dict(measured=stretch, sample_rate=r.sample_rate, load=r.load,
-                                      shaft_hz=r.shaft_hz[-m:], slip_hz=slip * r.load / op.load if op.load else slip)))
+            held.append((r.name, dict(measured=r.signal[-m:], sample_rate=r.sample_rate, load=r.load,
+                                      shaft_hz=r.shaft_hz[-m:], slip_hz=slip * r.load / op.load if op.load else slip,
+                                      discrepancy=discrepancy.get(r.name))))
         fitting = [c for c in cands if fits(before, c, min_cut, min_db)]
         # nothing to test when no candidate fits: the base model is not run on the held-out records
         tasks = [HeldOutSpec(name, str(candidates_fmu), dict(probe), channel, solver_step=solver_step, **kw)

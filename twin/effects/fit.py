@@ -42,19 +42,23 @@ class TrialSpec:
     # once on the whole stretch at the operating point's step (None, None: search on that directly)
     search_samples: int | None = None
     search_step: float | None = None
+    # the record's known model-form error (twin.effects.baseline.Discrepancy), taken out of its levels
+    discrepancy: object = None
 
 
 class _Objective:
     """LSD [dB] between a simulated and the measured signal, the measured PSD computed once."""
 
     def __init__(self, measured: np.ndarray, fs: float, fmin: float = 10.0, fmax: float = 5000.0,
-                 resolution: float = 2.0):
+                 resolution: float = 2.0, discrepancy=None):
         from twin.signals import welch_psd
         self.fs, self.n = fs, measured.size
         self.resolution = max(resolution, 4.0 * fs / self.n)
         f, pp = welch_psd(measured, fs, resolution=self.resolution)
         self.band = (f >= fmin) & (f <= min(fmax, fs / 2))
         self.pp = pp[self.band]
+        # a known model-form error (twin.effects.baseline.Discrepancy) taken out of the measured levels
+        self.offset = discrepancy.at(f[self.band]) if discrepancy is not None else 0.0
 
     def __call__(self, simulated: np.ndarray) -> float:
         from twin.signals import welch_psd
@@ -62,7 +66,7 @@ class _Objective:
             return 1e3
         _, pm = welch_psd(simulated[: self.n], self.fs, resolution=self.resolution)
         lp, lm, _ = spectral_levels(pm[self.band], self.pp)
-        return float(np.sqrt(np.mean((lp - lm) ** 2)))
+        return float(np.sqrt(np.mean((lp - self.offset - lm) ** 2)))
 
 
 def simulate(fmu_path, parameters: Mapping[str, float], op: Operating, n: int, channel: str, *,
@@ -94,7 +98,7 @@ def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int, np.ndarra
     if spec.search_step is not None and op.solver_step is not None:
         op = replace(op, solver_step=spec.search_step)
     short = n_search < n or op != spec.operating        # search on a shorter or coarser run, score on the whole
-    objective = _Objective(spec.measured[-n_search:], spec.operating.sample_rate)
+    objective = _Objective(spec.measured[-n_search:], spec.operating.sample_rate, discrepancy=spec.discrepancy)
     fixed = dict(spec.parameters)
     params = list(eff.fit)
     free = [p for p in params if p.guess is None]
@@ -185,7 +189,7 @@ def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int, np.ndarra
         count += 1
         try:
             sim = simulate(spec.fmu_path, {**fixed, **fitted}, spec.operating, n, spec.channel)
-            val = _Objective(spec.measured, spec.operating.sample_rate)(sim)
+            val = _Objective(spec.measured, spec.operating.sample_rate, discrepancy=spec.discrepancy)(sim)
         except Exception:  # a fit that diverges on the whole stretch scores badly, as in the search
             sim, val = None, 1e3
     return fitted, val, count, sim

@@ -241,22 +241,22 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
                              record=rec.name, duration=duration)
     measured, current, z1, z2, op = cond.measured, cond.current, cond.z1, cond.z2, cond.operating
     shaft = op.shaft_hz
+    known = None
     if baseline is not None:
         from collections.abc import Mapping
 
         from twin.effects.baseline import learn_all
         from twin.effects.records import as_records, read_records
         this = read_records(measurements, channel, [rec.name])
-        known = baseline if isinstance(baseline, Mapping) else as_records(baseline)
-        measured = learn_all(current_fmu, base_params, this, known, channel,
-                             duration=duration)[rec.name].remove(measured, rec.sample_rate, shaft)
+        given = baseline if isinstance(baseline, Mapping) else as_records(baseline)
+        known = learn_all(current_fmu, base_params, this, given, channel, duration=duration)[rec.name]
     active = active_effects(current)
     if effect_id in active:
         raise ParameterError(f"the model {scenario.fmu} already has {effect_id}")
     # carry the active effects' values into the new variant so it reproduces the current model
     values = {k: v for k, v in current.items() if any(k.startswith(a + ".") for a in active)}
     sim0 = simulate(current_fmu, base_params, op, measured.size, channel)
-    before = compare_signals(sim0, measured, rec.sample_rate, shaft, z1=z1, z2=z2)
+    before = compare_signals(sim0, measured, rec.sample_rate, shaft, z1=z1, z2=z2, discrepancy=known)
     anchors, now = related_anchors(scenario, eff, base_params, current)
 
     # 1) the effect's parameters (and its related base parameters) in the candidate model
@@ -270,7 +270,7 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
                                         _REPO_MODELICA.parent / "build", cond.structural)
         probe = {**base_params, **values, **neutral_values(active)}
         spec = TrialSpec(effect_id, str(candidates_fmu), channel, measured, op, probe, guesses, max_evals,
-                         related=now, related_anchor=anchors)
+                         related=now, related_anchor=anchors, discrepancy=known)
         fitted, _, _, _ = fit_effect(spec)
     else:
         fitted = {**{eff.parameter(k): float(v) for k, v in guesses.items()},
@@ -286,7 +286,7 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
                                 modelica_dir)
     fmu_path = build_like(model, modelica_dir, build_dir, cond.structural)
     sim1 = simulate(fmu_path, base_params, op, measured.size, channel)
-    after = compare_signals(sim1, measured, rec.sample_rate, shaft, z1=z1, z2=z2)
+    after = compare_signals(sim1, measured, rec.sample_rate, shaft, z1=z1, z2=z2, discrepancy=known)
     per = tuple((f.description, _band_error(before, f.band_hz), _band_error(after, f.band_hz))
                 for f in before.findings)
     # 3) a scenario for the variant, so the next step (or twin run) starts from it; the model name

@@ -198,13 +198,14 @@ class HeldOutSpec:
     shaft_hz: np.ndarray | None = field(default=None, repr=False)
     slip_hz: float = 0.0
     solver_step: float | None = 1e-5
+    discrepancy: object = None          # the record's known model-form error (twin.effects.baseline)
 
 
 def held_out_lsd(spec: HeldOutSpec) -> float:
     """LSD [dB] of the model run against the held-out stretch (the diagnosis's fit objective)."""
     from twin.effects.fit import _Objective
     from twin.operating import simulate_at
-    objective = _Objective(spec.measured, spec.sample_rate)
+    objective = _Objective(spec.measured, spec.sample_rate, discrepancy=spec.discrepancy)
     if spec.shaft_hz is not None:
         sim = simulate_runup(spec.fmu_path, spec.parameters, spec.shaft_hz, spec.load, spec.sample_rate,
                              spec.channel, slip_hz=spec.slip_hz, solver_step=spec.solver_step)
