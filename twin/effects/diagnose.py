@@ -89,9 +89,10 @@ def _trials(eff: Effect) -> int:
 
 
 def _candidate(eff: Effect, before: Comparison, fitted: dict, n_eval: int, sim: np.ndarray, measured: np.ndarray,
-               op: Operating, z1: int, z2: int) -> Candidate:
-    """Score a fitted candidate against the baseline comparison."""
-    after = compare_signals(sim, measured, op.sample_rate, op.shaft_hz, z1=z1, z2=z2)
+               op: Operating, z1: int, z2: int, discrepancy=None) -> Candidate:
+    """Score a fitted candidate against the baseline comparison (``discrepancy``: the record's
+    known model-form error, taken out of the compared levels as in ``before``)."""
+    after = compare_signals(sim, measured, op.sample_rate, op.shaft_hz, z1=z1, z2=z2, discrepancy=discrepancy)
     score = max(0.0, (before.lsd_db - after.lsd_db) / before.lsd_db) if before.lsd_db > 0 else 0.0
     return Candidate(eff.id, eff.title, score, after.lsd_db, fitted, _explained(before, after, eff), after.findings,
                      n_eval)
