@@ -196,3 +196,46 @@ def test_a_housing_mode_filters_what_reaches_the_sensor(shafts_fmu, fmu_dir, sha
         offs.append(off)
     assert np.std(added[0]) > 0.01 * np.std(offs[0])
     assert np.allclose(added[1], 3.0 * added[0], rtol=1e-6, atol=1e-6 * np.max(np.abs(added[1])))
+
+
+@pytest.mark.parametrize("setting", [{"lead_mismatch": 30e-6}, {"pinion_eccentricity.wobble": 30e-6}])
+def test_the_face_law_is_the_sum_of_thin_slices_by_hand(candidates_fmu, setting):
+    """Thin slices across the face (the uncoupled springs of Velex & Maatar 1996 and of ISO 6336-1's
+    face load factor): a pair of stiffness k is N slices of k/N, slice j set back by D (j + 1/2)/N
+    along the line of action. Summed slice by slice from the FMU's own approach and roll, they give
+    each pair's force, in partial contact (a < D, as here at 20 N.m: a/D about 0.2) and, where the
+    wobble D = |w cos theta5| passes zero, with the whole face in contact."""
+    from twin.fmu import FMU
+    from twin.operating import operating_point
+
+    start, inputs = operating_point(20.0, 20.0)
+    names = ["theta5", "theta10", "x5", "y5", "x10", "y10"] + [f"roll[{i}]" for i in (1, 2, 3)] \
+        + [f"pair_force[{i}]" for i in (1, 2, 3)]
+    with FMU(candidates_fmu) as f:       # states are no outputs: stepped and read one sample at a time
+        v = f.parameter_values()
+        f.setup(0.0, parameters={**start, "pinion_eccentricity.eccentricity": 0.0, **setting}, inputs=inputs)
+        rb1, rb2, force_static = f.get(["rb1", "rb2", "mesh_force_static"])      # calculated parameters
+        f.step(0.05)
+        rows = []
+        for _ in range(6000):              # 0.06 s, more than a turn of the pinion
+            f.step(1e-5)
+            rows.append(f.get(names))
+    y = np.array(rows)
+    k_pair = np.array([v[f"k_pair[{n}]"] for n in range(1, 12)])
+    s = v["contact_smoothing"]
+    th5, th10, x5, y5, x10, y10 = y[:, :6].T
+    roll, pair_force = y[:, 6:9], y[:, 9:12]
+    a = (rb1 * th5 - rb2 * th10 + (x5 - x10) * np.sin(v["alpha"]) + (y5 - y10) * np.cos(v["alpha"]))
+    D = np.abs(setting.get("lead_mismatch", 0.0) + setting.get("pinion_eccentricity.wobble", 0.0) * np.cos(th5))
+    # away from the smoothed entry and exit of a pair: k is k_pair along the roll, or 0 outside the path
+    clear = np.all((np.abs(roll) > s) & (np.abs(roll - 1) > s), axis=1)
+    k = np.where((roll > 0) & (roll < 1), np.interp(np.clip(roll, 0, 1), np.linspace(0, 1, 11), k_pair), 0.0)
+    n = 4000
+    gaps = D[:, None] * (np.arange(n) + 0.5) / n
+    per_unit = np.maximum(0.0, a[:, None] - gaps).mean(axis=1)        # force of the slices per unit k
+    slices = k * per_unit[:, None]
+    assert clear.mean() > 0.8
+    assert np.mean(a[clear] < D[clear]) > 0.8                             # mostly partial face contact
+    np.testing.assert_allclose(pair_force[clear], slices[clear], rtol=1e-4, atol=1e-5 * force_static)
+    if "pinion_eccentricity.wobble" in setting:
+        assert np.any(a[clear] > D[clear])                                # and the whole face near D = 0
