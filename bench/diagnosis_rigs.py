@@ -1,7 +1,7 @@
 """Benchmark: `twin diagnose` on gearboxes the twin did not generate (rigs/pedestal, rigs/beam).
 
     python bench/diagnosis_rigs.py --calibrated bench_out/calibration_rigs [--rigs pedestal beam]
-                                   [--seed 1] [--effects ...] [--baseline] [--out bench_out/diagnosis_rigs]
+                                   [--seed 1] [--effects ...] [--no-baseline] [--out bench_out/diagnosis_rigs]
 
 Per rig: the gearbox ``Rig().scattered(seed, 0.12)`` that ``bench/calibration_rigs.py`` calibrated
 (its ``<rig>_<seed>_cal/calibrated.yaml`` under ``--calibrated``: the twin as well calibrated as
@@ -19,9 +19,9 @@ floor-aware, gain-free spectral distance of ``bench/spectral_distance.py`` (writ
 ``twin.compare``) between the record and (a) the calibrated twin, (b) the twin with the top
 candidate at its fitted values, both simulated at the operating point the diagnosis measured.
 
-With ``--baseline`` the diagnosis is given the records the gearbox was calibrated on (the file
+The diagnosis is given the records the gearbox was calibrated on (the file
 ``bench/calibration_rigs.py`` wrote beside ``<rig>_<seed>_cal``) as its baseline
-(``twin diagnose --baseline``), and the change distance of ``bench/spectral_distance.py`` (the
+(``twin diagnose --baseline``; ``--no-baseline``: without, the control), and the change distance of ``bench/spectral_distance.py`` (the
 change since the calibration's steady record against the change the model shows) is reported
 beside the distance to the record.
 
@@ -194,9 +194,10 @@ def main() -> None:
                          "twin.effects.diagnose.SEARCH_S)")
     ap.add_argument("--search-step", type=float, default=None,
                     help="RK4 step [s] of the search (0: the operating point's; default: SEARCH_STEP)")
-    ap.add_argument("--baseline", action="store_true",
+    ap.add_argument("--baseline", action=argparse.BooleanOptionalAction, default=True,
                     help="give the diagnosis the records the gearbox was calibrated on as its baseline "
-                         "(twin diagnose --baseline), and score the change since them")
+                         "(twin diagnose --baseline), and score the change since them (default; "
+                         "--no-baseline: the diagnosis against the calibrated model alone)")
     ap.add_argument("--out", type=Path, default=REPO / "bench_out" / "diagnosis_rigs")
     args = ap.parse_args()
 

@@ -170,7 +170,7 @@ def run_demo(out_dir: Path | str = "demo_out", *, stop_time: float = 10.0,
     history = None
     if hidden_effect_records and rig is not None:
         from twin.demo_rig import loop_demo
-        history = loop_demo(out_dir, hidden_effect_records, rig["scenario"])
+        history = loop_demo(out_dir, hidden_effect_records, rig["scenario"], rig["records"])
     else:
         _heading(8, "skipped: no rig records with a hidden effect, or no calibrated rig scenario from step 6 "
                     "(make demo writes both with python -m rigs.pedestal)")

@@ -105,7 +105,8 @@ def rig_calibration_demo(out_dir: Path, steady_file: Path, runup_file: Path, *ha
     _lines(f"twin compare on the calibrated scenario against the steady record: {comp.lsd_db:.1f} dB, "
            f"{len(comp.findings)} findings (what the twin still lacks: docs/diagnosis.md)")
     _written(png, report.scenario_file, out_dir / "calibration_rig" / "report.html")
-    return {"survey": survey, "report": report, "scenario": report.scenario_file, "compare_lsd_db": comp.lsd_db}
+    return {"survey": survey, "report": report, "scenario": report.scenario_file, "compare_lsd_db": comp.lsd_db,
+            "records": h5}
 
 
 def _shaft_reading(survey) -> str:
@@ -126,11 +127,12 @@ def _shaft_reading(survey) -> str:
             f"Hz; output shaft {', '.join(on['output']) or '-'} Hz; both {', '.join(on['both']) or '-'} Hz")
 
 
-def loop_demo(out_dir: Path, records, calibrated) -> dict:
+def loop_demo(out_dir: Path, records, calibrated, baseline=None) -> dict:
     """Step 8: ``twin diagnose`` and ``twin improve`` on a steady record and a run-up of step 6's
     gearbox of ``rigs/pedestal`` with one of the rig's own effects hidden (``records``: the two
     files, written by ``python -m rigs.pedestal ... --effect casing_resonance``), against step 6's
-    calibrated scenario ``calibrated``.
+    calibrated scenario ``calibrated``, with step 6's records (``baseline``: the file holding its
+    ``steady`` and ``runup``) as the baseline (``--baseline``): what changed since calibration.
 
     Writes ``loop/models.h5``: the model before (record ``before``) and after ``twin improve``
     (``after``; the same model when nothing was added), at the operating point the diagnosis
@@ -140,7 +142,7 @@ def loop_demo(out_dir: Path, records, calibrated) -> dict:
     import shutil
 
     from twin.demo import REPO, _heading, _lines, _written
-    from twin.effects.loop import diagnose_scenario, history_table, improve
+    from twin.effects.loop import diagnose_scenario, history_table, improve, learn_discrepancy, read_baseline
     from twin.executor import LocalExecutor
     from twin.measurements import Record, write_measurements
     from twin.operating import simulate_at
@@ -153,8 +155,11 @@ def loop_demo(out_dir: Path, records, calibrated) -> dict:
     h5 = merge_records(Path(records[0]), Path(records[1]), out_dir / "rig" / "pedestal_hidden.h5")
     scenario = load_scenario(calibrated)
     with LocalExecutor() as ex:
+        # the discrepancy learned once on the calibrated model, kept by the diagnosis and improve
+        known = (learn_discrepancy(scenario, h5, read_baseline(baseline, scenario, ["steady", "runup"]),
+                                   record=["steady", "runup"], executor=ex) if baseline is not None else None)
         diag = diagnose_scenario(scenario, h5, record=["steady", "runup"], json_path=loop / "diagnosis.json",
-                                 executor=ex, progress=False)
+                                 executor=ex, progress=False, baseline=known)
     took = time.perf_counter() - t
     # variants go into a copy of modelica/, so the demo leaves the repository untouched
     modelica = out_dir / "modelica"
@@ -162,7 +167,7 @@ def loop_demo(out_dir: Path, records, calibrated) -> dict:
         shutil.rmtree(modelica)
     shutil.copytree(REPO / "modelica", modelica, ignore=shutil.ignore_patterns("Variants"))
     history = improve(scenario, h5, loop, record=["steady", "runup"], max_steps=1, diagnosis=diag,
-                      modelica_dir=modelica, build_dir=out_dir / "build", progress=False)
+                      modelica_dir=modelica, build_dir=out_dir / "build", progress=False, baseline=known)
     after = load_scenario(loop / f"scenario_{history[-1].effect}.yaml") if history[-1].effect else scenario
     channel = (scenario.outputs or ("accel_pinion_casing",))[0]
     fs = diag.operating.sample_rate
@@ -172,7 +177,8 @@ def loop_demo(out_dir: Path, records, calibrated) -> dict:
               for name, s in (("before", scenario), ("after", after))]
     write_measurements(models, loop / "models.h5")
     _heading(8, "The loop on a gearbox the twin did not generate: step 6's rigs/pedestal gearbox with a "
-                "casing resonance hidden; twin diagnose --record steady --record runup, then twin improve",
+                "casing resonance hidden; twin diagnose --record steady --record runup --baseline (step 6's records), "
+                "then twin improve",
              time.perf_counter() - t)
     _lines(f"twin diagnose ({took:.0f} s; candidates searched on 1 s at a 20 us step, scored on 2 s at 10 us):")
     _lines(diag.table())
