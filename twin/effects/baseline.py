@@ -13,20 +13,21 @@ calibrated on) measures that error. For each record diagnosed, at its own operat
 the baseline's measured PSD as it would read at the record's speed: its lines (Lambda, the power
 6 dB or more above a 30 Hz running median) carried in shaft orders, since what is locked to a
 shaft moves with it, and the rest (B: the floor, the path's resonance humps, fixed in frequency)
-left where it is (carrying everything in orders moves a resonance as much as the lines: a
-Q = 8 path resonance at 1500 Hz stood 2.4 dB RMS off over 1300-1700 Hz between records 1.6 %
-apart in speed, 1.7 dB with the split, which is the two records' own estimation scatter). That is set against the model
-simulated at the record's own operating point, the levels those the diagnosis compares (:func:`twin.compare.spectral_levels`:
-Welch PSDs floored 3 dB above the measured noise, the model with that noise added and its gain
-aligned; where the measurement is only noise, delta is 0). The diagnosis then compares the
-record's levels less delta with the model's (in the comparison's own level domain, so that a
-record no different from its baseline stands exactly at the model: taking delta out of the
-signal instead moved the median the noise floor is read from, and left the record 5-7 dB from the
-model in quiet bands where nothing had changed): what is left is what the measurement changed
-since the baseline, the model's form error and its own dependence on the operating point
-cancelling; the candidates are fitted and judged on that. This is a model-discrepancy term learned on reference data (Kennedy and
-O'Hagan, J. R. Stat. Soc. B 63, 2001, 425-464), kept fixed while the effect is sought: learned
-on the calibrated model, it anchors every later model (an effect added) to the calibrated one.
+left where it is (carrying everything in orders moves a resonance as much as the lines: a Q = 8
+path resonance at 1500 Hz stood 2.4 dB RMS off over 1300-1700 Hz between records 1.6 % apart in
+speed, 1.7 dB with the split, which is the two records' own estimation scatter). That is set
+against the model simulated at the record's own operating point, the levels those the diagnosis
+compares (:func:`twin.compare.spectral_levels`: Welch PSDs floored 3 dB above the measured noise,
+the model with that noise added and its gain aligned; where the measurement is only noise, delta
+is 0). The diagnosis then compares the record's levels less delta with the model's (in the
+comparison's own level domain, so that a record no different from its baseline stands exactly at
+the model: taking delta out of the signal instead moved the median the noise floor is read from,
+and left the record 5-7 dB from the model in quiet bands where nothing had changed): what is left
+is what the measurement changed since the baseline, the model's form error and its own
+dependence on the operating point cancelling; the candidates are fitted and judged on that. This
+is a model-discrepancy term learned on reference data (Kennedy and O'Hagan, J. R. Stat. Soc. B
+63, 2001, 425-464), kept fixed while the effect is sought: learned on the calibrated model, it
+anchors every later model (an effect added) to the calibrated one.
 
 Frequencies in Hz, speeds in Hz (pinion), levels in dB.
 """
@@ -101,7 +102,7 @@ def learn(spec: DiscrepancySpec) -> Discrepancy:
     # so that a bin where the measurement is only noise is left alone rather than pulled down to
     # the model's numerical silence
     objective = _Objective(spec.measured, spec.sample_rate)
-    f, pp = welch_psd(spec.measured, spec.sample_rate, resolution=objective.resolution)
+    f, pp = objective.frequencies, objective.psd
     _, pm = welch_psd(model[:n], spec.sample_rate, resolution=objective.resolution)
     ratio = spec.baseline_hz / speed if spec.baseline_hz > 0 else 1.0
     pp = at_speed(f, pp, ratio)

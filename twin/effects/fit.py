@@ -54,11 +54,12 @@ class _Objective:
         from twin.signals import welch_psd
         self.fs, self.n = fs, measured.size
         self.resolution = max(resolution, 4.0 * fs / self.n)
-        f, pp = welch_psd(measured, fs, resolution=self.resolution)
-        self.band = (f >= fmin) & (f <= min(fmax, fs / 2))
-        self.pp = pp[self.band]
+        # the whole Welch grid and PSD [Hz, units^2/Hz] kept for a discrepancy learned on this grid
+        self.frequencies, self.psd = welch_psd(measured, fs, resolution=self.resolution)
+        self.band = (self.frequencies >= fmin) & (self.frequencies <= min(fmax, fs / 2))
+        self.pp = self.psd[self.band]
         # a known model-form error (twin.effects.baseline.Discrepancy) taken out of the measured levels
-        self.offset = discrepancy.at(f[self.band]) if discrepancy is not None else 0.0
+        self.offset = discrepancy.at(self.frequencies[self.band]) if discrepancy is not None else 0.0
 
     def __call__(self, simulated: np.ndarray) -> float:
         from twin.signals import welch_psd
