@@ -131,7 +131,7 @@ def _loop_arguments(p: argparse.ArgumentParser, *, out: bool, several: bool = Fa
     p.add_argument("--duration", type=float, default=2.0, help="seconds of the record compared (default: 2)")
     p.add_argument("--baseline", type=Path, metavar="FILE",
                    help="measurement file of the gearbox as the scenario's model was calibrated on it (before the "
-                        "effect sought): the model's discrepancy on it is taken out of the records first")
+                        "effect sought): the model's discrepancy on it is taken out of the compared levels first")
     p.add_argument("--baseline-record", action="append", metavar="NAME",
                    help="record of --baseline, repeatable (default: those named like --record)")
     if out:
