@@ -20,10 +20,10 @@ floor-aware, gain-free spectral distance of ``bench/spectral_distance.py`` (writ
 candidate at its fitted values, both simulated at the operating point the diagnosis measured.
 
 The diagnosis is given the records the gearbox was calibrated on (the file
-``bench/calibration_rigs.py`` wrote beside ``<rig>_<seed>_cal``) as its baseline
-(``twin diagnose --baseline``; ``--no-baseline``: without, the control), and the change distance of ``bench/spectral_distance.py`` (the
-change since the calibration's steady record against the change the model shows) is reported
-beside the distance to the record.
+``bench/calibration_rigs.py`` wrote beside ``<rig>_<seed>_cal``) as its baseline (``twin
+diagnose --baseline``; ``--no-baseline``: without, the control), and the change distance of
+``bench/spectral_distance.py`` (the change since the calibration's steady record against the
+change the model shows) is reported beside the distance to the record.
 
 Cases already in --out/results.json for other rigs or effects are kept. Run once per method change; every figure goes to BENCHMARKS.md as measured. Prints a Markdown
 table; writes results.json under --out.

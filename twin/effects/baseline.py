@@ -50,12 +50,11 @@ class Discrepancy:
     """The model's discrepancy for one record (baseline measured minus model level [dB]).
 
     ``frequencies`` (m,) [Hz] and ``level_db`` (m,) on the Welch grid of the diagnosis's
-    objective at the record's speed ``shaft_hz`` [Hz] (mean pinion speed of its stretch);
-    ``record`` names the baseline record it was learned from.
+    objective, learned with the model at the record's own operating point (so read at the
+    record's frequencies as they are); ``record`` names the baseline record it was learned from.
     """
 
     record: str
-    shaft_hz: float
     frequencies: np.ndarray = field(repr=False)
     level_db: np.ndarray = field(repr=False)
 
@@ -109,7 +108,7 @@ def learn(spec: DiscrepancySpec) -> Discrepancy:
     lp, lm, _ = spectral_levels(pm[objective.band], pp[objective.band])
     level = np.zeros(f.size)
     level[objective.band] = lp - lm
-    return Discrepancy(spec.record, speed, f, np.clip(level, -MAX_DB, MAX_DB))
+    return Discrepancy(spec.record, f, np.clip(level, -MAX_DB, MAX_DB))
 
 
 def at_speed(frequencies: np.ndarray, psd: np.ndarray, ratio: float, *, width_hz: float = 30.0,

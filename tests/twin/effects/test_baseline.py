@@ -37,7 +37,7 @@ def test_the_discrepancy_is_taken_out_of_the_compared_levels_by_hand():
     lp, lm, _ = spectral_levels(pm[objective.band], pp[objective.band])
     level = np.zeros(f.size)
     level[objective.band] = lp - lm
-    d = Discrepancy("then", 20.0, f, level)
+    d = Discrepancy("then", f, level)
     assert _Objective(same, fs)(model) > 2.0                          # the path resonance, 20 dB
     assert _Objective(same, fs, discrepancy=d)(model) < 0.2           # taken out: estimation scatter
     short = _Objective(same[-n // 2:], fs, discrepancy=d)
