@@ -202,6 +202,7 @@ model Gearbox21 "21-DOF lumped model of the UNSW spur-gear test rig (Feng et al.
   Real effect_pair_deviation[3](each unit = "m") = {0, 0, 0} "Extra material loss at the contact of each pair (leading, current, next): the gear's tooth errors (GearTwin.Variants.Gearbox21WheelErrors); added to pair_deviation";
   Real effect_mesh_displacement(unit = "m") = 0 "Rigid move of a gear along the line of action (run-out): extra approach of the flanks, and contact starting that much earlier along the path";
   Real effect_mesh_displacement_rate(unit = "m/s") = 0 "Time derivative of effect_mesh_displacement";
+  Real effect_off_line_displacement(unit = "m") = 0 "Rigid move of a gear normal to the line of action in the plane of the gears (run-out), positive where the centre distance shrinks: contact starts effect_off_line_displacement / tan(alpha) earlier along the path";
   Real effect_lead_mismatch(unit = "m") = 0 "Extra lead mismatch across the face (the wobble of a gear tilted on its shaft); added to lead_mismatch";
   Real effect_mesh_force(unit = "N") = 0 "Extra force along the line of action (back-flank contact)";
   Real effect_drive_torque(unit = "N.m") = 0 "Extra motor torque (torque ripple)";
@@ -256,7 +257,12 @@ equation
   // pair's roll, k_pair and the pinion's profile deviation stay), but the gear's tip reaches the
   // line u sooner, so contact starts u earlier along the path; the pinion's tip, which ends it,
   // stays at its roll. Elastic approach is local deformation, not a rigid move: it does not count.
-  window = {noEvent(min(1.0, max(0.0, (roll[i] + effect_mesh_displacement / contact_path_length + contact_smoothing) / (2 * contact_smoothing)))) ^ 2 * (3 - 2 * noEvent(min(1.0, max(0.0, (roll[i] + effect_mesh_displacement / contact_path_length + contact_smoothing) / (2 * contact_smoothing))))) * noEvent(min(1.0, max(0.0, (1 - roll[i] + contact_smoothing) / (2 * contact_smoothing)))) ^ 2 * (3 - 2 * noEvent(min(1.0, max(0.0, (1 - roll[i] + contact_smoothing) / (2 * contact_smoothing))))) for i in 1:3};
+  // A move w normal to the line (positive toward the other gear's side of it, where it shortens
+  // the centre distance a by w cos(alpha)) moves the gear's tip circle too: the path of contact
+  // starts where a sin(alpha') - sqrt(ra2^2 - rb2^2) from the pinion's base tangent, and
+  // d(a sin(alpha'))/da = 1/sin(alpha'), so contact starts w / tan(alpha) earlier (ISO 21771
+  // centre-distance geometry, to first order in w); run-out moves both, once per revolution.
+  window = {noEvent(min(1.0, max(0.0, (roll[i] + (effect_mesh_displacement + effect_off_line_displacement / tan(alpha)) / contact_path_length + contact_smoothing) / (2 * contact_smoothing)))) ^ 2 * (3 - 2 * noEvent(min(1.0, max(0.0, (roll[i] + (effect_mesh_displacement + effect_off_line_displacement / tan(alpha)) / contact_path_length + contact_smoothing) / (2 * contact_smoothing))))) * noEvent(min(1.0, max(0.0, (1 - roll[i] + contact_smoothing) / (2 * contact_smoothing)))) ^ 2 * (3 - 2 * noEvent(min(1.0, max(0.0, (1 - roll[i] + contact_smoothing) / (2 * contact_smoothing))))) for i in 1:3};
   // Each pair reads the entries of the tooth it holds (array indices computed without events:
   // a lookup, whatever z1 and n_profile), the leading pair the tooth ahead, the next pair the
   // tooth behind.

@@ -65,12 +65,15 @@ _GEOMETRY = {"roll_pitch": "roll_pitch", "contact_start_radius": "contact_start_
 
 def _eccentricity(gear: str) -> Effect:
     """Run-out of the pinion or the gear: one component, on that gear's shaft."""
-    shaft = {"pinion": ("theta5", "omega5"), "gear": ("theta10", "omega10")}[gear]
+    # the component reads its shaft's angle counter-clockwise in the plane of the line of action:
+    # the pinion's theta5; the gear turns the other way, theta10 counts its own sense
+    shaft = {"pinion": ("theta5", "omega5"), "gear": ("-theta10", "-omega10")}[gear]
     return Effect(
         f"{gear}_eccentricity", "GearTwin.Effects.ShaftEccentricity", f"{gear.capitalize()} run-out",
         inputs={"shaft_angle": shaft[0], "shaft_speed": shaft[1]},
         hooks={"effect_mesh_displacement": "mesh_displacement",
                "effect_mesh_displacement_rate": "mesh_displacement_rate",
+               "effect_off_line_displacement": "off_line_displacement",
                "effect_lead_mismatch": "lead_mismatch"},
         # a gear bored off-centre is usually bored off-square too: its tilt sweeps the lead
         # across the face once per turn (wobble), which at light load shrinks the contact
@@ -78,7 +81,8 @@ def _eccentricity(gear: str) -> Effect:
         # the mesh force of a run-out approach scales with the mesh stiffness
         related=("mesh_stiffness_scale",),
         neutral={"eccentricity": 0.0, "wobble": 0.0},
-        evidence={"sideband": f"run-out of the {gear} modulates the mesh approach once per {gear} revolution, "
+        evidence={"sideband": f"run-out of the {gear} modulates the mesh approach and the start of contact "
+                              f"(the centre distance) once per {gear} revolution, "
                               f"which puts sidebands at {gear}-speed spacing around the mesh harmonics",
                   "shaft_order": f"the once-per-revolution approach change excites the first {gear} orders",
                   "mesh_harmonic": "the modulation moves energy between the mesh harmonics and their sidebands; "

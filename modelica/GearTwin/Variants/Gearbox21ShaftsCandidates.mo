@@ -3,6 +3,7 @@ model Gearbox21ShaftsCandidates "GearTwin.Gearbox21Shafts with every catalogue e
   extends GearTwin.Gearbox21Shafts(
     effect_mesh_displacement = pinion_eccentricity.mesh_displacement + gear_eccentricity.mesh_displacement,
     effect_mesh_displacement_rate = pinion_eccentricity.mesh_displacement_rate + gear_eccentricity.mesh_displacement_rate,
+    effect_off_line_displacement = pinion_eccentricity.off_line_displacement + gear_eccentricity.off_line_displacement,
     effect_lead_mismatch = pinion_eccentricity.lead_mismatch + gear_eccentricity.lead_mismatch,
     effect_drive_torque = motor_torque_ripple.torque,
     effect_load_torque = load_torque_fluctuation.torque,
@@ -20,8 +21,8 @@ model Gearbox21ShaftsCandidates "GearTwin.Gearbox21Shafts with every catalogue e
     eccentricity = 0.0,
     wobble = 0.0) "Pinion run-out";
   GearTwin.Effects.ShaftEccentricity gear_eccentricity(
-    shaft_angle = theta10,
-    shaft_speed = omega10,
+    shaft_angle = -theta10,
+    shaft_speed = -omega10,
     eccentricity = 0.0,
     wobble = 0.0) "Gear run-out";
   GearTwin.Effects.MotorTorqueRipple motor_torque_ripple(

@@ -133,17 +133,22 @@ def test_a_twin_calibrated_on_the_casing_family_gets_its_candidates(shafts_fmu, 
     assert np.sqrt(np.mean((y2 - y0) ** 2)) > 1e-3 * np.sqrt(np.mean(y0 ** 2))
 
 
-def test_a_run_out_moves_the_start_of_contact_by_hand(candidates_fmu):
+@pytest.mark.parametrize("split", ["along", "normal"])
+def test_a_run_out_moves_the_start_of_contact_by_hand(candidates_fmu, split):
     """A gear moved bodily along the line of action by u starts each pair's contact u earlier
-    along the path: the share of a mesh cycle in double contact grows by u / p_b. Over the half
-    turn where e sin(theta) > 0 against the half where it is < 0 that is 4 e / (pi p_b), beyond
-    what the gearbox's own tooth errors make of the two halves without a run-out."""
+    along the path; moved by w normal to it (the centre distance shrinks by w cos(alpha)) it
+    starts w / tan(alpha) earlier (d(a sin(alpha'))/da = 1/sin(alpha')). The share of a mesh cycle
+    in double contact grows by that shift over p_b. With u = e sin(theta), w = e cos(theta), over
+    the half turn where sin(theta) > 0 against the other that is 4 e / (pi p_b); over the halves
+    of cos(theta), 4 e / (pi p_b tan(alpha)); beyond what the gearbox's own tooth errors make of
+    the two halves without a run-out."""
     from twin.fmu import FMU
     from twin.operating import simulate_operating_point
 
     with FMU(candidates_fmu) as f:
         v = f.parameter_values()
     p_b = np.pi * v["module"] * np.cos(v["alpha"])
+    expected = 4 * 1e-4 / (np.pi * p_b) / (1.0 if split == "along" else np.tan(v["alpha"]))
     kw = dict(settle=0.05, duration=0.2, channels=["mesh_stiffness", "encoder_pinion_angle"], output_interval=2e-6)
     shares = {}
     for e in (0.0, 1e-4):
@@ -152,9 +157,9 @@ def test_a_run_out_moves_the_start_of_contact_by_hand(candidates_fmu):
                                                  "pinion_eccentricity.phase": 0.0})
         k, angle = y[:, 0], y[:, 1]
         double = k > 0.5 * (np.percentile(k, 5) + np.percentile(k, 95))
-        ahead = np.sin(angle) > 0
+        ahead = (np.sin(angle) if split == "along" else np.cos(angle)) > 0
         shares[e] = float(np.mean(double[ahead]) - np.mean(double[~ahead]))
-    assert shares[1e-4] - shares[0.0] == pytest.approx(4 * 1e-4 / (np.pi * p_b), rel=0.15)
+    assert shares[1e-4] - shares[0.0] == pytest.approx(expected, rel=0.15)
 
 
 def test_a_lead_mismatch_shrinks_the_face_contact_by_hand(gearbox_fmu):
