@@ -71,6 +71,10 @@ CALIBRATION_SCHEMA: dict[str, Any] = {
                       "description": "fit: the pinion's as-manufactured profile deviation (slope and crowning, "
                                      "profile_deviation) fitted to the measured gear-mesh harmonics before the "
                                      "levels; none (default): perfect involutes"},
+        "face_contact_from": {"type": "string", "minLength": 1,
+                              "description": "a steady record at the steady record's speed and another load: the "
+                                             "flanks' lead mismatch (lead_mismatch) fitted to how the spectrum's "
+                                             "shape changes between the two loads, before the levels"},
         "path_sections": {"type": "integer", "minimum": 1, "maximum": 200,
                           "description": "second-order sections fitted to each measured path (default 32)"},
         "min_confidence": {"type": "number", "minimum": 0, "maximum": 1},

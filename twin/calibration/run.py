@@ -13,6 +13,8 @@ Scenario block (every key but ``parameters`` optional)::
       path_sections: 32           # second-order sections fitted to each measured path
       mesh_form: none             # or fit: the pinion's as-manufactured profile (slope, crowning)
                                   #   fitted to the measured mesh harmonics before the levels
+      face_contact_from: light    # a steady record at the same speed and another load: the flanks'
+                                  #   lead mismatch fitted to how the spectrum changes with load
       natural_frequencies: [22, 87, 218, 430]   # or typed by hand [Hz]
       foundation_modes: [13, 41]  # removed from the measured modes (paper: hammer test), in Hz
                                   #   or the name of a hammer-test record to read them from
@@ -121,8 +123,26 @@ def _mesh_form(scenario, fmu, parameters, rec, channel, target, settle, fmax, so
         raise MeasurementError(str(source or "<measurements>"), rec.name, f"{exc} (calibration.mesh_form: fit)") from None
 
 
+def _face_contact_record(scenario, mset, spec, rec, channel, source, measurements):
+    """``face_contact_from``'s record, checked against the steady record ``rec``: one speed, two loads."""
+    name = spec["face_contact_from"]
+    if name not in mset.names:
+        raise ScenarioError([(source, "calibration.face_contact_from", f"no record {name!r} in the measurements "
+                              f"(records: {', '.join(mset.names)})")])
+    other = _steady_record({"record": name}, mset, scenario, channel, 0.5, source, measurements)
+    if abs(other.nominal_speed - rec.nominal_speed) > 0.02 * rec.nominal_speed:
+        raise ScenarioError([(source, "calibration.face_contact_from", f"record {name!r} runs at "
+                              f"{other.nominal_speed:g} Hz, the steady record {rec.name!r} at {rec.nominal_speed:g} Hz: "
+                              "the load pair must share its speed (within 2 %)")])
+    if abs(other.load - rec.load) < 0.25 * max(abs(other.load), abs(rec.load)):
+        raise ScenarioError([(source, "calibration.face_contact_from", f"record {name!r} is at {other.load:g} N.m, "
+                              f"the steady record {rec.name!r} at {rec.load:g} N.m: the loads must differ by 25 % "
+                              "or more for the spectrum to show its load dependence")])
+    return other
+
+
 def _block(scenario, modes_from: str | None, pairing: str | None = None, foundation_from: str | None = None,
-           path_from: dict[str, str] | None = None) -> dict:
+           path_from: dict[str, str] | None = None, face_contact_from: str | None = None) -> dict:
     import jsonschema
 
     spec = scenario.raw.get("calibration")
@@ -141,6 +161,8 @@ def _block(scenario, modes_from: str | None, pairing: str | None = None, foundat
         spec["foundation_modes"] = foundation_from
     if path_from is not None:
         spec["path_from"] = dict(path_from)
+    if face_contact_from is not None:
+        spec["face_contact_from"] = face_contact_from
     errors = [(str(scenario.source), "calibration." + ".".join(map(str, e.absolute_path)),
                "must be 'auto' or a mapping of parameter name to [lower, upper]"
                if e.validator == "oneOf" else e.message)
@@ -153,12 +175,13 @@ def _block(scenario, modes_from: str | None, pairing: str | None = None, foundat
 def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Path, *, executor=None,
                     progress: bool = True, seed: int | None = None, resume: bool = False,
                     modes_from: str | list[str] | None = None, pairing: str | None = None,
-                    foundation_from: str | None = None, path_from: dict[str, str] | None = None
-                    ) -> CalibrationReport:
+                    foundation_from: str | None = None, path_from: dict[str, str] | None = None,
+                    face_contact_from: str | None = None) -> CalibrationReport:
     """Calibrate the scenario's FMU to a measurement file, or with ``measurements=None`` to the
     block's typed natural frequencies alone (see the module docstring); ``modes_from``,
-    ``pairing``, ``foundation_from`` (a hammer record: ``foundation_modes``) and ``path_from``
-    ({hammer record: bearing force}) override the calibration block's keys."""
+    ``pairing``, ``foundation_from`` (a hammer record: ``foundation_modes``), ``path_from``
+    ({hammer record: bearing force}) and ``face_contact_from`` (a steady record at another load)
+    override the calibration block's keys."""
     from twin._atomic import check_output_dir
     from twin.calibration.levels import fit_levels_and_panels, has_levels
     from twin.calibration.modal_fit import mode_errors, on_bounds
@@ -179,7 +202,7 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
     if measurements is None and scenario.raw.get("calibration") is None:
         raise ScenarioError([(source, "calibration", "the scenario has no calibration block: without --measurements "
                               "it must type the measured natural_frequencies [Hz]")])
-    spec = _block(scenario, modes_from, pairing, foundation_from, path_from)
+    spec = _block(scenario, modes_from, pairing, foundation_from, path_from, face_contact_from)
     pairing = spec.get("pairing", "frequency")
     visibility = spec.get("visibility", "mesh")
     fit = spec.get("fit", "follow")
@@ -187,6 +210,9 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
         if spec.get("path_from"):
             raise ScenarioError([(source, "calibration.path_from", "a measured path needs the measurement file "
                                   "that holds its hammer records (--measurements)")])
+        if spec.get("face_contact_from"):
+            raise ScenarioError([(source, "calibration.face_contact_from", "a load pair needs the measurement file "
+                                  "that holds its records (--measurements)")])
         objectives = modes_only_objectives(spec, source)
         speed_hz, load_nm = typed_operating_point(scenario, spec)
     with_path = bool(scenario.structural.get("n_path_sections"))
@@ -202,7 +228,7 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
     auto = spec["parameters"] == "auto"
     # the model's modes are read at the sensors the measured ones were seen by (those it has)
     outputs = _outputs(fmu)
-    rec = None
+    rec, light = None, None
     if measurements is None:
         freqs, rel_sd, modes_what, damping, confidence, seen_by, shapes = measured_modes(spec, None, source, out_dir,
                                                                                          with_damping=True)
@@ -214,6 +240,8 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
         freqs, rel_sd, modes_what, damping, confidence, seen_by, shapes = measured_modes(spec, mset, source, out_dir,
                                                                                          with_damping=True)
         rec = _steady_record(spec, mset, scenario, channel, duration, source, measurements)
+        light = (_face_contact_record(scenario, mset, spec, rec, channel, source, measurements)
+                 if spec.get("face_contact_from") else None)     # refused before the modes fit
         if spec.get("path_from"):     # refused before the modes fit
             from twin.calibration.transfer_path import check_path_from
             path_channels = check_path_from(scenario, mset, spec, source, outputs)
@@ -301,6 +329,17 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
             chosen.update(form.parameters)
             if progress:
                 print(form.describe())
+        contact = None
+        if rec is not None and light is not None:
+            # the flanks' lead mismatch from how the spectrum changes with load (path and gain divide out)
+            from twin.calibration.face_contact import fit_face_contact
+            contact = fit_face_contact(spectrum_fmu, {**fixed, **chosen},
+                                       [(np.asarray(rec[channel], float), rec.load),
+                                        (np.asarray(light[channel], float), light.load)],
+                                       channel, rec.sample_rate, target.drive_hz, executor=ex, progress=progress)
+            chosen.update(contact.parameters)
+            if progress:
+                print(contact.describe())
         if rec is not None and has_levels(spectrum_fmu, channel):
             # the level of the spectrum: sensor gain, roughness and process-force levels (three runs)
             level_kw = dict(speed_hz=target.drive_hz, load_nm=target.load, channel=channel, fmin=band[0],
@@ -326,8 +365,12 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
         from twin.calibration.mesh_form import BOUND
         warnings.append(f"{form.describe()}: on the bound of +-{1e6 * BOUND:g} um (about ISO 1328-1 grade 9); "
                         "the mesh harmonics ask for more than a gear's profile deviation")
+    if contact is not None and contact.on_bound():
+        warnings.append(f"{contact.describe()}: on the bound of {1e6 * max(contact.grid):g} um; the load dependence "
+                        "asks for more than a misaligned pair")
     notes = tuple(n for n in (path_note, measured_path.describe() if measured_path is not None else None,
                               form.describe() if form is not None else None,
+                              contact.describe() if contact is not None else None,
                               f"levels: {levels.describe()}" if levels is not None else None) if n)
     if progress:
         for w in warnings:
@@ -372,7 +415,7 @@ def _steady_record(spec: dict, mset, scenario, channel: str, duration: float, so
 
     # the first record that neither gives the modes nor is the foundation's hammer test
     not_steady = {*modes_records(spec), spec.get("foundation_modes") if isinstance(spec.get("foundation_modes"), str)
-                  else None}
+                  else None, spec.get("face_contact_from")}
     steady_name = spec.get("record") or next((n for n in mset.names if n not in not_steady), mset.names[0])
     if steady_name not in mset.names:
         raise ScenarioError([(source, "calibration.record", f"no record {steady_name!r} in the measurements")])

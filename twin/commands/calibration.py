@@ -29,6 +29,9 @@ def add_subcommands(sub) -> None:
                    help="a hammer record struck at a bearing housing and the model's bearing force its blow stands "
                         "for (e.g. hammer_pinion=bearing_force_input_y; repeat per record): the casing sensors then "
                         "read the model's bearing forces through the measured path (calibration.path_from)")
+    p.add_argument("--face-contact-from", metavar="RECORD",
+                   help="a steady record at the steady record's speed and another load: the flanks' lead mismatch "
+                        "fitted to how the spectrum changes with load (calibration.face_contact_from)")
     _add_pairing_option(p)
     p.add_argument("--no-progress", action="store_true", help="quiet")
     p.set_defaults(handler=_cmd_calibrate)
@@ -55,7 +58,8 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
                                                           resume=args.resume, modes_from=args.modes_from,
                                                           pairing=args.pairing,
                                                           foundation_from=args.foundation_from,
-                                                          path_from=dict(args.path_from) if args.path_from else None)
+                                                          path_from=dict(args.path_from) if args.path_from else None,
+                                                          face_contact_from=args.face_contact_from)
     print(f"modes: {report.modes_source}")
     print(report.table())
     for n in report.notes:

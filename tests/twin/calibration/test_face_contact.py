@@ -1,0 +1,73 @@
+"""The flanks' lead mismatch fitted to a load pair (calibration.face_contact_from)."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from twin.calibration.face_contact import choose, fit_face_contact, ratio_distance, smoothed_db
+
+CH = "accel_pinion_casing"
+FS = 25600.0
+GRID = (0.0, 5e-6, 15e-6, 30e-6)
+
+
+def test_the_smallest_lead_mismatch_within_the_tolerance_is_taken():
+    grid = (0.0, 5e-6, 10e-6, 20e-6)
+    assert choose([6.0, 5.0, 3.9, 3.8], grid) == 10e-6          # 3.9 is within 0.25 dB of 3.8
+    assert choose([6.0, 5.0, 4.2, 3.8], grid) == 20e-6
+    assert choose([4.0, 4.1, 4.2, 3.9], grid) == 0.0            # a flat ratio keeps the aligned pair
+
+
+def test_the_ratio_distance_is_gain_free_and_smoothing_removes_the_lines():
+    rng = np.random.default_rng(0)
+    a = rng.normal(size=4000)
+    assert ratio_distance(a, a + 7.0) == pytest.approx(0.0, abs=1e-12)
+    assert ratio_distance(a, -a) > 1.0
+    # white noise with a strong line every 380 Hz: the smoothed PSD is flat within 1 dB over 1-8 kHz
+    t = np.arange(int(2 * FS)) / FS
+    x = rng.normal(size=t.size) + sum(3.0 * np.sin(2 * np.pi * 380.0 * h * t) for h in range(3, 20))
+    f, db = smoothed_db(x, FS)
+    band = (f > 1500) & (f < 7000)
+    assert np.ptp(db[band]) < 1.5
+
+
+def _pair(fmu, lead_mismatch, seed=0):
+    from twin.operating import simulate_operating_point
+    rng = np.random.default_rng(seed)
+    out = []
+    for load in (20.0, 5.0):
+        y = simulate_operating_point(fmu, 20.0, load, parameters={"lead_mismatch": lead_mismatch}, settle=0.3,
+                                     duration=1.0, channels=[CH], output_interval=1.0 / FS)[:, 0]
+        out.append((3.0 * y + rng.normal(0.0, 1e-3 * y.std(), y.size), load))     # a gain the fit must not see
+    return out
+
+
+@pytest.mark.parametrize("made_with", [15e-6, 0.0])
+def test_the_fit_finds_the_lead_mismatch_the_records_were_made_with(measured_fmu, made_with):
+    fit = fit_face_contact(measured_fmu, {}, _pair(measured_fmu, made_with), CH, FS, 20.0, duration=1.0, grid=GRID)
+    assert fit.lead_mismatch == pytest.approx(made_with, abs=1e-12), fit.describe()
+    d = dict(zip(fit.grid, fit.distances_db))
+    if made_with:
+        # an aligned pair's mesh mode does not move with load: its ratio is far from the records'
+        assert d[0.0] > d[made_with] + 1.0, fit.describe()
+        assert not fit.on_bound() and fit.parameters == {"lead_mismatch": made_with}
+
+
+def test_a_load_pair_that_is_not_one_speed_and_two_loads_is_refused_by_name():
+    from twin.calibration.run import _face_contact_record
+    from twin.errors import ScenarioError
+    from twin.measurements import MeasurementSet, Record
+    from twin.scenario import scenario_from_dict
+
+    x = np.zeros(int(FS))
+    rec = lambda name, speed, load: Record(name, {CH: x}, {CH: "m/s2"}, FS, nominal_speed=speed, load=load)
+    steady = rec("steady", 20.0, 20.0)
+    mset = MeasurementSet((steady, rec("light", 20.0, 5.0), rec("fast", 25.0, 5.0), rec("same", 20.0, 18.0)))
+    sc = scenario_from_dict({"version": 1, "name": "m", "fmu": "x.fmu", "stop_time": 0.1,
+                             "output": {"sample_rate": FS, "variables": [CH]}})
+    assert _face_contact_record(sc, mset, {"face_contact_from": "light"}, steady, CH, "s.yaml", "m.h5").name == "light"
+    for name, msg in (("dark", "no record 'dark' in the measurements"),
+                      ("fast", "runs at 25 Hz, the steady record 'steady' at 20 Hz"),
+                      ("same", "is at 18 N.m, the steady record 'steady' at 20 N.m: the loads must differ")):
+        with pytest.raises(ScenarioError, match=msg):
+            _face_contact_record(sc, mset, {"face_contact_from": name}, steady, CH, "s.yaml", "m.h5")
