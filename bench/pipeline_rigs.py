@@ -3,6 +3,7 @@
     python bench/pipeline_rigs.py [--rigs pedestal,beam] [--tasks pitting,wear] [--members 5]
                                   [--epochs 80] [--retrainings 3] [--per-stage 8] [--jobs 2]
                                   [--out bench_out/pipeline_rigs] [--arms path,calibrated,default]
+                                  (arms also: path_form, path_contact)
                                   [--no-ablation] [--no-reversal]
 
 For each rig (``rigs/``, used as black boxes through their public interface, defaults fixed) and
@@ -22,7 +23,10 @@ each test (pitting: 6 stages at 20 Hz / 20 N.m; wear: 4 stages at 10 Hz / 5 N.m)
    healthy records too and measure the path to the sensor (``path_from``: the pinion's support for
    ``bearing_force_input_y``, the gear's for ``bearing_force_output_y``), so the archive is simulated
    through the rig's measured path; arm ``path_form``: the same with the pinion's profile fitted to
-   the mesh lines (``calibration.mesh_form: fit``); arm ``calibrated``: the modelled path;
+   the mesh lines (``calibration.mesh_form: fit``); arm ``path_contact``: the same as ``path`` with a
+   healthy steady record at another load (``light``: 5 N.m for pitting, 20 N.m for wear, seed 105)
+   and the flanks' lead mismatch fitted to the load pair (``calibration.face_contact_from``); arm
+   ``calibrated``: the modelled path;
 3. **retrainings**: the ensemble trained again ``retrainings - 1`` times with disjoint seeds on the
    same archive, for the spread of the ensemble's accuracy (the calibrated arms);
 4. **ablation**: the same pipeline with the default (uncalibrated) twin, one ensemble; every
@@ -61,7 +65,8 @@ HAMMER_SEEDS = (103, 104)
 #: Where the path's blows strike each rig (its bearing supports) and the twin's bearing force each stands for.
 PATH_BLOWS = {"pedestal": ("pinion_pedestal", "gear_pedestal"), "beam": ("pinion_housing", "gear_housing")}
 PATH_FORCES = ("bearing_force_input_y", "bearing_force_output_y")
-ARMS = {"path_form": "calibrated, measured path, fitted profile", "path": "calibrated, measured path",
+ARMS = {"path_contact": "calibrated, measured path, lead mismatch from a load pair",
+        "path_form": "calibrated, measured path, fitted profile", "path": "calibrated, measured path",
         "calibrated": "calibrated", "default": "default"}
 CHANNEL = "accel_pinion_casing"
 
@@ -111,12 +116,8 @@ def path_data(name: str, task: str, per_stage: int, data: Path) -> tuple[Path, d
     if path_file.exists() and key.exists() and key.read_text() == wanted:
         return path_file, path_from
     box, write = _rig(name)
-    _, _, load = TESTS[task]
-    blows = [box.impact(speed=0.5, load=load, duration=8.0, impacts_per_second=4.0, location=loc, seed=seed,
-                        name=f"hammer_{loc}") for loc, seed in zip(PATH_BLOWS[name], HAMMER_SEEDS)]
     # the same records as rig_file (re-simulated with the same seeds), then the blows
-    healthy = [dataclasses.replace(r, name=n) for r, n in zip(_healthy(name, box, task), ("runup", "steady"))]
-    write(str(path_file), healthy + _stage_records(name, box, task, per_stage, ADAPT_SEED) + blows)
+    write(str(path_file), _rig_records(name, box, task, per_stage))
     # the stage records must be the ones the other arms adapt to
     a, b = load_measurements(rig_file, channels=[CHANNEL]), load_measurements(path_file, channels=[CHANNEL])
     for r in a.records:
@@ -125,6 +126,45 @@ def path_data(name: str, task: str, per_stage: int, data: Path) -> tuple[Path, d
             raise SystemExit(f"{path_file}: record {r.name} differs from {rig_file}'s; the rig is not repeatable")
     key.write_text(wanted)
     return path_file, path_from
+
+
+#: The other load of the load pair [N.m] (``path_contact``: a healthy steady record at the test's speed), its seed.
+CONTACT_LOAD, CONTACT_SEED = {"pitting": 5.0, "wear": 20.0}, 105
+
+
+def contact_data(name: str, task: str, per_stage: int, data: Path) -> tuple[Path, dict]:
+    """(the file of :func:`path_data` with a healthy steady record at :data:`CONTACT_LOAD` added as
+    ``light``, path_from); cached."""
+    from twin.measurements import load_measurements
+    path_file, path_from = path_data(name, task, per_stage, data)
+    file, key = data / f"{name}_{task}_contact.h5", data / f"{name}_{task}_contact.json"
+    wanted = json.dumps({"path_file": (data / f"{name}_{task}_path.json").read_text(),
+                         "load": CONTACT_LOAD[task], "seed": CONTACT_SEED})
+    if file.exists() and key.exists() and key.read_text() == wanted:
+        return file, path_from
+    box, write = _rig(name)
+    _, speed, _ = TESTS[task]
+    light = box.steady(speed=speed, load=CONTACT_LOAD[task], duration=2.0, seed=CONTACT_SEED, name="light")
+    records = list(load_measurements(path_file).records)
+    write(str(file), [*_rig_records(name, box, task, per_stage), light])
+    b = load_measurements(file)
+    for r in records:
+        for c in r.channel_names:
+            if not np.array_equal(np.asarray(r[c]), np.asarray(b[r.name][c])):
+                file.unlink()
+                raise SystemExit(f"{file}: record {r.name} differs from {path_file}'s; the rig is not repeatable")
+    key.write_text(wanted)
+    return file, path_from
+
+
+def _rig_records(name: str, box, task: str, per_stage: int) -> list:
+    """The healthy records, the adaptation stage records and two blows at the bearing supports
+    (the records of :func:`path_data`'s file), simulated with their fixed seeds."""
+    _, _, load = TESTS[task]
+    healthy = [dataclasses.replace(r, name=n) for r, n in zip(_healthy(name, box, task), ("runup", "steady"))]
+    blows = [box.impact(speed=0.5, load=load, duration=8.0, impacts_per_second=4.0, location=loc, seed=seed,
+                        name=f"hammer_{loc}") for loc, seed in zip(PATH_BLOWS[name], HAMMER_SEEDS)]
+    return healthy + _stage_records(name, box, task, per_stage, ADAPT_SEED) + blows
 
 
 def _healthy(name: str, box, task: str) -> list:
@@ -177,8 +217,13 @@ def run_arm(name: str, task: str, arm: str, args, out: Path) -> dict:
     if arm in ("path", "path_form"):
         rig_file, path_from = path_data(name, task, args.per_stage, out / "data")
         healthy += tuple(path_from)
+    if arm == "path_contact":
+        rig_file, path_from = contact_data(name, task, args.per_stage, out / "data")
+        healthy += (*path_from, "light")
     if arm == "path_form":
         scenario = _with_mesh_form(scenario, out / "scenarios")
+    if arm == "path_contact":
+        scenario = _with_calibration(scenario, out / "scenarios", "face_contact", face_contact_from="light")
     t = time.perf_counter()
     run_pipeline(PipelinePlan(rig_file, healthy, scenario, d, members=args.members,
                               epochs=args.epochs, jobs=args.jobs, calibrate=arm != "default", time_ordered=True,
@@ -199,13 +244,18 @@ def run_arm(name: str, task: str, arm: str, args, out: Path) -> dict:
 
 def _with_mesh_form(scenario: Path, where: Path) -> Path:
     """A copy of ``scenario`` whose calibration block is the pipeline's with ``mesh_form: fit``."""
+    return _with_calibration(scenario, where, "mesh_form", mesh_form="fit")
+
+
+def _with_calibration(scenario: Path, where: Path, tag: str, **keys) -> Path:
+    """A copy of ``scenario`` whose calibration block is the pipeline's with ``keys`` added."""
     import yaml
 
     from twin.pipeline.run import CALIBRATION
     raw = yaml.safe_load(scenario.read_text())
-    raw["calibration"] = {**CALIBRATION, "mesh_form": "fit"}
+    raw["calibration"] = {**CALIBRATION, **keys}
     where.mkdir(parents=True, exist_ok=True)
-    path = where / f"{scenario.stem}_mesh_form.yaml"
+    path = where / f"{scenario.stem}_{tag}.yaml"
     path.write_text(yaml.safe_dump(raw, sort_keys=False))
     return path
 
