@@ -10,6 +10,10 @@ and ``steady``; ``twin`` never imports ``rigs``). The step does what a user does
     twin calibrate scenario.yaml --measurements rig.h5 --modes-from runup --out calibration_rig/
     twin compare calibration_rig/calibrated.yaml --measurements rig.h5 --record steady
 
+With a steady record at another load (``light``) the step also shows what the opt-in
+``--face-contact-from light`` fits: the flanks' lead mismatch from how the spectrum changes with
+load (:mod:`twin.calibration.face_contact`).
+
 With both hammer records (blows at the pinion's and the gear's pedestal) the twin is
 ``GearTwin.Gearbox21Shafts`` and its casing sensors read the path those blows measured
 (``calibration.path_from``, :mod:`twin.calibration.transfer_path`); without them,
@@ -32,18 +36,23 @@ STRUCK = {"hammer": "input", "hammer_gear": "output"}
 PATH_FROM = {"hammer": "bearing_force_input_y", "hammer_gear": "bearing_force_output_y"}
 
 
-def merge_records(steady_file: Path, runup_file: Path, out: Path, *hammer_files: Path) -> Path:
+#: The names of the optional records after the steady one and the run-up, in the order given.
+EXTRA = (*STRUCK, "light")
+
+
+def merge_records(steady_file: Path, runup_file: Path, out: Path, *more_files: Path) -> Path:
     """One measurement file holding the first record of each file, named ``steady``, ``runup`` and
-    (when given) ``hammer`` and ``hammer_gear`` (blows at the pinion's, then the gear's pedestal)."""
+    (when given) ``hammer`` and ``hammer_gear`` (blows at the pinion's, then the gear's pedestal) and
+    ``light`` (a steady record at the same speed and another load)."""
     from twin.measurements import load_measurements, write_measurements
 
     records = [replace(load_measurements(steady_file)[0], name="steady"),
                replace(load_measurements(runup_file)[0], name="runup")]
-    records += [replace(load_measurements(f)[0], name=name) for f, name in zip(hammer_files, STRUCK)]
+    records += [replace(load_measurements(f)[0], name=name) for f, name in zip(more_files, EXTRA)]
     return write_measurements(records, out)
 
 
-def rig_calibration_demo(out_dir: Path, steady_file: Path, runup_file: Path, *hammer_files: Path) -> dict:
+def rig_calibration_demo(out_dir: Path, steady_file: Path, runup_file: Path, *more_files: Path) -> dict:
     """Step 6 (see the module docstring); returns the paths and headline numbers."""
     from twin.calibration.run import run_calibration
     from twin.compare import compare
@@ -56,7 +65,7 @@ def rig_calibration_demo(out_dir: Path, steady_file: Path, runup_file: Path, *ha
     t = time.perf_counter()
     d = out_dir / "rig"
     d.mkdir(exist_ok=True)
-    h5 = merge_records(Path(steady_file), Path(runup_file), d / "pedestal.h5", *map(Path, hammer_files))
+    h5 = merge_records(Path(steady_file), Path(runup_file), d / "pedestal.h5", *map(Path, more_files))
     mset = load_measurements(h5)
     survey = survey_record(mset["runup"])
     png = plot_modal_survey(survey, d / "modes.png", title="Run-up of the pedestal rig: modes (red), fixed lines "
@@ -104,9 +113,24 @@ def rig_calibration_demo(out_dir: Path, steady_file: Path, runup_file: Path, *ha
     comp = compare(calibrated, h5, out_dir / "compare_rig", record="steady", duration=1.0)
     _lines(f"twin compare on the calibrated scenario against the steady record: {comp.lsd_db:.1f} dB, "
            f"{len(comp.findings)} findings (what the twin still lacks: docs/diagnosis.md)")
+    if "light" in mset.names:
+        _lines(_face_contact_line(calibrated, mset))
     _written(png, report.scenario_file, out_dir / "calibration_rig" / "report.html")
     return {"survey": survey, "report": report, "scenario": report.scenario_file, "compare_lsd_db": comp.lsd_db,
             "records": h5}
+
+
+def _face_contact_line(calibrated, mset) -> str:
+    """What ``--face-contact-from light`` (an opt-in) makes of the calibrated twin's flanks."""
+    from twin.calibration.face_contact import fit_face_contact
+    steady, light = mset["steady"], mset["light"]
+    ch = "accel_pinion_casing"
+    t = time.perf_counter()
+    fit = fit_face_contact(calibrated.fmu_path(), dict(calibrated.parameters),
+                           [(np.asarray(steady[ch], float), steady.load), (np.asarray(light[ch], float), light.load)],
+                           ch, steady.sample_rate, steady.nominal_speed)
+    return (f"twin calibrate ... --face-contact-from light (an opt-in; {time.perf_counter() - t:.0f} s): "
+            f"{fit.describe()}")
 
 
 def _shaft_reading(survey) -> str:
