@@ -106,7 +106,6 @@ def rig_data(name: str, task: str, per_stage: int, data: Path) -> tuple[Path, Pa
 
 def path_data(name: str, task: str, per_stage: int, data: Path) -> tuple[Path, dict]:
     """(the rig file of :func:`rig_data` with two hammer tests of the healthy rig added, path_from); cached."""
-    from twin.measurements import load_measurements
     rig_file, _ = rig_data(name, task, per_stage, data)
     path_file, key = data / f"{name}_{task}_path.h5", data / f"{name}_{task}_path.json"
     path_from = {f"hammer_{loc}": force for loc, force in zip(PATH_BLOWS[name], PATH_FORCES)}
@@ -119,13 +118,20 @@ def path_data(name: str, task: str, per_stage: int, data: Path) -> tuple[Path, d
     # the same records as rig_file (re-simulated with the same seeds), then the blows
     write(str(path_file), _rig_records(name, box, task, per_stage))
     # the stage records must be the ones the other arms adapt to
-    a, b = load_measurements(rig_file, channels=[CHANNEL]), load_measurements(path_file, channels=[CHANNEL])
-    for r in a.records:
-        if not np.array_equal(np.asarray(r[CHANNEL]), np.asarray(b[r.name][CHANNEL])):
-            path_file.unlink()
-            raise SystemExit(f"{path_file}: record {r.name} differs from {rig_file}'s; the rig is not repeatable")
+    _same_records(rig_file, path_file, [CHANNEL])
     key.write_text(wanted)
     return path_file, path_from
+
+
+def _same_records(old: Path, new: Path, channels=None) -> None:
+    """Every record of ``old`` is in ``new`` sample for sample (``channels``: None, all of them);
+    else ``new`` is removed and the run stops: the rig is not repeatable."""
+    from twin.measurements import load_measurements
+    a, b = load_measurements(old, channels=channels), load_measurements(new, channels=channels)
+    for r in a.records:
+        if not all(np.array_equal(np.asarray(r[c]), np.asarray(b[r.name][c])) for c in r.channel_names):
+            new.unlink()
+            raise SystemExit(f"{new}: record {r.name} differs from {old}'s; the rig is not repeatable")
 
 
 #: The other load of the load pair [N.m] (``path_contact``: a healthy steady record at the test's speed), its seed.
@@ -135,7 +141,6 @@ CONTACT_LOAD, CONTACT_SEED = {"pitting": 5.0, "wear": 20.0}, 105
 def contact_data(name: str, task: str, per_stage: int, data: Path) -> tuple[Path, dict]:
     """(the file of :func:`path_data` with a healthy steady record at :data:`CONTACT_LOAD` added as
     ``light``, path_from); cached."""
-    from twin.measurements import load_measurements
     path_file, path_from = path_data(name, task, per_stage, data)
     file, key = data / f"{name}_{task}_contact.h5", data / f"{name}_{task}_contact.json"
     wanted = json.dumps({"path_file": (data / f"{name}_{task}_path.json").read_text(),
@@ -145,14 +150,8 @@ def contact_data(name: str, task: str, per_stage: int, data: Path) -> tuple[Path
     box, write = _rig(name)
     _, speed, _ = TESTS[task]
     light = box.steady(speed=speed, load=CONTACT_LOAD[task], duration=2.0, seed=CONTACT_SEED, name="light")
-    records = list(load_measurements(path_file).records)
     write(str(file), [*_rig_records(name, box, task, per_stage), light])
-    b = load_measurements(file)
-    for r in records:
-        for c in r.channel_names:
-            if not np.array_equal(np.asarray(r[c]), np.asarray(b[r.name][c])):
-                file.unlink()
-                raise SystemExit(f"{file}: record {r.name} differs from {path_file}'s; the rig is not repeatable")
+    _same_records(path_file, file)
     key.write_text(wanted)
     return file, path_from
 
