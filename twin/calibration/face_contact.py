@@ -64,6 +64,19 @@ class FaceContactFit:
                 f"pair's, {best:.2f} dB at best")
 
 
+def load_pair_problem(steady, other) -> str | None:
+    """Why two records (``nominal_speed`` [Hz], ``load`` [N.m], ``name``) are no load pair, or None:
+    the same speed within 2 %, loads 25 % apart or more."""
+    if abs(other.nominal_speed - steady.nominal_speed) > 0.02 * steady.nominal_speed:
+        return (f"record {other.name!r} runs at {other.nominal_speed:g} Hz, the steady record {steady.name!r} at "
+                f"{steady.nominal_speed:g} Hz: the load pair must share its speed (within 2 %)")
+    if abs(other.load - steady.load) < 0.25 * max(abs(other.load), abs(steady.load)):
+        return (f"record {other.name!r} is at {other.load:g} N.m, the steady record {steady.name!r} at "
+                f"{steady.load:g} N.m: the loads must differ by 25 % or more for the spectrum to show its load "
+                "dependence")
+    return None
+
+
 def smoothed_db(x: np.ndarray, fs: float) -> tuple[np.ndarray, np.ndarray]:
     """Frequencies [Hz] (n,) and the Welch PSD of ``x`` in dB with a running median over
     :data:`SMOOTH_HZ` (n,)."""

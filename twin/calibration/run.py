@@ -125,19 +125,14 @@ def _mesh_form(scenario, fmu, parameters, rec, channel, target, settle, fmax, so
 
 def _face_contact_record(scenario, mset, spec, rec, channel, source, measurements):
     """``face_contact_from``'s record, checked against the steady record ``rec``: one speed, two loads."""
+    from twin.calibration.face_contact import load_pair_problem
     name = spec["face_contact_from"]
     if name not in mset.names:
         raise ScenarioError([(source, "calibration.face_contact_from", f"no record {name!r} in the measurements "
                               f"(records: {', '.join(mset.names)})")])
     other = _steady_record({"record": name}, mset, scenario, channel, 0.5, source, measurements)
-    if abs(other.nominal_speed - rec.nominal_speed) > 0.02 * rec.nominal_speed:
-        raise ScenarioError([(source, "calibration.face_contact_from", f"record {name!r} runs at "
-                              f"{other.nominal_speed:g} Hz, the steady record {rec.name!r} at {rec.nominal_speed:g} Hz: "
-                              "the load pair must share its speed (within 2 %)")])
-    if abs(other.load - rec.load) < 0.25 * max(abs(other.load), abs(rec.load)):
-        raise ScenarioError([(source, "calibration.face_contact_from", f"record {name!r} is at {other.load:g} N.m, "
-                              f"the steady record {rec.name!r} at {rec.load:g} N.m: the loads must differ by 25 % "
-                              "or more for the spectrum to show its load dependence")])
+    if problem := load_pair_problem(rec, other):
+        raise ScenarioError([(source, "calibration.face_contact_from", problem)])
     return other
 
 
