@@ -71,3 +71,17 @@ def test_a_load_pair_that_is_not_one_speed_and_two_loads_is_refused_by_name():
                       ("same", "is at 18 N.m, the steady record 'steady' at 20 N.m: the loads must differ")):
         with pytest.raises(ScenarioError, match=msg):
             _face_contact_record(sc, mset, {"face_contact_from": name}, steady, CH, "s.yaml", "m.h5")
+
+
+def test_a_load_pair_without_a_measurement_file_is_refused_before_anything_is_written(tmp_path):
+    from twin.calibration.run import run_calibration
+    from twin.errors import ScenarioError
+    from twin.scenario import scenario_from_dict
+
+    sc = scenario_from_dict({"version": 1, "name": "m", "fmu": "x.fmu", "stop_time": 0.1,
+                             "output": {"sample_rate": FS, "variables": [CH]},
+                             "calibration": {"parameters": "auto", "natural_frequencies": [430.0, 512.0],
+                                             "face_contact_from": "light"}})
+    with pytest.raises(ScenarioError, match="calibration.face_contact_from.*needs the measurement file"):
+        run_calibration(sc, None, tmp_path / "out", progress=False)
+    assert not (tmp_path / "out").exists()
