@@ -21,6 +21,7 @@ this face width with shaft misalignment; a fit at the bound is reported as a war
 """
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
@@ -100,6 +101,21 @@ def choose(distances_db, grid=GRID, tolerance_db: float = TOLERANCE_DB) -> float
     return float(min(g for g, v in zip(grid, d) if v <= d.min() + tolerance_db))
 
 
+def _checked(x, fs: float, load: float) -> np.ndarray:
+    """The record as a 1-D float array, refused by name (:class:`MeasurementError`) when it is not
+    finite or holds fewer than four Welch segments."""
+    from twin.errors import MeasurementError
+    x = np.asarray(x, float)
+    where = f"the load pair's record at {load:g} N.m"
+    if x.ndim != 1 or not np.all(np.isfinite(x)):
+        raise MeasurementError("<array>", where, f"needs a 1-D finite signal, got shape {x.shape} with NaN or Inf"
+                               if x.ndim == 1 else f"needs a 1-D finite signal, got shape {x.shape}")
+    if x.size < 2.5 * SEGMENT_S * fs:
+        raise MeasurementError("<array>", where, f"lasts {x.size / fs:.3g} s; the spectra need {2.5 * SEGMENT_S:g} s "
+                               "or more (four half-overlapping segments)")
+    return x
+
+
 def _simulate(task) -> np.ndarray:
     from twin.operating import simulate_operating_point
     fmu, speed, load, params, settle, duration, channel, fs = task
@@ -117,7 +133,12 @@ def fit_face_contact(fmu_path, parameters: Mapping[str, float], records, channel
     after ``settle`` (at most each record's length); ``grid`` the lead mismatches tried [m].
     """
     from twin.executor import LocalExecutor
+    from twin.errors import MeasurementError
     (xa, la), (xb, lb) = records
+    if not (math.isfinite(fs) and 0.4 * fs > 2 * FMIN):
+        raise MeasurementError("<array>", "the load pair", f"sampled at {fs!r} Hz: the compared band from {FMIN:g} Hz "
+                               f"needs {5 * FMIN:g} Hz or more")
+    xa, xb = _checked(xa, fs, la), _checked(xb, fs, lb)
     band_top = min(FMAX, 0.4 * fs)
     f, a_db = smoothed_db(xa, fs)
     _, b_db = smoothed_db(xb, fs)

@@ -85,3 +85,16 @@ def test_a_load_pair_without_a_measurement_file_is_refused_before_anything_is_wr
     with pytest.raises(ScenarioError, match="calibration.face_contact_from.*needs the measurement file"):
         run_calibration(sc, None, tmp_path / "out", progress=False)
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("signal, fs, message, record", [
+    (np.full(int(FS), np.nan), FS, "1-D finite signal", "the load pair's record at 5 N.m"),
+    (np.zeros(2000), FS, "lasts 0.0781 s", "the load pair's record at 5 N.m"),
+    (np.zeros(4000), 2000.0, "sampled at 2000.0 Hz", "the load pair"),
+])
+def test_a_record_the_spectra_cannot_be_read_from_is_refused_by_name(gearbox_fmu, signal, fs, message, record):
+    from twin.errors import MeasurementError
+    good = np.random.default_rng(0).normal(size=int(fs))
+    with pytest.raises(MeasurementError, match=message) as err:
+        fit_face_contact(gearbox_fmu, {}, [(good, 20.0), (signal, 5.0)], CH, fs, 20.0, grid=GRID)
+    assert err.value.record == record
