@@ -47,16 +47,19 @@ def _find(dirs: list[Path], rig: str, seed: int) -> Path:
     raise SystemExit(f"no {rig}_{seed}_cal/calibrated.yaml under {', '.join(map(str, dirs))}")
 
 
-def _distance(fmu, params, rec) -> float:
+def _distances(fmu, parameter_sets, rec) -> tuple[float, ...]:
+    """The record against the twin with each parameter set, simulated at the operating point the
+    record shows (read once, with the first set)."""
     from spectral_distance import spectral_distance_report
 
     from twin.effects.diagnose import record_conditions
     from twin.operating import simulate_at
-    x = np.asarray(rec[CHANNEL], float)
     fs = float(rec.sample_rate)
-    cond = record_conditions(fmu, x, fs, rec.nominal_speed, rec.load, params, record=rec.name)
-    y = simulate_at(fmu, params, cond.operating, cond.measured.size, [CHANNEL])[:, 0]
-    return float(spectral_distance_report(y, cond.measured, fs)["distance_db"])
+    cond = record_conditions(fmu, np.asarray(rec[CHANNEL], float), fs, rec.nominal_speed, rec.load,
+                             parameter_sets[0], record=rec.name)
+    return tuple(float(spectral_distance_report(simulate_at(fmu, p, cond.operating, cond.measured.size,
+                                                            [CHANNEL])[:, 0], cond.measured, fs)["distance_db"])
+                 for p in parameter_sets)
 
 
 def one(rig: str, seed: int, calibrated: Path, out: Path, ex) -> dict:
@@ -95,7 +98,7 @@ def one(rig: str, seed: int, calibrated: Path, out: Path, ex) -> dict:
            "fit_s": fit_s, "load_average": os.getloadavg()[0]}
     for name in ("steady", "light", "held_out"):
         rec = recs[name]
-        row[f"distance_{name}"] = (_distance(fmu, params, rec), _distance(fmu, fitted, rec))
+        row[f"distance_{name}"] = _distances(fmu, (params, fitted), rec)
     if rig == "pedestal":
         row["rig_mesh_mode_hz"] = {f"{load:g}": next((m.frequency for m in box.modes(speed=SPEED, load=load)
                                                        if "on mesh" in m.label), None)

@@ -16,8 +16,9 @@ spacing, so the broadband shape is compared, not the lines), the ratio in dB is 
 records' over [:data:`FMIN`, min(:data:`FMAX`, 0.4 fs)] with its median removed (gain-free), and
 the distance is the RMS. A flat ratio says little about D: the smallest D whose distance is within
 :data:`TOLERANCE_DB` of the best is taken, so a gearbox whose spectrum does not change its shape
-with load keeps an aligned pair.  Bounds: 0 to 45 um, ISO 6336-1 F_beta_x of a grade 9-10 pair of
-this face width with shaft misalignment; a fit at the bound is reported as a warning.
+with load keeps an aligned pair.  Bounds: 0 to 45 um, two to four times the 10-20 um of helix
+deviation and misalignment an ISO 1328-1 grade 7-8 pair of this face width has; a fit at the bound
+is reported as a warning.
 """
 from __future__ import annotations
 
