@@ -19,7 +19,7 @@ REPO = Path(__file__).resolve().parents[2]
 CHECK = """package ExcitationCheck
   model Blocks
     Real a(start = 0.2);
-    GearTwin.Excitation.RoughnessTransmissionError r(angle = a, speed = 7.3, seed = 4, rms = 1e-6, slope = 0.8);
+    GearTwin.Excitation.RoughnessTransmissionError r(angle = a, speed = 7.3, seed = 4, rms = 1e-6, slope = 0.8, rolling_radius = 0.01, contact_half_width = 3e-5);
     GearTwin.Excitation.ProcessForce p(seed = 5, rms = 2, f_high = 8000);
     output Real te = r.displacement;
     output Real rate = r.displacement_rate;
@@ -42,15 +42,20 @@ def check_dir(tmp_path_factory):
     return root
 
 
-def _roughness_reference(angle, rms, slope, seed):
-    j, k = np.arange(1, 17), np.arange(1, 9)
-    p = (16.0 * j) ** (-slope)
+def _roughness_reference(angle, rms, slope, seed, rho=0.01, b=0.0):
+    """The block's sum written order by order (not as its product): order n = 63 j + m, |m| <= 31."""
+    j, k, l = np.arange(1, 33), np.arange(1, 5), np.arange(1, 4)
+    gauss = lambda n: np.exp(-(n * b / rho) ** 2 / 8)
+    p0 = 32.0 ** (-slope) * gauss(16.0)
+    p = (63.0 * j) ** (-slope) * gauss(63.0 * j)
     phi = 43758.5453 * np.sin(12.9898 * j + 78.233 * seed)
     psi = 43758.5453 * np.sin(39.3468 * k + 11.135 * seed)
-    norm = np.sqrt(np.sum(p ** 2) / 2 * 9 / 2)
-    P = np.sum(p[None, :] * np.cos(16 * j[None, :] * angle[:, None] + phi[None, :]), axis=1)
-    Q = 1 / np.sqrt(2) + np.sum(np.cos(k[None, :] * angle[:, None] + psi[None, :]), axis=1)
-    return rms / norm * P * Q
+    chi = 43758.5453 * np.sin(93.9898 * l + 67.345 * seed)
+    norm = np.sqrt((31 * p0 ** 2 + 63 * np.sum(p ** 2)) / 32)
+    P = p0 / 2 + np.sum(p[None, :] * np.cos(63 * j[None, :] * angle[:, None] + phi[None, :]), axis=1)
+    Q = 0.5 + np.sum(np.cos(7 * k[None, :] * angle[:, None] + psi[None, :]), axis=1)
+    R = 0.5 + np.sum(np.cos(l[None, :] * angle[:, None] + chi[None, :]), axis=1)
+    return rms / norm * (P * Q * R - p0 / 8)
 
 
 def test_blocks_follow_their_formulas(check_dir, tmp_path):
@@ -58,9 +63,11 @@ def test_blocks_follow_their_formulas(check_dir, tmp_path):
     fmu = build_fmu("ExcitationCheck.Blocks", check_dir, tmp_path)
     res = simulate_fmu(fmu, stop_time=2.0, output_interval=1 / 20000)
     angle = 0.2 + 7.3 * res.time
-    np.testing.assert_allclose(res["te"], _roughness_reference(angle, 1e-6, 0.8, 4.0), atol=1e-12)
-    rate = np.gradient(res["te"], res.time)
-    assert np.sqrt(np.mean((rate - res["rate"])[5:-5] ** 2)) < 0.01 * np.sqrt(np.mean(res["rate"] ** 2))
+    np.testing.assert_allclose(res["te"], _roughness_reference(angle, 1e-6, 0.8, 4.0, 0.01, 3e-5), atol=1e-12)
+    h = 1e-6                                           # rad: a central difference of the reference
+    rate = 7.3 * (_roughness_reference(angle + h, 1e-6, 0.8, 4.0, 0.01, 3e-5)
+                  - _roughness_reference(angle - h, 1e-6, 0.8, 4.0, 0.01, 3e-5)) / (2 * h)
+    assert np.sqrt(np.mean((rate - res["rate"]) ** 2)) < 1e-4 * np.sqrt(np.mean(res["rate"] ** 2))
     force = res["force"]
     assert np.sqrt(np.mean(force ** 2)) == pytest.approx(2.0, rel=0.25)
     fc, level = band_levels(force, 20000, 100, 7000, resolution=2.0)
@@ -70,11 +77,27 @@ def test_blocks_follow_their_formulas(check_dir, tmp_path):
 
 def test_roughness_rms_and_orders(check_dir, tmp_path):
     angle = np.linspace(0, 2 * np.pi, 8192, endpoint=False)
-    te = _roughness_reference(angle, 1e-6, 0.8, 4.0)
-    assert np.sqrt(np.mean(te ** 2)) == pytest.approx(1e-6, rel=0.35)     # a random sum: RMS as designed in mean
-    spectrum = np.abs(np.fft.rfft(te)) / te.size
-    assert spectrum[1:8].max() < 1e-3 * spectrum.max()                  # orders below 8 are not there
-    assert spectrum[8:265].min() > 0 and spectrum[266:].max() < 1e-9
+    rho, b = 0.01, 3e-5
+    te = _roughness_reference(angle, 1e-6, 0.8, 4.0, rho, b)
+    assert np.mean(te) == pytest.approx(0.0, abs=1e-12)                  # no static offset
+    assert np.sqrt(np.mean(te ** 2)) == pytest.approx(1e-6, rel=0.35)    # a random sum: RMS as designed in mean
+    amp = 2 * np.abs(np.fft.rfft(te)) / te.size
+    n = np.arange(amp.size)
+    # every order 1..2047 is there once, nothing above; the amplitudes fall as n^-0.8 times the
+    # contact's Gaussian: compare block means (orders of one block share one amplitude)
+    assert amp[1:2048].min() > 0 and amp[2048:].max() < 1e-15
+    for j in (1, 5, 12, 20):
+        block = amp[63 * j - 31:63 * j + 32]
+        assert np.allclose(block, block[0], rtol=1e-9)
+        expected = (63.0 * j) ** -0.8 * np.exp(-(63 * j * b / rho) ** 2 / 8) / 4
+        assert block[0] / amp[33] == pytest.approx(expected / ((63.0) ** -0.8 * np.exp(-(63 * b / rho) ** 2 / 8) / 4))
+    # the Hertzian width ends the band: at 3e-5 m on a 0.01 m rolling radius the orders near
+    # n = rho / b * sqrt(8 ln 10) = 1430 are a tenth of what the power law alone would give
+    assert amp[1449] / amp[63] == pytest.approx((1449 / 63) ** -0.8 * np.exp(-(1449 * b / rho) ** 2 / 8)
+                                              / np.exp(-(63 * b / rho) ** 2 / 8), rel=1e-6)
+    wide = _roughness_reference(angle, 1e-6, 0.8, 4.0, rho, 0.0)
+    amp_wide = 2 * np.abs(np.fft.rfft(wide)) / wide.size
+    assert amp[1449] / amp[63] < 0.12 * amp_wide[1449] / amp_wide[63]
 
 
 def test_switch_off_folds_the_excitation_away(check_dir, tmp_path, gearbox_fmu, measured_fmu):
