@@ -90,7 +90,8 @@ class GearboxParams:
     ``n_profile`` entries, ``tooth_stiffness_factor`` and ``tooth_deviation_offset`` have
     ``z1``, ``wheel_tooth_deviation_offset`` has ``z2``, and is the variant
     ``GearTwin.Variants.Gearbox21WheelErrors``'s); lists or numpy arrays passed in are converted.  The Modelica parameters with a binding to other parameters (``rb1``, ``rb2``, ``contact_ratio``, ``torque_out``,
-    ``torque_in``, ``mesh_force_static``, ``speed_start``, ``k_mesh_mean``) are properties.
+    ``torque_in``, ``mesh_force_static``, ``speed_start``, ``k_mesh_mean``, ``pitch_curvature_pinion``,
+    ``pitch_curvature_gear``, ``hertz_half_width``) are properties.
     The instance is hashable, which lets the per-parameter-set constants be cached.
     """
 
@@ -190,6 +191,9 @@ class GearboxParams:
     sensor_angle_gear: float = 0.0       # rad
     speed_ref_start: float = 2 * PI * 20  # rad/s, speed command assumed for the steady start
     load_start: float = 20.0             # N.m, brake torque of the static pre-load
+    # ---- gear steel (the Hertzian width that ends the roughness band of the measured models)
+    gear_youngs_modulus: float = 2.1e11  # Pa
+    gear_poisson_ratio: float = 0.3      # -
 
     def __post_init__(self):
         for name in _ARRAY_FIELDS:
@@ -271,6 +275,24 @@ class GearboxParams:
     def mesh_force_static(self) -> float:
         """Static mesh force [N]."""
         return self.torque_in / self.rb1
+
+    @property
+    def pitch_curvature_pinion(self) -> float:
+        """Radius of curvature of the pinion flank at the pitch point [m]."""
+        return 0.5 * self.module * self.z1 * math.sin(self.alpha)
+
+    @property
+    def pitch_curvature_gear(self) -> float:
+        """Radius of curvature of the gear flank at the pitch point [m]."""
+        return 0.5 * self.module * self.z2 * math.sin(self.alpha)
+
+    @property
+    def hertz_half_width(self) -> float:
+        """Hertzian half-width [m] of the static mesh force on one pair at the pitch point (line contact, steel on steel)."""
+        r1, r2 = self.pitch_curvature_pinion, self.pitch_curvature_gear
+        line_load = max(self.mesh_force_static, 0.0) / self.face_width
+        return math.sqrt(8 * line_load * (r1 * r2 / (r1 + r2)) * (1 - self.gear_poisson_ratio ** 2)
+                         / (PI * self.gear_youngs_modulus))
 
     @property
     def speed_start(self) -> float:

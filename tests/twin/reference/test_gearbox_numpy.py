@@ -126,7 +126,8 @@ def test_parameters_and_start_state_match_fmu(gearbox_fmu, tmp_path):
         fmu.freeInstance()
     assert set(derived) == {"rb1", "rb2", "contact_ratio", "torque_out", "torque_in",
                             "mesh_force_static", "speed_start", "k_mesh_mean", "line_of_action_length",
-                            "contact_path_length", "contact_start_radius", "roll_pitch"}
+                            "contact_path_length", "contact_start_radius", "roll_pitch",
+                            "pitch_curvature_pinion", "pitch_curvature_gear", "hertz_half_width"}
     for name in derived:
         assert values[name] == pytest.approx(getattr(p, name), rel=1e-12), name
     x0 = gn.initial_state(p)
