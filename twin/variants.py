@@ -20,9 +20,12 @@ from twin.errors import ParameterError
 GEOMETRY_OPTIONS = ("z1", "z2", "module", "alpha", "face_width", "addendum_coefficient", "n_profile",
                     "youngs_modulus", "poisson_ratio", "profile_shift_pinion", "profile_shift_gear",
                     "dedendum_coefficient", "root_radius_coefficient", "bore_radius_pinion", "bore_radius_gear")
-#: Options that only the stiffness computation reads (not parameters of the Modelica model).
+#: Options that the stiffness computation reads under these names (not parameters of the Modelica model).
 STIFFNESS_ONLY = ("youngs_modulus", "poisson_ratio", "dedendum_coefficient", "root_radius_coefficient",
                   "bore_radius_pinion", "bore_radius_gear")
+#: The gears' material also sizes the model's Hertzian contact (``hertz_half_width``, which ends the
+#: flank roughness's band): the same values go to these parameters, so one steel sets both.
+MATERIAL_PARAMETERS = {"youngs_modulus": "gear_youngs_modulus", "poisson_ratio": "gear_poisson_ratio"}
 _REPO = Path(__file__).resolve().parents[1]
 
 
@@ -39,7 +42,8 @@ def build_options(sets: Mapping[str, float], *, n_profile_default: int = 11) -> 
     Integer-valued options stay ints (structural parameters need them).  When an option in
     :data:`GEOMETRY_OPTIONS` is set and ``k_pair`` is not, ``k_pair`` gets the potential-energy
     single-pair stiffness of the resulting geometry at ``n_profile`` nodes.  Options in
-    :data:`STIFFNESS_ONLY` enter only that computation.
+    :data:`STIFFNESS_ONLY` enter that computation under their own names; the material among them
+    also sets the model's ``gear_youngs_modulus`` / ``gear_poisson_ratio`` (:data:`MATERIAL_PARAMETERS`).
     """
     mods = _normalised(sets)
     if any(k in GEOMETRY_OPTIONS for k in mods) and "k_pair" not in mods:
@@ -48,7 +52,9 @@ def build_options(sets: Mapping[str, float], *, n_profile_default: int = 11) -> 
         geometry = GearPair.from_parameters({k: v for k, v in mods.items() if not isinstance(v, list)})
         n = int(mods.get("n_profile", n_profile_default))
         mods["k_pair"] = k_pair_nodes(geometry, n)
-    return {k: v for k, v in mods.items() if k not in STIFFNESS_ONLY}
+    out = {k: v for k, v in mods.items() if k not in STIFFNESS_ONLY}
+    out.update({MATERIAL_PARAMETERS[k]: float(v) for k, v in mods.items() if k in MATERIAL_PARAMETERS})
+    return out
 
 
 def _normalised(sets: Mapping[str, float]) -> dict:
@@ -120,4 +126,24 @@ def geometry_summary(fmu) -> list[str]:
         f"{rep.k_mesh_mean:.4g} N/m",
         f"              ISO 6336-1 B: c' b = {rep.iso.single:.4g} N/m ({100 * rep.single_difference:+.1f} %), "
         f"c_gamma_alpha b = {rep.iso.mesh:.4g} N/m ({100 * rep.mesh_difference:+.1f} %)",
+        *_contact_line(values, g),
     ]
+
+
+def _contact_line(values: Mapping[str, float], g) -> list[str]:
+    """The Hertzian half-width at the FMU's start load, as ``hertz_half_width`` of GearTwin.Gearbox21
+    computes it, and the shaft orders where the contact halves a roughness's amplitude
+    (``GearTwin.Excitation.RoughnessTransmissionError``: exp(-(n b / rho)^2 / 8) = 1/2)."""
+    needed = ("load_start", "gear_youngs_modulus", "gear_poisson_ratio")
+    if not all(values.get(k) is not None for k in needed):
+        return []
+    rho1 = g.pitch_radius_pinion * math.sin(g.pressure_angle)
+    rho2 = g.pitch_radius_gear * math.sin(g.pressure_angle)
+    force = max(float(values["load_start"]), 0.0) / g.base_radius_gear      # one pair carries it
+    nu, e = float(values["gear_poisson_ratio"]), float(values["gear_youngs_modulus"])
+    b = math.sqrt(8 * force / g.face_width * (rho1 * rho2 / (rho1 + rho2)) * (1 - nu ** 2) / (math.pi * e))
+    if b <= 0:
+        return [f"Contact       no static load (load_start 0): the roughness is not averaged by the contact"]
+    half = math.sqrt(8 * math.log(2))
+    return [f"Contact       Hertz half-width {b * 1e6:.1f} um at load_start {float(values['load_start']):g} N.m; "
+            f"roughness amplitude halved at shaft order {half * rho1 / b:.0f} (pinion) / {half * rho2 / b:.0f} (gear)"]

@@ -36,9 +36,10 @@ def test_a_changed_geometry_gets_the_computed_mesh_stiffness():
     assert mods["k_pair"] == k_pair_nodes(GearPair(z1=18, z2=35), 11)
     finer = build_options({"z1": 18, "n_profile": 21})
     assert len(finer["k_pair"]) == 21
-    # material options only feed the stiffness, they are not model parameters
+    # the material feeds the stiffness and, as the model's own parameters, its Hertzian contact
     soft = build_options({"z2": 35, "youngs_modulus": 103e9})
-    assert "youngs_modulus" not in soft
+    assert "youngs_modulus" not in soft and soft["gear_youngs_modulus"] == 103e9
+    assert build_options({"poisson_ratio": 0.28})["gear_poisson_ratio"] == 0.28
     assert soft["k_pair"][5] == pytest.approx(0.5 * build_options({"z2": 35})["k_pair"][5], rel=1e-9)
     # an explicit k_pair wins; options that are not geometry leave k_pair alone
     assert build_options({"z1": 18, "k_pair": [1.0] * 11})["k_pair"] == [1.0] * 11
@@ -57,6 +58,12 @@ def test_variant_builds_with_its_own_stiffness_and_geometry(pair_18_35):
     text = describe(pair_18_35)
     assert "Structural (3" in text and "z1 = 18, z2 = 35" in text
     assert "Contact ratio 1.6082" in text and "ISO 6336-1" in text and "potential energy" in text
+    # the Hertzian width as the model computes it (hertz_half_width at the 20 N.m start load)
+    a = np.radians(20)
+    rho1, rho2 = 0.5 * 3e-3 * 18 * np.sin(a), 0.5 * 3e-3 * 35 * np.sin(a)
+    line_load = 20.0 / (0.5 * 3e-3 * 35 * np.cos(a)) / 0.020           # N/m: the output torque on one pair
+    b = np.sqrt(4 * line_load * rho1 * rho2 / (rho1 + rho2) / (np.pi * 2.06e11 / (2 * (1 - 0.3 ** 2))))
+    assert f"Hertz half-width {b * 1e6:.1f} um at load_start 20 N.m" in text
 
 
 @pytest.mark.needs_gcc

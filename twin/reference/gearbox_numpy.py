@@ -192,7 +192,7 @@ class GearboxParams:
     speed_ref_start: float = 2 * PI * 20  # rad/s, speed command assumed for the steady start
     load_start: float = 20.0             # N.m, brake torque of the static pre-load
     # ---- gear steel (the Hertzian width that ends the roughness band of the measured models)
-    gear_youngs_modulus: float = 2.1e11  # Pa
+    gear_youngs_modulus: float = 2.06e11  # Pa
     gear_poisson_ratio: float = 0.3      # -
 
     def __post_init__(self):
