@@ -4,12 +4,14 @@
                                      [--model GearTwin.Gearbox21Shafts] [--pairing frequency]
                                      [--visibility mesh] [--fit follow] [--hammer]
                                      [--hammer-at default] [--hammer-from above] [--lscf]
-                                     [--hammer-rate 4] [--hammer-duration 8]
+                                     [--hammer-rate 4] [--hammer-duration 8] [--no-load-pair]
                                      [--out bench_out/calibration_rigs]
 
 For each rig and seed: one gearbox with its base parameters scattered +-12 %
 (``Rig().scattered(seed, 0.12)``); a 2 s steady record at 20 Hz / 20 N.m and a 6 s run-up from 2 to
-20 Hz, written in the measurement format (truth apart); with ``--hammer`` also a hammer test per
+20 Hz, written in the measurement format (truth apart), and a 2 s steady record at 20 Hz / 5 N.m
+(``light``, the load pair the calibration reads the flanks' lead mismatch from; ``--no-load-pair``
+leaves it out); with ``--hammer`` also a hammer test per
 struck point (:data:`HAMMER`: the pedestal rig's two pedestals, the beam rig's two shaft ends;
 ``--hammer-at`` another choice of :data:`HAMMER_AT`), vertical (``--hammer-from both``: also one from
 the side at each point, :data:`HAMMER_FROM`), at slow roll (0.5 Hz, 20 N.m, 8 s, 4 blows/s), read
@@ -89,7 +91,7 @@ def struck_shafts(tests) -> dict[str, str]:
 
 def _scenario(path: Path, fs: float, workers: int, model: str, pairing: str = "frequency",
               visibility: str = "mesh", fit: str = "follow", modes_from=("runup",), struck=None,
-              path_from=None, mesh_form: bool = False) -> Path:
+              path_from=None, mesh_form: bool = False, face_contact_from: str | None = None) -> Path:
     path.write_text(json.dumps({
         "version": 1, "name": "rig-calibration", "fmu": model, "stop_time": 2.0,
         "output": {"sample_rate": fs, "variables": [CHANNEL]},
@@ -100,10 +102,14 @@ def _scenario(path: Path, fs: float, workers: int, model: str, pairing: str = "f
                         "pop_size": 12, "n_gen": 6, "pairing": pairing, "visibility": visibility,
                         "fit": fit, **({"struck_shafts": struck} if struck else {}),
                         **({"path_from": path_from} if path_from else {}),
-                        **({"mesh_form": "fit"} if mesh_form else {})}}, indent=2))
+                        **({"mesh_form": "fit"} if mesh_form else {}),
+                        **({"face_contact_from": face_contact_from} if face_contact_from else {})}}, indent=2))
     return path
 
 
+#: The light load of the load pair [N.m]: a healthy steady record at it, beside the 20 N.m one, gives the
+#: calibration the flanks' lead mismatch (``calibration.face_contact_from``; ``--no-load-pair`` leaves it out).
+LIGHT_LOAD = 5.0
 #: The bearing force of the twin that a blow at each rig's bearing supports stands for (``--path``).
 PATH_FORCES = ("bearing_force_input_y", "bearing_force_output_y")
 
@@ -231,7 +237,7 @@ def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str, p
                 visibility: str = "mesh", fit: str = "follow", hammer: bool = False,
                 hammer_at: str = "default", hammer_from: str = "above", hammer_rate: float = HAMMER_RATE,
                 hammer_duration: float = HAMMER_DURATION, name_shafts: bool = False, path: bool = False,
-                mesh_form: bool = False) -> dict:
+                mesh_form: bool = False, load_pair: bool = True) -> dict:
     from spectral_distance import spectral_distance_report
 
     from fmu_build import build_fmu
@@ -253,7 +259,8 @@ def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str, p
     design = (hammer_rate, hammer_duration) != (HAMMER_RATE, HAMMER_DURATION)
     h5 = out / (f"{rig_name}_{seed}{('_hammer_' + '_'.join(struck_at)) * hammer}"
                 f"{'_both' * (hammer and hammer_from == 'both')}"
-                f"{f'_{hammer_rate:g}per_s_{hammer_duration:g}s' * (hammer and design)}{'_path' * bool(extra)}.h5")
+                f"{f'_{hammer_rate:g}per_s_{hammer_duration:g}s' * (hammer and design)}{'_path' * bool(extra)}"
+                f"{'_light' * load_pair}.h5")
     modes_from = ("runup",) + tuple(name for name, _, _ in tests)
     path_from = {name: force for (name, _, _), force in zip(path_tests, PATH_FORCES)}
     if not h5.exists():          # the records depend on the rig version and the seeds only
@@ -261,7 +268,9 @@ def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str, p
         runup = box.runup(speeds=(2.0, SPEED), load=LOAD, duration=6.0, seed=seed, name="runup")
         struck = [box.impact(speed=HAMMER_SPEED, load=LOAD, duration=hammer_duration, impacts_per_second=hammer_rate,
                              location=loc, seed=seed, name=name, direction=d) for name, loc, d in tests + extra]
-        rigmod.write(h5, [steady, runup, *struck])
+        # the load pair: a steady record at the same speed and a light load (face_contact_from)
+        light = [box.steady(speed=SPEED, load=LIGHT_LOAD, duration=2.0, seed=300 + seed, name="light")] * load_pair
+        rigmod.write(h5, [steady, runup, *struck, *light])
     rig_wall = time.perf_counter() - t
     truth = box.modes(speed=SPEED, load=LOAD)
     all_modes = np.array([m.frequency for m in truth])
@@ -277,7 +286,7 @@ def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str, p
     scenario = load_scenario(_scenario(out / f"{rig_name}_{seed}.yaml", float(load_measurements(h5)[0].sample_rate),
                                        workers, model, pairing, visibility, fit, modes_from,
                                        struck_shafts(tests) if name_shafts and tests else None, path_from or None,
-                                       mesh_form))
+                                       mesh_form, "light" if load_pair else None))
     t0 = time.perf_counter()
     report = run_calibration(scenario, h5, out / f"{rig_name}_{seed}_cal", progress=False)
     t_cal = time.perf_counter() - t0
@@ -387,6 +396,9 @@ def main() -> None:
     ap.add_argument("--mesh-form", action="store_true",
                     help="fit the pinion's as-manufactured profile (slope, crowning) to the mesh harmonics "
                          "(calibration.mesh_form: fit); the same calibration with perfect involutes is reported beside it")
+    ap.add_argument("--load-pair", action=argparse.BooleanOptionalAction, default=True,
+                    help="also write a steady record at LIGHT_LOAD and let twin calibrate fit the flanks' lead mismatch "
+                         "from the pair (calibration.face_contact_from; adopted on seeds 2, 4, 5, 6, 2026-11-28)")
     ap.add_argument("--out", type=Path, default=REPO / "bench_out" / "calibration_rigs")
     ap.add_argument("--explain", action="store_true",
                     help="only the per-mode analysis of the results already in --out (no new scoring)")
@@ -417,7 +429,7 @@ def main() -> None:
             t = time.perf_counter()
             r = one_gearbox(rig, seed, args.out, args.workers, args.model, args.pairing, args.visibility,
                             args.fit, args.hammer, args.hammer_at, args.hammer_from, args.hammer_rate,
-                            args.hammer_duration, args.struck_shafts, args.path, args.mesh_form)
+                            args.hammer_duration, args.struck_shafts, args.path, args.mesh_form, args.load_pair)
             r["fit"] = args.fit
             r["load_after"] = os.getloadavg()
             r["first6_explained"] = explain_modes(rig, seed, r, args.out, args.visibility)

@@ -10,9 +10,9 @@ and ``steady``; ``twin`` never imports ``rigs``). The step does what a user does
     twin calibrate scenario.yaml --measurements rig.h5 --modes-from runup --out calibration_rig/
     twin compare calibration_rig/calibrated.yaml --measurements rig.h5 --record steady
 
-With a steady record at another load (``light``) the step also shows what the opt-in
-``--face-contact-from light`` fits: the flanks' lead mismatch from how the spectrum changes with
-load (:mod:`twin.calibration.face_contact`).
+With a steady record at another load (``light``) the calibration also fits the flanks' lead
+mismatch from how the spectrum changes with load (``face_contact_from: light``,
+:mod:`twin.calibration.face_contact`), before the levels.
 
 With both hammer records (blows at the pinion's and the gear's pedestal) the twin is
 ``GearTwin.Gearbox21Shafts`` and its casing sensors read the path those blows measured
@@ -101,11 +101,14 @@ def rig_calibration_demo(out_dir: Path, steady_file: Path, runup_file: Path, *mo
         "output": {"sample_rate": mset["steady"].sample_rate, "variables": ["accel_pinion_casing"]},
         "operating": {"speed": mset["steady"].nominal_speed, "load": mset["steady"].load}, "seed": 0,
         "calibration": {"parameters": "auto", "modes_from": "runup", "record": "steady", "objectives": ["modes"],
-                        "algorithm": "nsga2", "pop_size": 8, "n_gen": 2, **({"path_from": PATH_FROM} if path else {})}},
+                        "algorithm": "nsga2", "pop_size": 8, "n_gen": 2, **({"path_from": PATH_FROM} if path else {}),
+                        **({"face_contact_from": "light"} if "light" in mset.names else {})}},
         indent=2))
     t = time.perf_counter()
     report = run_calibration(load_scenario(scenario_file), h5, out_dir / "calibration_rig", progress=False)
-    _lines(f"twin calibrate --modes-from runup{' (path_from: the two hammer records)' * path}, parameters chosen "
+    pair = "light" in mset.names
+    _lines(f"twin calibrate --modes-from runup{' (path_from: the two hammer records)' * path}"
+           f"{' --face-contact-from light' * pair}, parameters chosen "
            f"from the modes' sensitivities ({', '.join(report.result.chosen)}; {time.perf_counter() - t:.0f} s):")
     _lines(report.table())
     _lines("\n".join((*report.notes, *(f"warning: {w}" for w in report.warnings))))
@@ -113,24 +116,9 @@ def rig_calibration_demo(out_dir: Path, steady_file: Path, runup_file: Path, *mo
     comp = compare(calibrated, h5, out_dir / "compare_rig", record="steady", duration=1.0)
     _lines(f"twin compare on the calibrated scenario against the steady record: {comp.lsd_db:.1f} dB, "
            f"{len(comp.findings)} findings (what the twin still lacks: docs/diagnosis.md)")
-    if "light" in mset.names:
-        _lines(_face_contact_line(calibrated, mset))
     _written(png, report.scenario_file, out_dir / "calibration_rig" / "report.html")
     return {"survey": survey, "report": report, "scenario": report.scenario_file, "compare_lsd_db": comp.lsd_db,
             "records": h5}
-
-
-def _face_contact_line(calibrated, mset) -> str:
-    """What ``--face-contact-from light`` (an opt-in) makes of the calibrated twin's flanks."""
-    from twin.calibration.face_contact import fit_face_contact
-    steady, light = mset["steady"], mset["light"]
-    ch = "accel_pinion_casing"
-    t = time.perf_counter()
-    fit = fit_face_contact(calibrated.fmu_path(), dict(calibrated.parameters),
-                           [(np.asarray(steady[ch], float), steady.load), (np.asarray(light[ch], float), light.load)],
-                           ch, steady.sample_rate, steady.nominal_speed)
-    return (f"twin calibrate ... --face-contact-from light (an opt-in; {time.perf_counter() - t:.0f} s): "
-            f"{fit.describe()}")
 
 
 def _shaft_reading(survey) -> str:
