@@ -143,7 +143,7 @@ def _contact_line(values: Mapping[str, float], g) -> list[str]:
     nu, e = float(values["gear_poisson_ratio"]), float(values["gear_youngs_modulus"])
     b = math.sqrt(8 * force / g.face_width * (rho1 * rho2 / (rho1 + rho2)) * (1 - nu ** 2) / (math.pi * e))
     if b <= 0:
-        return [f"Contact       no static load (load_start 0): the roughness is not averaged by the contact"]
+        return ["Contact       no static load (load_start 0): the roughness is not averaged by the contact"]
     half = math.sqrt(8 * math.log(2))
     return [f"Contact       Hertz half-width {b * 1e6:.1f} um at load_start {float(values['load_start']):g} N.m; "
             f"roughness amplitude halved at shaft order {half * rho1 / b:.0f} (pinion) / {half * rho2 / b:.0f} (gear)"]
