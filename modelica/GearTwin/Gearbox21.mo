@@ -116,7 +116,7 @@ model Gearbox21 "21-DOF lumped model of the UNSW spur-gear test rig (Feng et al.
   parameter Real mesh_force_static(unit = "N") = torque_in / rb1 "Static mesh force";
   // Hertzian contact of the static mesh force on one pair at the pitch point (both gears steel):
   // its width sets how short a roughness wavelength still reaches the mesh (GearTwin.Excitation).
-  parameter Real gear_youngs_modulus(unit = "Pa", min = 0) = 2.06e11 "Young's modulus of the gears' steel (the build option youngs_modulus sets it and the computed mesh stiffness alike)";
+  parameter Real gear_youngs_modulus(unit = "Pa", min = 1e8) = 2.06e11 "Young's modulus of the gears' steel (the build option youngs_modulus sets it and the computed mesh stiffness alike)";
   parameter Real gear_poisson_ratio(min = 0, max = 0.5) = 0.3 "Poisson's ratio of the gears' steel (build option poisson_ratio)";
   parameter Real pitch_curvature_pinion(unit = "m", min = 0) = 0.5 * module * z1 * sin(alpha) "Radius of curvature of the pinion flank at the pitch point";
   parameter Real pitch_curvature_gear(unit = "m", min = 0) = 0.5 * module * z2 * sin(alpha) "Radius of curvature of the gear flank at the pitch point";

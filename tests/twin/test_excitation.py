@@ -182,3 +182,12 @@ def test_modes_no_gearbox_mode_reaches_go_to_the_casing_path(measured_fmu, gearb
     low = casing_path(measured_fmu, "accel_pinion_casing", (13.2, 1700.0), np.array([13.2, 1700.0]),
                       np.array([0.02, 0.02]), np.array([0.9, 0.5]))
     assert low["sensor_pinion.panel_frequency[1]"] == 1700.0 and "sensor_pinion.panel_frequency[2]" not in low
+
+
+def test_a_gear_steel_without_stiffness_is_refused_by_name(measured_fmu):
+    # a zero modulus would make the Hertzian width, and so the roughness, non-finite: the FMU's
+    # declared range (polymer gears and up) refuses it before the run, naming the parameter
+    from twin.errors import SimulationError
+    with pytest.raises(SimulationError, match=r"gear_youngs_modulus = 0 is outside its range"):
+        simulate_operating_point(measured_fmu, 20.0, 20.0, parameters={"gear_youngs_modulus": 0.0}, settle=0.0,
+                                 duration=0.01, channels=["accel_pinion_casing"], output_interval=1e-4)
