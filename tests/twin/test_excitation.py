@@ -82,7 +82,6 @@ def test_roughness_rms_and_orders(check_dir, tmp_path):
     assert np.mean(te) == pytest.approx(0.0, abs=1e-12)                  # no static offset
     assert np.sqrt(np.mean(te ** 2)) == pytest.approx(1e-6, rel=0.35)    # a random sum: RMS as designed in mean
     amp = 2 * np.abs(np.fft.rfft(te)) / te.size
-    n = np.arange(amp.size)
     # every order 1..2047 is there once, nothing above; the amplitudes fall as n^-0.8 times the
     # contact's Gaussian: compare block means (orders of one block share one amplitude)
     assert amp[1:2048].min() > 0 and amp[2048:].max() < 1e-15
