@@ -129,13 +129,19 @@ CATALOGUE: dict[str, Effect] = {e.id: e for e in (
                      "mesh_harmonic": "mesh harmonics inside the band of the mode are amplified",
                      "sideband": "sidebands inside the band of the mode are amplified"}),
     Effect("local_tooth_damage", "GearTwin.Effects.LocalToothDamage", "Local damage of one pinion tooth",
-           inputs={"z1": "z1"},
-           base_bindings={"effect_tooth_stiffness_factor": "tooth_factor", "effect_tooth_offset": "tooth_offset"},
-           fit=(FitParameter("stiffness_loss", 0.0, 0.9),),
+           # the spall sits where spalls start, from the pinion's lowest point of single-tooth contact
+           # to the pitch point (it carries the whole load there, under negative sliding); its edges
+           # are as sharp as the Hertzian contact is wide
+           inputs={"z1": "z1", "roll": "roll", "pair_tooth": "pair_tooth", "contact_ratio": "contact_ratio",
+                   "roll_pitch": "roll_pitch",
+                   "edge_width": "max(1e-3, 2 * hertz_half_width / contact_path_length)"},
+           hooks={"effect_pair_deviation": "pair_deviation"},
+           base_bindings={"effect_tooth_stiffness_factor": "tooth_factor"},
+           fit=(FitParameter("stiffness_loss", 0.0, 0.9), FitParameter("spall_depth", 1e-7, 2e-5, log=True)),
            related=("mesh_stiffness_scale",),
-           neutral={"stiffness_loss": 0.0, "material_loss": 0.0},
-           evidence={"impulsive": "a weak tooth gives one short change of mesh stiffness per pinion revolution, "
-                                  "an impulse in the synchronous average",
+           neutral={"stiffness_loss": 0.0, "spall_depth": 0.0},
+           evidence={"impulsive": "a weak or spalled tooth gives one short change of mesh stiffness or approach per "
+                                  "pinion revolution, an impulse in the synchronous average",
                      "sideband": "a once-per-revolution impulse spreads into many sidebands at pinion-speed spacing",
                      "resonance": "the impulse excites the structural resonances once per revolution",
                      "shaft_order": "the impulse train has lines at every pinion order"}),

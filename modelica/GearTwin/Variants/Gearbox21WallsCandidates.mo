@@ -8,12 +8,12 @@ model Gearbox21WallsCandidates "GearTwin.Gearbox21Walls with every catalogue eff
     effect_drive_torque = motor_torque_ripple.torque,
     effect_load_torque = load_torque_fluctuation.torque,
     effect_sensor_acceleration_pinion = housing_mode.extra_acceleration,
+    effect_pair_deviation = local_tooth_damage.pair_deviation,
     effect_mesh_force = backlash.back_force,
     effect_pinion_torque = tooth_friction.pinion_torque,
     effect_gear_torque = tooth_friction.gear_torque,
     effect_off_line_force = tooth_friction.off_line_force,
     effect_tooth_stiffness_factor = local_tooth_damage.tooth_factor,
-    effect_tooth_offset = local_tooth_damage.tooth_offset,
     effect_profile_deviation = distributed_wear.deviation);
   GearTwin.Effects.ShaftEccentricity pinion_eccentricity(
     shaft_angle = theta5,
@@ -34,8 +34,13 @@ model Gearbox21WallsCandidates "GearTwin.Gearbox21Walls with every catalogue eff
     participation = 0.0) "Casing or sensor-mount mode";
   GearTwin.Effects.LocalToothDamage local_tooth_damage(
     z1 = z1,
+    roll = roll,
+    pair_tooth = pair_tooth,
+    contact_ratio = contact_ratio,
+    roll_pitch = roll_pitch,
+    edge_width = max(1e-3, 2 * hertz_half_width / contact_path_length),
     stiffness_loss = 0.0,
-    material_loss = 0.0) "Local damage of one pinion tooth";
+    spall_depth = 0.0) "Local damage of one pinion tooth";
   GearTwin.Effects.Backlash backlash(
     mesh_deflection = mesh_deflection,
     mesh_stiffness = mesh_stiffness,

@@ -244,3 +244,56 @@ def test_the_face_law_is_the_sum_of_thin_slices_by_hand(candidates_fmu, setting)
     np.testing.assert_allclose(pair_force[clear], slices[clear], rtol=1e-4, atol=1e-5 * force_static)
     if "pinion_eccentricity.wobble" in setting:
         assert np.any(a[clear] > D[clear])                                # and the whole face near D = 0
+
+
+def test_a_spall_sets_back_one_tooth_over_its_span_by_hand(candidates_fmu):
+    """A spall of depth d on tooth 1 from the pinion's lowest point of single-tooth contact to the
+    pitch point (roll positions from the gear geometry, worked out here): each pair carries
+    k(roll) max(0, a - e) with e = d while tooth 1's contact lies in that span, 0 elsewhere and on
+    every other tooth (away from the spall's edges and the pairs' entry and exit)."""
+    from twin.fmu import FMU
+    from twin.operating import operating_point
+
+    d = 2e-6
+    start, inputs = operating_point(20.0, 20.0)
+    names = ["theta5", "theta10", "x5", "y5", "x10", "y10"] + [f"roll[{i}]" for i in (1, 2, 3)] \
+        + [f"pair_force[{i}]" for i in (1, 2, 3)]
+    with FMU(candidates_fmu) as f:
+        v = f.parameter_values()
+        f.setup(0.0, parameters={**start, "local_tooth_damage.spall_depth": d}, inputs=inputs)
+        rb1, rb2, edge = f.get(["rb1", "rb2", "local_tooth_damage.edge_width"])
+        f.step(0.05)
+        rows = []
+        for _ in range(6000):              # 0.06 s, more than a turn of the pinion
+            f.step(1e-5)
+            rows.append(f.get(names))
+    y = np.array(rows)
+    m, alpha, z1, z2, ha = v["module"], v["alpha"], 19, 52, v["addendum_coefficient"]
+    r1, r2 = m * z1 / 2, m * z2 / 2
+    p_b = np.pi * m * np.cos(alpha)
+    approach = np.sqrt((r2 + ha * m) ** 2 - (r2 * np.cos(alpha)) ** 2) - r2 * np.sin(alpha)
+    recess = np.sqrt((r1 + ha * m) ** 2 - (r1 * np.cos(alpha)) ** 2) - r1 * np.sin(alpha)
+    path = approach + recess
+    lo, hi = (path - p_b) / path, approach / path            # lowest point of single contact, pitch point
+    assert 0.3 < lo < hi < 0.7
+    th5, th10, x5, y5, x10, y10 = y[:, :6].T
+    roll, pair_force = y[:, 6:9], y[:, 9:12]
+    # the pinion tooth in each pair (leading, current, next) from the count of completed mesh cycles
+    mesh_angle = z1 * th5 + v["mesh_phase0"]
+    cycles = np.floor(mesh_angle / (2 * np.pi))
+    tooth = np.mod(cycles[:, None] + np.array([-1, 0, 1]), z1) + 1
+    a = rb1 * th5 - rb2 * th10 + (x5 - x10) * np.sin(alpha) + (y5 - y10) * np.cos(alpha)
+    k_pair = np.array([v[f"k_pair[{n}]"] for n in range(1, 12)])
+    k = v["mesh_stiffness_scale"] * np.where((roll > 0) & (roll < 1),
+                                             np.interp(np.clip(roll, 0, 1), np.linspace(0, 1, 11), k_pair), 0.0)
+    inside = (np.round(tooth) == 1) & (roll > lo) & (roll < hi)
+    e = np.where(inside, d, 0.0)
+    s = v["contact_smoothing"]
+    clear = (np.abs(roll) > s) & (np.abs(roll - 1) > s) & (np.abs(roll - lo) > edge) & (np.abs(roll - hi) > edge)
+    assert inside[clear].sum() > 20 and (~inside[clear]).sum() > 1000
+    expected = k * np.maximum(0.0, a[:, None] - e)
+    np.testing.assert_allclose(pair_force[clear], expected[clear], rtol=1e-4, atol=1e-5 * np.abs(pair_force).max())
+    # in single contact the spalled tooth gives way by the spall: the approach jumps by about d
+    single = inside & (roll > lo + edge) & (roll < hi - edge)
+    healthy = (np.round(tooth) != 1) & (roll > lo + edge) & (roll < hi - edge)
+    assert a[np.any(single, axis=1)].mean() - a[np.any(healthy, axis=1)].mean() == pytest.approx(d, rel=0.25)
