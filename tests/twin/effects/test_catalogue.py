@@ -203,6 +203,29 @@ def test_a_housing_mode_filters_what_reaches_the_sensor(shafts_fmu, fmu_dir, sha
     assert np.allclose(added[1], 3.0 * added[0], rtol=1e-6, atol=1e-6 * np.max(np.abs(added[1])))
 
 
+def _mesh_states(fmu_path, parameters, calculated):
+    """One turn and more of the pinion at 20 Hz / 20 N.m after 0.05 s, stepped by 1e-5 s and read
+    one sample at a time (states are no outputs): the parameter values, the ``calculated``
+    parameters' values, and per sample theta5, theta10, x5, y5, x10, y10, roll[1..3],
+    pair_force[1..3] (6000 x 12)."""
+    from twin.fmu import FMU
+    from twin.operating import operating_point
+
+    start, inputs = operating_point(20.0, 20.0)
+    names = ["theta5", "theta10", "x5", "y5", "x10", "y10"] + [f"roll[{i}]" for i in (1, 2, 3)] \
+        + [f"pair_force[{i}]" for i in (1, 2, 3)]
+    with FMU(fmu_path) as f:
+        v = f.parameter_values()
+        f.setup(0.0, parameters={**start, **parameters}, inputs=inputs)
+        values = f.get(calculated)
+        f.step(0.05)
+        rows = []
+        for _ in range(6000):              # 0.06 s, more than a turn of the pinion
+            f.step(1e-5)
+            rows.append(f.get(names))
+    return v, values, np.array(rows)
+
+
 @pytest.mark.parametrize("setting", [{"lead_mismatch": 30e-6}, {"pinion_eccentricity.wobble": 30e-6}])
 def test_the_face_law_is_the_sum_of_thin_slices_by_hand(candidates_fmu, setting):
     """Thin slices across the face (the uncoupled springs of Velex & Maatar 1996 and of ISO 6336-1's
@@ -210,22 +233,8 @@ def test_the_face_law_is_the_sum_of_thin_slices_by_hand(candidates_fmu, setting)
     along the line of action. Summed slice by slice from the FMU's own approach and roll, they give
     each pair's force, in partial contact (a < D, as here at 20 N.m: a/D about 0.2) and, where the
     wobble D = |w cos theta5| passes zero, with the whole face in contact."""
-    from twin.fmu import FMU
-    from twin.operating import operating_point
-
-    start, inputs = operating_point(20.0, 20.0)
-    names = ["theta5", "theta10", "x5", "y5", "x10", "y10"] + [f"roll[{i}]" for i in (1, 2, 3)] \
-        + [f"pair_force[{i}]" for i in (1, 2, 3)]
-    with FMU(candidates_fmu) as f:       # states are no outputs: stepped and read one sample at a time
-        v = f.parameter_values()
-        f.setup(0.0, parameters={**start, "pinion_eccentricity.eccentricity": 0.0, **setting}, inputs=inputs)
-        rb1, rb2, force_static = f.get(["rb1", "rb2", "mesh_force_static"])      # calculated parameters
-        f.step(0.05)
-        rows = []
-        for _ in range(6000):              # 0.06 s, more than a turn of the pinion
-            f.step(1e-5)
-            rows.append(f.get(names))
-    y = np.array(rows)
+    v, (rb1, rb2, force_static), y = _mesh_states(candidates_fmu, {"pinion_eccentricity.eccentricity": 0.0, **setting},
+                                                  ["rb1", "rb2", "mesh_force_static"])
     k_pair = np.array([v[f"k_pair[{n}]"] for n in range(1, 12)])
     s = v["contact_smoothing"]
     th5, th10, x5, y5, x10, y10 = y[:, :6].T
@@ -251,23 +260,9 @@ def test_a_spall_sets_back_one_tooth_over_its_span_by_hand(candidates_fmu):
     pitch point (roll positions from the gear geometry, worked out here): each pair carries
     k(roll) max(0, a - e) with e = d while tooth 1's contact lies in that span, 0 elsewhere and on
     every other tooth (away from the spall's edges and the pairs' entry and exit)."""
-    from twin.fmu import FMU
-    from twin.operating import operating_point
-
     d = 2e-6
-    start, inputs = operating_point(20.0, 20.0)
-    names = ["theta5", "theta10", "x5", "y5", "x10", "y10"] + [f"roll[{i}]" for i in (1, 2, 3)] \
-        + [f"pair_force[{i}]" for i in (1, 2, 3)]
-    with FMU(candidates_fmu) as f:
-        v = f.parameter_values()
-        f.setup(0.0, parameters={**start, "local_tooth_damage.spall_depth": d}, inputs=inputs)
-        rb1, rb2, edge = f.get(["rb1", "rb2", "local_tooth_damage.edge_width"])
-        f.step(0.05)
-        rows = []
-        for _ in range(6000):              # 0.06 s, more than a turn of the pinion
-            f.step(1e-5)
-            rows.append(f.get(names))
-    y = np.array(rows)
+    v, (rb1, rb2, edge), y = _mesh_states(candidates_fmu, {"local_tooth_damage.spall_depth": d},
+                                          ["rb1", "rb2", "local_tooth_damage.edge_width"])
     m, alpha, z1, z2, ha = v["module"], v["alpha"], 19, 52, v["addendum_coefficient"]
     r1, r2 = m * z1 / 2, m * z2 / 2
     p_b = np.pi * m * np.cos(alpha)
