@@ -29,7 +29,7 @@ import signal
 import tempfile
 import time
 from collections.abc import Callable, Sequence
-from concurrent.futures import FIRST_COMPLETED
+from concurrent.futures import FIRST_COMPLETED, BrokenExecutor
 from concurrent.futures import TimeoutError as FutureTimeout
 from concurrent.futures import wait
 from pathlib import Path
@@ -165,6 +165,14 @@ class IsolatedPool:
         except pebble.ProcessExpired as exc:
             err = WorkerCrashError(f"the worker process running task {i} {describe_exit(exc.exitcode)} "
                                    "(it was replaced)", exitcode=exc.exitcode)
+        except BrokenExecutor as exc:
+            # no worker could start (every one died while importing): no task ran, so the pool is
+            # unusable and every result would be this error; stop instead of handing it back as
+            # the task's own failure, which a caller would score as a candidate that did not fit
+            raise WorkerCrashError(f"the worker processes could not start ({exc}); a script that runs twin with "
+                                   "worker processes must start it under 'if __name__ == \"__main__\":' (Python's "
+                                   "multiprocessing: safe importing of the main module), or run the tasks in "
+                                   "this process (LocalExecutor(isolate=False))") from None
         except Exception as exc:   # raised by the task itself: the caller decides
             return exc
         self.crashes.append(err)

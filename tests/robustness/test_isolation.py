@@ -154,3 +154,28 @@ def test_dask_worker_that_dies_is_reported_and_replaced():
         out = ex.map(python_fault, ["segfault", "fine", "fine"])
     assert isinstance(out[0], WorkerCrashError) and "died" in str(out[0])
     assert out[1:] == ["fine", "fine"]
+
+
+def test_workers_that_cannot_start_stop_the_map_with_a_typed_error(tmp_path):
+    """A script without the ``__main__`` guard makes every spawned worker die while importing it:
+    no task runs, and map raises one WorkerCrashError that says why, instead of handing back a
+    broken-pool exception per task that a caller would take for the tasks' own failures."""
+    import subprocess
+    import sys
+
+    repo = Path(__file__).resolve().parents[2]
+    script = tmp_path / "unguarded.py"
+    script.write_text("from twin.executor import LocalExecutor\n"
+                      "from twin.errors import WorkerCrashError\n"
+                      "ex = LocalExecutor(1)\n"
+                      "try:\n"
+                      "    print('RESULTS', ex.map(abs, [-1, -2]))\n"
+                      "except WorkerCrashError as exc:\n"
+                      "    print('TYPED', exc)\n"
+                      "ex.close()\n")
+    env = {**os.environ, "PYTHONPATH": str(repo)}
+    out = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120, env=env,
+                         cwd=tmp_path).stdout
+    assert "RESULTS" not in out
+    line, = [l for l in out.splitlines() if l.startswith("TYPED")]
+    assert "could not start" in line and "__main__" in line
