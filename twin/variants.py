@@ -131,19 +131,27 @@ def geometry_summary(fmu) -> list[str]:
 
 
 def _contact_line(values: Mapping[str, float], g) -> list[str]:
-    """The Hertzian half-width at the FMU's start load, as ``hertz_half_width`` of GearTwin.Gearbox21
-    computes it, and the shaft orders where the contact halves a roughness's amplitude
+    """The Hertzian half-width at the FMU's start load on one pair at the pitch point
+    (:meth:`twin.degradation.geometry.GearPair.hertz_half_width` with the FMU's gear steel; the
+    FMU's ``hertz_half_width`` takes the same formula at the standard pitch radii, equal for gears
+    without profile shift), and the shaft orders where the contact halves a roughness's amplitude
     (``GearTwin.Excitation.RoughnessTransmissionError``: exp(-(n b / rho)^2 / 8) = 1/2)."""
+    import dataclasses
+
     needed = ("load_start", "gear_youngs_modulus", "gear_poisson_ratio")
     if not all(values.get(k) is not None for k in needed):
         return []
-    rho1 = g.pitch_radius_pinion * math.sin(g.pressure_angle)
-    rho2 = g.pitch_radius_gear * math.sin(g.pressure_angle)
+    try:
+        steel = dataclasses.replace(g, youngs_modulus=float(values["gear_youngs_modulus"]),
+                                    poisson_ratio=float(values["gear_poisson_ratio"]))
+    except ParameterError:       # a steel the stiffness formulas refuse (nu = 0.5): no line, not a failed info
+        return []
+    xi = g.pitch_point_xi
     force = max(float(values["load_start"]), 0.0) / g.base_radius_gear      # one pair carries it
-    nu, e = float(values["gear_poisson_ratio"]), float(values["gear_youngs_modulus"])
-    b = math.sqrt(8 * force / g.face_width * (rho1 * rho2 / (rho1 + rho2)) * (1 - nu ** 2) / (math.pi * e))
+    b = float(steel.hertz_half_width(force, xi))
     if b <= 0:
         return ["Contact       no static load (load_start 0): the roughness is not averaged by the contact"]
     half = math.sqrt(8 * math.log(2))
+    rho1, rho2 = float(g.rho1(xi)), float(g.rho2(xi))
     return [f"Contact       Hertz half-width {b * 1e6:.1f} um at load_start {float(values['load_start']):g} N.m; "
             f"roughness amplitude halved at shaft order {half * rho1 / b:.0f} (pinion) / {half * rho2 / b:.0f} (gear)"]
