@@ -82,7 +82,7 @@ def calibration_records(calibrated_dir: Path, rig_name: str, seed: int) -> Path:
 
 
 def one_case(rig_name: str, seed: int, effect: str, calibrated, out: Path, ex, search: dict | None = None,
-             baseline: Path | None = None) -> dict:
+             baseline: Path | None = None, encoder: bool = True) -> dict:
     from spectral_distance import change_distance_report, spectral_distance_report
 
     from twin.effects.catalogue import CATALOGUE
@@ -109,7 +109,7 @@ def one_case(rig_name: str, seed: int, effect: str, calibrated, out: Path, ex, s
     t0 = time.perf_counter()
     base_recs = read_records(baseline, CHANNEL, ["steady", "runup"]) if baseline else None
     d = diagnose(fmu, read_records(h5, CHANNEL, ["steady", "runup"]), parameters=params, executor=ex,
-                 duration=2.0, baseline=base_recs, **(search or {}))
+                 duration=2.0, baseline=base_recs, encoder=encoder, **(search or {}))
     wall = time.perf_counter() - t0
     n = int(round(2.0 * fs))
     xm = x[-n:]
@@ -156,7 +156,7 @@ def one_case(rig_name: str, seed: int, effect: str, calibrated, out: Path, ex, s
            "twin_lsd_before": d.lsd_db, "twin_lsd_after_top": top.lsd_after_db,
            "distance_before_db": dist0, "distance_after_top_db": dist1, "baseline": str(baseline or ""),
            "change_before": change0, "change_after_top": change1, "diagnose_s": wall, "rig_s": rig_s,
-           "search": search or "default", "load_average": os.getloadavg()[0],
+           "search": search or "default", "encoder": encoder, "load_average": os.getloadavg()[0],
            "truth_effect": next((r.get("effect") for r in truth.get("records", [truth]) if isinstance(r, dict)
                                  and r.get("effect")), None) if isinstance(truth, dict) else None}
     return row
@@ -198,6 +198,9 @@ def main() -> None:
                     help="give the diagnosis the records the gearbox was calibrated on as its baseline "
                          "(twin diagnose --baseline), and score the change since them (default; "
                          "--no-baseline: the diagnosis against the calibrated model alone)")
+    ap.add_argument("--encoder", action=argparse.BooleanOptionalAction, default=True,
+                    help="compare the records' pinion encoder as a second channel (twin diagnose's default; "
+                         "--no-encoder: the casing channel alone, the control)")
     ap.add_argument("--out", type=Path, default=REPO / "bench_out" / "diagnosis_rigs")
     args = ap.parse_args()
 
@@ -218,7 +221,8 @@ def main() -> None:
             calibrated = load_scenario(args.calibrated / f"{rig}_{args.seed}_cal" / "calibrated.yaml")
             for effect in args.effects:
                 rows.append(one_case(rig, args.seed, effect, calibrated, args.out, ex, search,
-                                     calibration_records(args.calibrated, rig, args.seed) if args.baseline else None))
+                                     calibration_records(args.calibrated, rig, args.seed) if args.baseline else None,
+                                     args.encoder))
                 print(json.dumps({k: v for k, v in rows[-1].items() if k != "top_fitted"}), flush=True)
                 (args.out / "results.json").write_text(json.dumps(rows, indent=1, default=str))
     print(f"Machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, {args.workers} workers, "

@@ -65,7 +65,8 @@ def spectral_levels(pm: np.ndarray, pp: np.ndarray, *, max_gain_db: float = MAX_
 
 @dataclass(frozen=True)
 class Finding:
-    kind: str                    # mesh_harmonic, sideband, shaft_order, unlocked_line, resonance, impulsive
+    kind: str                    # mesh_harmonic, sideband, shaft_order, unlocked_line, resonance, impulsive,
+                                 # angular_line (the encoder's, twin.angular)
     description: str
     frequency_hz: float          # centre (or the line)
     band_hz: tuple[float, float]
@@ -86,6 +87,9 @@ class Comparison:
     freqs: np.ndarray = field(repr=False)           # (n,) Hz
     level_measured: np.ndarray = field(repr=False)  # (n,) dB, floored
     level_model: np.ndarray = field(repr=False)     # (n,) dB, floored
+    # the encoder channel folded in (twin.angular.joint): lsd_db and the findings' shares are then
+    # the two channels' together
+    angular: object = field(default=None, repr=False)
 
     def to_dict(self) -> dict:
         return {"headline": {"log_spectral_distance_db": self.lsd_db,
@@ -96,7 +100,11 @@ class Comparison:
                 "f1_waveform": self.f1, "f2_spectrum": self.f2,
                 "rms": {"measured": self.rms_measured, "model": self.rms_model},
                 "shaft_hz": self.shaft_hz,
-                "findings": [asdict(f) for f in self.findings]}
+                "findings": [asdict(f) for f in self.findings],
+                **({"encoder": {"log_spectral_distance_db": self.angular.lsd_db,
+                                "definition": "the same over the encoder's angular vibration (the angle less a "
+                                              "quadratic in time), 2-500 Hz; the headline is then the RMS of the "
+                                              "casing's and the encoder's"}} if self.angular is not None else {})}
 
 
 def compare_signals(model: np.ndarray, measured: np.ndarray, fs: float, shaft_hz: float, *,

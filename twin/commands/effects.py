@@ -67,7 +67,7 @@ def _cmd_diagnose(args: argparse.Namespace) -> int:
     diag = loop.diagnose_scenario(scenario, Path(args.measurements), record=args.record,
                                   all_records=args.all_records, json_path=args.json, executor=local_executor(args.workers),
                                   duration=args.duration, effects=_effect_ids(args.effects),
-                                  baseline=_baseline(args, scenario))
+                                  baseline=_baseline(args, scenario), encoder=args.encoder)
     print(diag.table())
     for c in diag.candidates[:1]:
         for e in c.evidence:
@@ -81,7 +81,8 @@ def _cmd_add_effect(args: argparse.Namespace) -> int:
     scenario = lib("twin.scenario").load_scenario(Path(args.scenario))
     add = lib("twin.effects.loop").add_effect(scenario, Path(args.measurements), args.effect, Path(args.out),
                                                record=args.record, modelica_dir=args.modelica_dir,
-                                               duration=args.duration, baseline=_baseline(args, scenario))
+                                               duration=args.duration, baseline=_baseline(args, scenario),
+                                               encoder=args.encoder)
     print(f"variant {add.model} -> {add.modelica_file}")
     print(f"FMU -> {add.fmu}")
     print("fitted: " + ", ".join(f"{k} = {v:.4g}" for k, v in add.fitted.items()))
@@ -99,7 +100,8 @@ def _cmd_improve(args: argparse.Namespace) -> int:
     history = loop.improve(scenario, Path(args.measurements), Path(args.out), record=args.record,
                            all_records=args.all_records, diagnosis=args.from_diagnosis, max_steps=args.max_steps, executor=local_executor(args.workers),
                            modelica_dir=args.modelica_dir, duration=args.duration,
-                           effects=_effect_ids(args.effects), baseline=_baseline(args, scenario))
+                           effects=_effect_ids(args.effects), baseline=_baseline(args, scenario),
+                           encoder=args.encoder)
     print(loop.history_table(history))
     print(f"history -> {Path(args.out) / 'history.csv'}, plot -> {Path(args.out) / 'history.png'}")
     return 0
@@ -134,6 +136,9 @@ def _loop_arguments(p: argparse.ArgumentParser, *, out: bool, several: bool = Fa
                         "effect sought): the model's discrepancy on it is taken out of the compared levels first")
     p.add_argument("--baseline-record", action="append", metavar="NAME",
                    help="record of --baseline, repeatable (default: those named like --record)")
+    p.add_argument("--no-encoder", dest="encoder", action="store_false",
+                   help="compare the casing channel alone, not the records' pinion encoder angle as well "
+                        "(default: both, where every record has an angle encoder)")
     if out:
         p.add_argument("--out", required=True, help="output directory")
         p.add_argument("--modelica-dir", type=Path, default=None,

@@ -57,6 +57,8 @@ class Discrepancy:
     record: str
     frequencies: np.ndarray = field(repr=False)
     level_db: np.ndarray = field(repr=False)
+    # the encoder channel's (twin.angular.AngularDiscrepancy), when both records have an encoder
+    angle: object = field(default=None, repr=False)
 
     def at(self, frequencies: np.ndarray) -> np.ndarray:
         """The discrepancy [dB] at ``frequencies`` (m,) [Hz] of the record's analysis (linear
@@ -80,20 +82,24 @@ def learn(spec: DiscrepancySpec) -> Discrepancy:
     """Simulate the model at the record's operating point and return its :class:`Discrepancy`
     to the baseline's measured stretch carried there in shaft orders."""
     from twin.compare import spectral_levels
-    from twin.effects.fit import _Objective
+    from twin.effects.fit import _Objective, channels
     from twin.effects.records import simulate_runup
     from twin.errors import ParameterError
     from twin.operating import simulate_settled
     from twin.signals import welch_psd
 
     n = spec.measured.size
+    names = channels(spec.channel, spec.angle)
     if spec.shaft_hz is not None:
         model = simulate_runup(spec.fmu_path, spec.parameters, spec.shaft_hz[-n:], spec.load, spec.sample_rate,
-                               spec.channel, slip_hz=spec.slip_hz, solver_step=spec.solver_step)
+                               names, slip_hz=spec.slip_hz, solver_step=spec.solver_step)
         speed = float(np.mean(spec.shaft_hz[-n:]))
     else:
-        _, model = simulate_settled(spec.fmu_path, spec.parameters, spec.operating, n, spec.channel)
+        _, model = simulate_settled(spec.fmu_path, spec.parameters, spec.operating, n, names)
         speed = float(spec.operating.shaft_hz)
+    angle_model = None
+    if spec.angle is not None:
+        model, angle_model = model[:, 0], model[:, 1]
     if not np.all(np.isfinite(model)):
         raise ParameterError(f"the current model does not run at the operating point of the record "
                              f"diagnosed against baseline {spec.record}")
@@ -108,7 +114,14 @@ def learn(spec: DiscrepancySpec) -> Discrepancy:
     lp, lm, _ = spectral_levels(pm[objective.band], pp[objective.band])
     level = np.zeros(f.size)
     level[objective.band] = lp - lm
-    return Discrepancy(spec.record, f, np.clip(level, -MAX_DB, MAX_DB))
+    angle = None
+    if spec.angle is not None:
+        # the encoder's: what the baseline holds beyond the model, added to it (twin.angular)
+        from twin.angular import AngularDiscrepancy, AngularObjective
+        ao = AngularObjective(spec.angle[-n:], spec.sample_rate, objective.resolution)
+        angle = AngularDiscrepancy.learn(spec.record, ao.frequencies[ao.band],
+                                         at_speed(ao.frequencies, ao.psd, ratio)[ao.band], ao.model_psd(angle_model))
+    return Discrepancy(spec.record, f, np.clip(level, -MAX_DB, MAX_DB), angle)
 
 
 def at_speed(frequencies: np.ndarray, psd: np.ndarray, ratio: float, *, width_hz: float = 30.0,
@@ -169,16 +182,25 @@ def pair(records: Sequence, baseline: Sequence) -> dict[str, object]:
     return out
 
 
+def _angle(record, n: int, wanted: bool) -> np.ndarray | None:
+    """The last n samples of a record's encoder angle [rad], if wanted and it has one."""
+    return record.angle[-n:] if wanted and record.angle is not None else None
+
+
 def learn_all(fmu_path, parameters: Mapping[str, float], records: Sequence, baseline: Sequence, channel: str, *,
               duration: float, solver_step: float | None = 1e-5, held_out_runup: float = 2.0, slip_hz: float = 0.0,
-              fit_load: float = 0.0, executor=None, progress: bool = False) -> dict[str, Discrepancy]:
+              fit_load: float = 0.0, executor=None, progress: bool = False,
+              encoder: bool = False) -> dict[str, Discrepancy]:
     """Each record's :class:`Discrepancy` to its baseline, by record name: the model at the
     record's operating point (a steady record's last ``duration`` s; a run-up's last
     ``held_out_runup`` s along its measured speed, driven with the loaded motor's ``slip_hz`` at
     ``fit_load`` [N.m], scaled to its load) against the baseline's stretch as long.
     ``baseline`` may also be a mapping of record name to :class:`Discrepancy` already learned
     (:func:`twin.effects.loop.improve` learns it once, on the calibrated model, and keeps it
-    while effects are added): it is then checked to cover every record and returned."""
+    while effects are added): it is then checked to cover every record and returned.
+    With ``encoder`` the encoder channel's discrepancy is learned too (``Discrepancy.angle``)
+    for each record that has an encoder angle, as its baseline has, when the model has the
+    encoder output (:mod:`twin.angular`)."""
     from twin.effects.diagnose import record_conditions
     from twin.errors import ParameterError
 
@@ -189,6 +211,10 @@ def learn_all(fmu_path, parameters: Mapping[str, float], records: Sequence, base
                                  f"{', '.join(baseline) or 'none'})")
         return {r.name: baseline[r.name] for r in records}
     pairs = pair(records, baseline)
+    if encoder:
+        from twin.angular import ANGLE_OUTPUT
+        from twin.effects.diagnose import fmu_outputs
+        encoder = ANGLE_OUTPUT in fmu_outputs(fmu_path)
     specs = []
     for r in records:
         b = pairs[r.name]
@@ -204,6 +230,7 @@ def learn_all(fmu_path, parameters: Mapping[str, float], records: Sequence, base
             slip = slip_hz * r.load / fit_load if fit_load else slip_hz
             specs.append(DiscrepancySpec(b.name, str(fmu_path), dict(parameters), channel, b.signal[-m:], r.sample_rate,
                                          r.load, shaft_hz=r.shaft_hz[-m:], slip_hz=slip, solver_step=solver_step,
+                                         angle=_angle(b, m, encoder and r.angle is not None),
                                          baseline_hz=float(np.mean(b.shaft_hz[-m:]))))
         else:
             c = record_conditions(fmu_path, r.signal, r.sample_rate, r.nominal_speed, r.load, parameters,
@@ -212,6 +239,7 @@ def learn_all(fmu_path, parameters: Mapping[str, float], records: Sequence, base
                                    record=b.name, duration=duration, solver_step=solver_step)
             specs.append(DiscrepancySpec(b.name, str(fmu_path), dict(parameters), channel, cb.measured, r.sample_rate,
                                          r.load, operating=c.operating, solver_step=solver_step,
+                                         angle=_angle(b, cb.measured.size, encoder and r.angle is not None),
                                          baseline_hz=float(cb.operating.shaft_hz)))
     out = (executor.map(guarded_learn, specs, progress=progress, desc="baseline records") if executor is not None
            else [guarded_learn(sp) for sp in specs])

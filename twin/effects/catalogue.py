@@ -88,7 +88,9 @@ def _eccentricity(gear: str) -> Effect:
                   "mesh_harmonic": "the modulation moves energy between the mesh harmonics and their sidebands; "
                                    "a tilted gear's wobble shrinks the face contact, which softens the mesh "
                                    "and raises its harmonics",
-                  "resonance": "sideband families fill the region around resonances"})
+                  "resonance": "sideband families fill the region around resonances",
+                  "angular_line": f"below the first torsional mode the shafts turn to follow the run-out's approach "
+                                  f"change, so the encoder's angle moves once per {gear} revolution"})
 
 
 CATALOGUE: dict[str, Effect] = {e.id: e for e in (
@@ -102,14 +104,17 @@ CATALOGUE: dict[str, Effect] = {e.id: e for e in (
            neutral={"amplitude": 0.0},
            evidence={"unlocked_line": "an electrical torque ripple vibrates the drive train at its own frequency, "
                                       "which is locked to neither shaft",
-                     "sideband": "the ripple modulates the mesh force, giving sidebands at the ripple frequency"}),
+                     "sideband": "the ripple modulates the mesh force, giving sidebands at the ripple frequency",
+                     "angular_line": "the ripple's torque turns the drive train at its own frequency, which the "
+                                     "encoder's angle shows locked to neither shaft"}),
     Effect("load_torque_fluctuation", "GearTwin.Effects.LoadTorqueFluctuation", "Brake torque fluctuation",
            hooks={"effect_load_torque": "torque"},
            fit=(FitParameter("frequency", 0.5, 15.0, guess="slow_sideband"),
                 FitParameter("amplitude", 1e-2, 10.0, log=True)),
            related=("c_motor",),           # the motor's torque-slip slope sets the slow speed response
            neutral={"amplitude": 0.0},
-           evidence={"unlocked_line": "a slow load fluctuation modulates the mesh force and the speed, giving "
+           evidence={"angular_line": "the brake's torque fluctuation turns the drive train at its frequency",
+                     "unlocked_line": "a slow load fluctuation modulates the mesh force and the speed, giving "
                                       "lines beside the mesh harmonics at a spacing locked to no shaft",
                      "sideband": "the mesh-force modulation gives sidebands around the mesh harmonics",
                      "mesh_harmonic": "the modulation moves energy out of the mesh harmonics"}),

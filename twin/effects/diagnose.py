@@ -50,7 +50,7 @@ import numpy as np
 from twin.compare import Comparison, compare_signals
 from twin.effects.catalogue import CATALOGUE, Effect, effect as get_effect
 # the fit runs in the workers; its names stay importable from here
-from twin.effects.fit import (TrialSpec, _fine_spectrum, _guarded_fit, _Objective, fit_effect,  # noqa: F401
+from twin.effects.fit import (TrialSpec, _fine_spectrum, _guarded_fit, _Objective, channels, fit_effect,  # noqa: F401
                               simulate, starting_values)
 from twin.operating import Operating, simulate_settled
 from twin.effects.verdict import MIN_CUT, MIN_DB, Candidate, Diagnosis, _explained, fits, judge
@@ -61,6 +61,27 @@ HELD_OUT_RUNUP_S = 2.0   # s of the end of a run-up simulated as a held-out reco
 # record (``duration``) at the operating point's step, which is what the verdict is judged on.
 SEARCH_S = 1.0
 SEARCH_STEP = 2e-5
+
+
+def fmu_outputs(fmu_path) -> frozenset:
+    """The output names an FMU declares."""
+    from twin.fmu import FMU
+    with FMU(fmu_path) as fmu:
+        return frozenset(v.name for v in fmu.outputs)
+
+
+def uses_encoder(records: Sequence, baseline, outputs) -> bool:
+    """Whether the diagnosis compares the encoder channel too (:mod:`twin.angular`): the model
+    has the encoder output, every record has an encoder angle, and so has every baseline record
+    (or every learned baseline discrepancy its encoder part)."""
+    from twin.angular import ANGLE_OUTPUT
+    if ANGLE_OUTPUT not in outputs or any(r.angle is None for r in records):
+        return False
+    if baseline is None:
+        return True
+    if isinstance(baseline, Mapping):
+        return all(getattr(baseline.get(r.name), "angle", None) is not None for r in records)
+    return all(b.angle is not None for b in baseline)
 
 
 def active_effects(parameter_names: Sequence[str]) -> list[str]:
@@ -88,11 +109,25 @@ def _trials(eff: Effect) -> int:
     return sum(p.grid + 8 for p in free) + (15 if len(eff.fit) > 1 else 0)
 
 
+def compare_record(sim: np.ndarray, measured: np.ndarray, angle: np.ndarray | None, fs: float, shaft_hz: float,
+                   z1: int, z2: int, discrepancy=None) -> Comparison:
+    """The casing channel's comparison (``sim`` (n,) or its first column), with the encoder's
+    folded in when the record has an ``angle`` (n,) [rad] and ``sim`` is (n, 2) (:func:`twin.angular.joint`)."""
+    from twin.angular import compare_angles, joint
+    casing = compare_signals(sim[:, 0] if sim.ndim == 2 else sim, measured, fs, shaft_hz, z1=z1, z2=z2,
+                             discrepancy=discrepancy)
+    if angle is None:
+        return casing
+    return joint(casing, compare_angles(sim[:, 1], angle, fs, shaft_hz, z1=z1, z2=z2,
+                                        discrepancy=getattr(discrepancy, "angle", None)))
+
+
 def _candidate(eff: Effect, before: Comparison, fitted: dict, n_eval: int, sim: np.ndarray, measured: np.ndarray,
-               op: Operating, z1: int, z2: int, discrepancy=None) -> Candidate:
+               op: Operating, z1: int, z2: int, discrepancy=None, angle: np.ndarray | None = None) -> Candidate:
     """Score a fitted candidate against the baseline comparison (``discrepancy``: the record's
-    known model-form error, taken out of the compared levels as in ``before``)."""
-    after = compare_signals(sim, measured, op.sample_rate, op.shaft_hz, z1=z1, z2=z2, discrepancy=discrepancy)
+    known model-form error, taken out of the compared levels as in ``before``; ``angle``: the
+    record's encoder angle, compared as in ``before``)."""
+    after = compare_record(sim, measured, angle, op.sample_rate, op.shaft_hz, z1, z2, discrepancy)
     score = max(0.0, (before.lsd_db - after.lsd_db) / before.lsd_db) if before.lsd_db > 0 else 0.0
     return Candidate(eff.id, eff.title, score, after.lsd_db, fitted, _explained(before, after, eff), after.findings,
                      n_eval)
@@ -108,6 +143,7 @@ class Conditions:
     z2: int                                     # gear teeth
     operating: Operating
     structural: dict = field(default_factory=dict)   # the FMU's build-time Integers (n_path_sections, ...)
+    outputs: frozenset = frozenset()                 # the FMU's output names
 
 
 def record_conditions(fmu_path, measured: np.ndarray, sample_rate: float, nominal_speed: float, load: float,
@@ -135,6 +171,7 @@ def record_conditions(fmu_path, measured: np.ndarray, sample_rate: float, nomina
     with FMU(fmu_path) as fmu:
         current = fmu.parameter_values()
         structural = fmu.structural_values()
+        outputs = frozenset(v.name for v in fmu.outputs)
         teeth = {**{k: v for k, v in current.items() if k in ("z1", "z2")}, **structural}
     missing = [h for h in ("z1", "z2") if h not in teeth] + [h for h in ("c_motor",) if h not in current]
     if missing:
@@ -144,7 +181,7 @@ def record_conditions(fmu_path, measured: np.ndarray, sample_rate: float, nomina
     op = measured_operating(measured, sample_rate, nominal_speed, load, teeth=z1, gear_teeth=z2,
                             c_motor=float(parameters.get("c_motor", current["c_motor"])),
                             solver_step=solver_step if "solver.step_size" in current else None)
-    return Conditions(measured, current, z1, z2, op, structural)
+    return Conditions(measured, current, z1, z2, op, structural, outputs)
 
 
 def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed: float | None = None,
@@ -155,7 +192,8 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
              min_cut: float = MIN_CUT, min_db: float = MIN_DB, solver_step: float | None = 1e-5,
              related_leaders: int = 2, anchors: Mapping[str, float] | None = None,
              held_out_runup: float = HELD_OUT_RUNUP_S, search: float | None = SEARCH_S,
-             search_step: float | None = SEARCH_STEP, baseline=None, progress: bool = False) -> Diagnosis:
+             search_step: float | None = SEARCH_STEP, baseline=None, progress: bool = False,
+             encoder: bool = True) -> Diagnosis:
     """Diagnose one record, or several records of the same gearbox (see the module docstring).
 
     Parameters
@@ -188,6 +226,10 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
         (:mod:`twin.effects.baseline`), so the candidates meet what changed since, not what the
         calibrated model never matched. Or a mapping of record name to an already learned
         :class:`~twin.effects.baseline.Discrepancy`.
+    encoder : compare the records' pinion encoder as a second channel (:mod:`twin.angular`) when
+        the model has the encoder output and every record (and baseline record) an encoder angle:
+        the candidates are fitted and held out on both channels' joint LSD, and a run-out's
+        signature may be the encoder's line at its shaft's speed. False: the casing channel alone.
 
     Raises :class:`~twin.errors.ParameterError` for records that hold no steady record (a
     run-up alone cannot be fitted) or a run-up without a shaft speed.
@@ -219,19 +261,28 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
     ids = [e for e in (effects or CATALOGUE) if e not in active]
     for e in ids:
         get_effect(e)
+    given = None if baseline is None else baseline if isinstance(baseline, Mapping) else as_records(baseline)
+    encoder = encoder and uses_encoder(recs, given, cond.outputs)
+
+    def angle_of(r, n: int) -> np.ndarray | None:
+        return r.angle[-n:] if encoder else None
+
+    fit_angle = angle_of(fit_rec, measured.size)
     # the trials start from the drive command that gave the base model the measured speed: without
     # it a model whose slip differs from the estimate runs every trial twice (simulate_at)
-    op, base_model = simulate_settled(fmu_path, parameters, op, measured.size, channel)
+    op, base_model = simulate_settled(fmu_path, parameters, op, measured.size, channels(channel, fit_angle))
     ex = executor or LocalExecutor()
     discrepancy: dict = {}
-    if baseline is not None:
+    if given is not None:
         from twin.effects.baseline import learn_all
-        given = baseline if isinstance(baseline, Mapping) else as_records(baseline)
         discrepancy = learn_all(fmu_path, parameters, recs, given, channel, duration=duration,
                                 solver_step=solver_step, held_out_runup=held_out_runup,
-                                slip_hz=op.drive_hz - op.shaft_hz, fit_load=op.load, executor=ex, progress=progress)
+                                slip_hz=op.drive_hz - op.shaft_hz, fit_load=op.load, executor=ex, progress=progress,
+                                encoder=encoder)
     known = discrepancy.get(fit_rec.name)
-    before = compare_signals(base_model, measured, sample_rate, shaft, z1=z1, z2=z2, discrepancy=known)
+    before = compare_record(base_model, measured, fit_angle, sample_rate, shaft, z1, z2, known)
+    if base_model.ndim == 2:
+        base_model = base_model[:, 0]
 
     if candidates_fmu is None:
         from twin.effects.variant import _REPO_MODELICA, base_of, build_like, candidates_model
@@ -248,7 +299,7 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
     guesses = starting_values(before, measured, base_model, sample_rate, shaft, z1, z2)
     short = dict(search_samples=int(round(search * sample_rate)) if search else None, search_step=search_step)
     specs = [TrialSpec(e, str(candidates_fmu), channel, measured, op, probe, guesses.get(e, {}), max_evals, **short,
-                       discrepancy=known)
+                       discrepancy=known, angle=fit_angle)
              for e in ids]
     # the candidates with the most trials first, so that no worker is left with a long one at the end
     specs.sort(key=lambda sp: -_trials(CATALOGUE[sp.effect]))
@@ -265,20 +316,20 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
             cands.append(Candidate(eff.id, eff.title, 0.0, before.lsd_db, fitted, (), (), n_eval,
                                    "every trial of this effect failed to simulate"))
             continue
-        cands.append(_candidate(eff, before, fitted, n_eval, sim, measured, op, z1, z2, known))
+        cands.append(_candidate(eff, before, fitted, n_eval, sim, measured, op, z1, z2, known, fit_angle))
     cands.sort(key=lambda c: -c.score)
     # the leading candidates are tried again with their related base parameters refitted too
     lead = [c for c in cands[:related_leaders] if c.error is None and c.score > 0 and CATALOGUE[c.effect].related]
     specs2 = [TrialSpec(c.effect, str(candidates_fmu), channel, measured, op, probe, split_fitted(c.effect, c.fitted)[0],
                         max_evals, related=related_values(CATALOGUE[c.effect], probe, current), polish_only=True,
-                        related_anchor=dict(anchors or {}), **short, discrepancy=known)
+                        related_anchor=dict(anchors or {}), **short, discrepancy=known, angle=fit_angle)
               for c in lead]
     for c, r in zip(lead, ex.map(_guarded_fit, specs2, progress=progress, desc="related base parameters")
                     if specs2 else ()):
         if isinstance(r, Exception) or r[3] is None:
             continue
         joint = _candidate(CATALOGUE[c.effect], before, r[0], c.n_evaluations + r[2], r[3], measured, op, z1, z2,
-                           known)
+                           known, fit_angle)
         if joint.lsd_after_db < c.lsd_after_db:
             cands[cands.index(c)] = joint
     cands.sort(key=lambda c: -c.score)
@@ -294,7 +345,8 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
         for r in steady[1:]:
             c2 = conds[r.name]
             held.append((r.name, dict(measured=c2.measured, sample_rate=r.sample_rate, load=r.load,
-                                      operating=c2.operating, discrepancy=discrepancy.get(r.name))))
+                                      operating=c2.operating, discrepancy=discrepancy.get(r.name),
+                                      angle=angle_of(r, c2.measured.size))))
         for r in runups:
             if r.shaft_hz is None:
                 raise ParameterError(f"run-up {r.name} has no tachometer, encoder or speed channel: its speed "
@@ -302,7 +354,7 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
             m = int(round(min(held_out_runup, r.signal.size / r.sample_rate) * r.sample_rate))
             held.append((r.name, dict(measured=r.signal[-m:], sample_rate=r.sample_rate, load=r.load,
                                       shaft_hz=r.shaft_hz[-m:], slip_hz=slip * r.load / op.load if op.load else slip,
-                                      discrepancy=discrepancy.get(r.name))))
+                                      discrepancy=discrepancy.get(r.name), angle=angle_of(r, m))))
         fitting = [c for c in cands if fits(before, c, min_cut, min_db)]
         # nothing to test when no candidate fits: the base model is not run on the held-out records
         tasks = [HeldOutSpec(name, str(candidates_fmu), dict(probe), channel, solver_step=solver_step, **kw)
@@ -321,7 +373,12 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
             cands[cands.index(c)] = replace(c, held_out=ho)
         held_names = tuple(name for name, _ in held)
         shafts = {r.name: conds[r.name].operating.shaft_hz for r in steady}
-        survey = survey_records(steady, runups[0] if runups else None, channel, z1, z2, shafts)
+        base_recs = None
+        if encoder and given is not None and not isinstance(given, Mapping):
+            from twin.effects.baseline import pair
+            base_recs = pair(recs, given)
+        survey = survey_records(steady, runups[0] if runups else None, channel, z1, z2, shafts,
+                                encoder=encoder, baseline=base_recs)
         runup_name = survey.runup
         from twin.effects.signatures import signature
         cands = [replace(c, **dict(zip(("signature_present", "signature"), signature(c.effect, c.fitted, survey))))

@@ -44,13 +44,31 @@ class TrialSpec:
     search_step: float | None = None
     # the record's known model-form error (twin.effects.baseline.Discrepancy), taken out of its levels
     discrepancy: object = None
+    # the record's pinion encoder angle (n,) [rad], a second channel (twin.angular), or None
+    angle: np.ndarray | None = field(default=None, repr=False)
+
+    @property
+    def channels(self) -> str | list[str]:
+        """What a trial simulates: the casing channel, and the encoder's angle with an encoder."""
+        return channels(self.channel, self.angle)
+
+
+def channels(channel: str, angle) -> str | list[str]:
+    """The FMU outputs a record is compared on: ``channel``, and the encoder angle when ``angle`` is given."""
+    from twin.angular import ANGLE_OUTPUT
+    return channel if angle is None else [channel, ANGLE_OUTPUT]
 
 
 class _Objective:
-    """LSD [dB] between a simulated and the measured signal, the measured PSD computed once."""
+    """LSD [dB] between a simulated and the measured signal, the measured PSD computed once.
+
+    With the record's encoder ``angle`` (n,) [rad] the simulation is (n, 2), the casing channel
+    and the model's encoder angle, and the objective is both channels' joint LSD
+    (:func:`twin.angular.joint_lsd`); ``discrepancy.angle`` is the encoder's known model-form error.
+    """
 
     def __init__(self, measured: np.ndarray, fs: float, fmin: float = 10.0, fmax: float = 5000.0,
-                 resolution: float = 2.0, discrepancy=None):
+                 resolution: float = 2.0, discrepancy=None, angle: np.ndarray | None = None):
         from twin.signals import welch_psd
         self.fs, self.n = fs, measured.size
         self.resolution = max(resolution, 4.0 * fs / self.n)
@@ -60,19 +78,30 @@ class _Objective:
         self.pp = self.psd[self.band]
         # a known model-form error (twin.effects.baseline.Discrepancy) taken out of the measured levels
         self.offset = discrepancy.at(self.frequencies[self.band]) if discrepancy is not None else 0.0
+        self.angular = None
+        if angle is not None:
+            from twin.angular import AngularObjective
+            self.angular = AngularObjective(np.asarray(angle, float)[-self.n:], fs, self.resolution,
+                                            getattr(discrepancy, "angle", None))
 
     def __call__(self, simulated: np.ndarray) -> float:
+        from twin.angular import joint_lsd
         from twin.signals import welch_psd
         if not np.all(np.isfinite(simulated)):
             return 1e3
-        _, pm = welch_psd(simulated[: self.n], self.fs, resolution=self.resolution)
+        casing = simulated[:, 0] if simulated.ndim == 2 else simulated
+        _, pm = welch_psd(casing[: self.n], self.fs, resolution=self.resolution)
         lp, lm, _ = spectral_levels(pm[self.band], self.pp)
-        return float(np.sqrt(np.mean((lp - self.offset - lm) ** 2)))
+        lsd = float(np.sqrt(np.mean((lp - self.offset - lm) ** 2)))
+        if self.angular is None:
+            return lsd
+        return joint_lsd(lsd, self.angular(simulated[:, 1]))
 
 
-def simulate(fmu_path, parameters: Mapping[str, float], op: Operating, n: int, channel: str, *,
+def simulate(fmu_path, parameters: Mapping[str, float], op: Operating, n: int, channel, *,
              retune: bool = True) -> np.ndarray:
-    """Model signal (n,) at the measured operating point (:func:`twin.operating.simulate_at`)."""
+    """Model signal (n,) at the measured operating point (:func:`twin.operating.simulate_at`);
+    (n, k) for a list of k channels."""
     return simulate_at(fmu_path, parameters, op, n, channel, retune=retune)
 
 
@@ -99,7 +128,8 @@ def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int, np.ndarra
     if spec.search_step is not None and op.solver_step is not None:
         op = replace(op, solver_step=spec.search_step)
     short = n_search < n or op != spec.operating        # search on a shorter or coarser run, score on the whole
-    objective = _Objective(spec.measured[-n_search:], spec.operating.sample_rate, discrepancy=spec.discrepancy)
+    objective = _Objective(spec.measured[-n_search:], spec.operating.sample_rate, discrepancy=spec.discrepancy,
+                           angle=None if spec.angle is None else spec.angle[-n_search:])
     fixed = dict(spec.parameters)
     params = list(eff.fit)
     free = [p for p in params if p.guess is None]
@@ -129,7 +159,7 @@ def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int, np.ndarra
             count += 1
             try:
                 sim = simulate(spec.fmu_path, {**fixed, **base, **{eff.parameter(k): v for k, v in values.items()}},
-                               op, n_search, spec.channel, retune=not short)
+                               op, n_search, spec.channels, retune=not short)
                 cache[key] = (objective(sim), sim)
             except Exception:  # a diverging trial scores badly; it does not end the diagnosis
                 cache[key] = (1e3, None)
@@ -189,8 +219,9 @@ def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int, np.ndarra
         # the values found are scored on the whole stretch at the operating point's step
         count += 1
         try:
-            sim = simulate(spec.fmu_path, {**fixed, **fitted}, spec.operating, n, spec.channel)
-            val = _Objective(spec.measured, spec.operating.sample_rate, discrepancy=spec.discrepancy)(sim)
+            sim = simulate(spec.fmu_path, {**fixed, **fitted}, spec.operating, n, spec.channels)
+            val = _Objective(spec.measured, spec.operating.sample_rate, discrepancy=spec.discrepancy,
+                             angle=spec.angle)(sim)
         except Exception:  # a fit that diverges on the whole stretch scores badly, as in the search
             sim, val = None, 1e3
     return fitted, val, count, sim
@@ -236,6 +267,12 @@ def starting_values(comp: Comparison, measured: np.ndarray, model: np.ndarray, f
         if not locked(f[j]):
             out["motor_torque_ripple"] = {"frequency": float(f[j])}
             break
+    # a torque ripple turns the drive train at its own frequency: a line the encoder shows locked
+    # to no shaft, above the model, is the better guess (the casing may hardly see it)
+    angular = getattr(comp, "angular", None)
+    unlocked = [fd for fd in (angular.findings if angular is not None else ()) if fd.order is None and fd.size_db > 0]
+    if unlocked:
+        out["motor_torque_ripple"] = {"frequency": float(max(unlocked, key=lambda fd: fd.size_db).frequency_hz)}
     # slow modulation: excess beside the first mesh harmonics at offsets of 0.5-15 Hz
     offsets = np.arange(0.5, 15.0, 0.05)
     score = np.zeros_like(offsets)

@@ -54,7 +54,8 @@ def _record_names(record) -> list[str] | None:
 
 def diagnose_scenario(scenario, measurements, *, record: str | Sequence[str] | None = None, all_records: bool = False,
                       json_path=None, executor=None, duration: float = 2.0, progress: bool = True,
-                      candidates_fmu=None, effects: Sequence[str] | None = None, baseline=None) -> Diagnosis:
+                      candidates_fmu=None, effects: Sequence[str] | None = None, baseline=None,
+                      encoder: bool = True) -> Diagnosis:
     """``twin diagnose``: the scenario's model against one or several records; writes ``json_path`` if given.
 
     ``record``: a record name or several (``--record steady --record runup``); ``all_records``:
@@ -62,7 +63,8 @@ def diagnose_scenario(scenario, measurements, *, record: str | Sequence[str] | N
     first steady record and must hold on the others (:func:`twin.effects.diagnose.diagnose`).
     ``effects``: the candidate ids tried (default: every catalogue effect the model lacks).
     ``baseline``: records of the gearbox as the scenario's model was calibrated on it, or their
-    learned discrepancies (:func:`twin.effects.diagnose.diagnose`).
+    learned discrepancies (:func:`twin.effects.diagnose.diagnose`). ``encoder``: compare the
+    records' pinion encoder too, where they have one (:mod:`twin.angular`).
     """
     from twin.effects.records import read_records
     from twin.errors import OutputPathError
@@ -73,7 +75,7 @@ def diagnose_scenario(scenario, measurements, *, record: str | Sequence[str] | N
     diag = diagnose(scenario.fmu_path(), recs, parameters=dict(scenario.parameters), channel=channel,
                     executor=executor, duration=duration, progress=progress, candidates_fmu=candidates_fmu,
                     effects=effects, anchors=(scenario.raw or {}).get("diagnosis", {}).get("calibrated", {}),
-                    baseline=baseline)
+                    baseline=baseline, encoder=encoder)
     if json_path is not None:
         _write_json(Path(json_path), {"scenario": scenario.name, "fmu": str(scenario.fmu),
                                       "measurements": str(Path(measurements).resolve()),
@@ -102,7 +104,7 @@ def read_baseline(path, scenario, names: Sequence[str] | None = None, record=Non
 
 
 def learn_discrepancy(scenario, measurements, baseline, *, record=None, all_records: bool = False,
-                      duration: float = 2.0, executor=None) -> dict:
+                      duration: float = 2.0, executor=None, encoder: bool = True) -> dict:
     """The scenario's model's discrepancy on ``baseline`` (records of the gearbox as the model was
     calibrated on it), for each record of ``measurements`` that ``record``/``all_records`` name:
     {record name: :class:`~twin.effects.baseline.Discrepancy`}. A run-up's baseline is driven with
@@ -121,7 +123,7 @@ def learn_discrepancy(scenario, measurements, baseline, *, record=None, all_reco
         op, _ = simulate_settled(fmu, params, c.operating, c.measured.size, channel)
         slip, load = op.drive_hz - op.shaft_hz, op.load
     return learn_all(fmu, params, recs, as_records(baseline), channel, duration=duration, slip_hz=slip,
-                     fit_load=load, executor=executor)
+                     fit_load=load, executor=executor, encoder=encoder)
 
 
 def load_diagnosis(path, scenario, measurements, *, duration: float = 2.0) -> dict:
@@ -202,13 +204,15 @@ def portable_scenario(scenario, name: str, fmu: str, parameter_file: str, anchor
 
 def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str | None = None,
                start: dict | None = None, refit: bool = True, modelica_dir=None, build_dir=None,
-               candidates_fmu=None, duration: float = 2.0, max_evals: int = 30, baseline=None) -> Addition:
+               candidates_fmu=None, duration: float = 2.0, max_evals: int = 30, baseline=None,
+               encoder: bool = True) -> Addition:
     """``twin add-effect``: fit -> variant .mo -> FMU -> before/after report -> scenario.
 
     ``baseline``: records of the gearbox as the scenario's (calibrated) model was fitted to it,
     or their learned discrepancies: the model's discrepancy on them is taken out of the record
     before the effect is fitted and the before/after distances are taken
-    (:mod:`twin.effects.baseline`).
+    (:mod:`twin.effects.baseline`). ``encoder``: the record's pinion encoder is a second channel
+    of the fit and the distances, as in the diagnosis (:func:`twin.effects.diagnose.uses_encoder`).
 
     The effect is fitted in the candidate model (the current model's effects at their values,
     the new one switched on), together with its related base parameters (within
@@ -222,9 +226,10 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
 
     from twin._atomic import atomic_path
     from twin.calibration.problem import write_parameter_set
-    from twin.compare import compare_signals
-    from twin.effects.diagnose import starting_values
-    from twin.effects.verdict import _band_error
+    from twin.effects.diagnose import compare_record, starting_values, uses_encoder
+    from twin.effects.fit import channels
+    from twin.effects.records import as_records, read_records
+    from twin.effects.verdict import finding_error
     from twin.effects.variant import (_REPO_MODELICA, base_of, build_like, candidates_model, modelica_root,
                                       variant_source, write_variant)
     from twin.errors import ParameterError
@@ -241,22 +246,25 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
                              record=rec.name, duration=duration)
     measured, current, z1, z2, op = cond.measured, cond.current, cond.z1, cond.z2, cond.operating
     shaft = op.shaft_hz
-    known = None
+    known = given = None
+    this = read_records(measurements, channel, [rec.name])
     if baseline is not None:
         from collections.abc import Mapping
 
         from twin.effects.baseline import learn_all
-        from twin.effects.records import as_records, read_records
-        this = read_records(measurements, channel, [rec.name])
         given = baseline if isinstance(baseline, Mapping) else as_records(baseline)
-        known = learn_all(current_fmu, base_params, this, given, channel, duration=duration)[rec.name]
+        known = learn_all(current_fmu, base_params, this, given, channel, duration=duration,
+                          encoder=encoder)[rec.name]
+    angle = this[0].angle[-measured.size:] if encoder and uses_encoder(this, given, cond.outputs) else None
     active = active_effects(current)
     if effect_id in active:
         raise ParameterError(f"the model {scenario.fmu} already has {effect_id}")
     # carry the active effects' values into the new variant so it reproduces the current model
     values = {k: v for k, v in current.items() if any(k.startswith(a + ".") for a in active)}
-    sim0 = simulate(current_fmu, base_params, op, measured.size, channel)
-    before = compare_signals(sim0, measured, rec.sample_rate, shaft, z1=z1, z2=z2, discrepancy=known)
+    sim0 = simulate(current_fmu, base_params, op, measured.size, channels(channel, angle))
+    before = compare_record(sim0, measured, angle, rec.sample_rate, shaft, z1, z2, known)
+    if sim0.ndim == 2:
+        sim0 = sim0[:, 0]
     anchors, now = related_anchors(scenario, eff, base_params, current)
 
     # 1) the effect's parameters (and its related base parameters) in the candidate model
@@ -270,7 +278,7 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
                                         _REPO_MODELICA.parent / "build", cond.structural)
         probe = {**base_params, **values, **neutral_values(active)}
         spec = TrialSpec(effect_id, str(candidates_fmu), channel, measured, op, probe, guesses, max_evals,
-                         related=now, related_anchor=anchors, discrepancy=known)
+                         related=now, related_anchor=anchors, discrepancy=known, angle=angle)
         fitted, _, _, _ = fit_effect(spec)
     else:
         fitted = {**{eff.parameter(k): float(v) for k, v in guesses.items()},
@@ -285,10 +293,9 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
                                                base=base_of(current)),
                                 modelica_dir)
     fmu_path = build_like(model, modelica_dir, build_dir, cond.structural)
-    sim1 = simulate(fmu_path, base_params, op, measured.size, channel)
-    after = compare_signals(sim1, measured, rec.sample_rate, shaft, z1=z1, z2=z2, discrepancy=known)
-    per = tuple((f.description, _band_error(before, f.band_hz), _band_error(after, f.band_hz))
-                for f in before.findings)
+    sim1 = simulate(fmu_path, base_params, op, measured.size, channels(channel, angle))
+    after = compare_record(sim1, measured, angle, rec.sample_rate, shaft, z1, z2, known)
+    per = tuple((f.description, finding_error(before, f), finding_error(after, f)) for f in before.findings)
     # 3) a scenario for the variant, so the next step (or twin run) starts from it; the model name
     # resolves through the repository's modelica/, a variant written elsewhere by its FMU file
     write_parameter_set(base_params, out / f"parameters_{effect_id}.json")
@@ -325,7 +332,7 @@ class Step:
 def improve(scenario, measurements, out_dir, *, record: str | Sequence[str] | None = None, all_records: bool = False,
             max_steps: int = 4, executor=None, modelica_dir=None, build_dir=None, duration: float = 2.0,
             progress: bool = True, effects: Sequence[str] | None = None, diagnosis=None,
-            baseline=None) -> tuple[Step, ...]:
+            baseline=None, encoder: bool = True) -> tuple[Step, ...]:
     """``twin improve``: diagnose -> add -> recalibrate until no candidate improves the fit.
 
     ``baseline``: records of the gearbox as the scenario's model was calibrated on it. Their
@@ -333,6 +340,7 @@ def improve(scenario, measurements, out_dir, *, record: str | Sequence[str] | No
     variant with an effect must not learn it again on records that lack the effect.
 
     ``effects``: the candidate ids tried at each step (default: the whole catalogue).
+    ``encoder``: compare the records' pinion encoder too, where they have one (:mod:`twin.angular`).
     ``diagnosis``: a diagnosis of this scenario already made (a ``diagnosis.json`` path, see
     :func:`load_diagnosis`, or a :class:`Diagnosis`): the first step takes its verdict and
     fitted values instead of diagnosing again.
@@ -342,7 +350,7 @@ def improve(scenario, measurements, out_dir, *, record: str | Sequence[str] | No
         get_effect(e)                   # an unknown id is refused before anything is written
     if baseline is not None and not isinstance(baseline, dict):
         baseline = learn_discrepancy(scenario, measurements, baseline, record=record, all_records=all_records,
-                                     duration=duration, executor=executor)
+                                     duration=duration, executor=executor, encoder=encoder)
     first = None
     if isinstance(diagnosis, Diagnosis):
         first = {"verdict": diagnosis.verdict, "missing": diagnosis.missing, "record": diagnosis.record,
@@ -367,7 +375,8 @@ def improve(scenario, measurements, out_dir, *, record: str | Sequence[str] | No
         else:
             diag = diagnose_scenario(scenario, measurements, record=record, all_records=all_records,
                                      executor=executor, duration=duration, progress=progress,
-                                     json_path=out / f"diagnosis_{k}.json", effects=effects, baseline=baseline)
+                                     json_path=out / f"diagnosis_{k}.json", effects=effects, baseline=baseline,
+                                     encoder=encoder)
             verdict, missing, fit_record, lsd = diag.verdict, diag.missing, diag.record, diag.lsd_db
             fitted = _fitted_of(diag)
         if verdict != "missing_effect":
@@ -375,7 +384,8 @@ def improve(scenario, measurements, out_dir, *, record: str | Sequence[str] | No
             break
         # the diagnosis fitted the effect already: add it with those values, without a refit
         add = add_effect(scenario, measurements, missing, out, record=fit_record, start=fitted, refit=False,
-                         modelica_dir=modelica_dir, build_dir=build_dir, duration=duration, baseline=baseline)
+                         modelica_dir=modelica_dir, build_dir=build_dir, duration=duration, baseline=baseline,
+                         encoder=encoder)
         history.append(Step(k, add.effect, add.lsd_before_db, add.lsd_after_db, add.model, verdict))
         if add.lsd_after_db >= add.lsd_before_db:
             break

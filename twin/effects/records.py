@@ -28,7 +28,9 @@ class Record:
 
     ``shaft_hz`` (n,) is the pinion speed per sample [Hz] when the record has a tachometer, an
     encoder or a speed channel (None otherwise); ``raw`` is the loaded record (for the run-up
-    analysis).
+    analysis); ``angle`` (n,) [rad] the pinion encoder's angle when the tachometer is an angle
+    encoder (``tachometer_kind: angle``; a pulse train or a speed channel gives no angular
+    vibration): the diagnosis's second channel (:mod:`twin.angular`).
     """
 
     name: str
@@ -38,6 +40,7 @@ class Record:
     load: float                                 # brake load [N.m]
     shaft_hz: np.ndarray | None = field(default=None, repr=False)
     raw: object = field(default=None, repr=False, compare=False)
+    angle: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def sweep(self) -> float:
@@ -103,11 +106,13 @@ def read_records(measurements, channel: str = "accel_pinion_casing", names: Sequ
             raise MeasurementError(str(measurements), rec.name, f"lacks {', '.join(missing)} (the drive speed [Hz] "
                                                                 "and brake load [N.m] the record was taken at)")
         angle = shaft_angle(rec)
-        speed = None
+        speed = encoder = None
         if angle is not None and np.all(np.isfinite(angle)):
             speed = shaft_speed(angle, float(rec.sample_rate))
+            if rec.tachometer is not None and rec.tachometer_kind == "angle":
+                encoder = angle
         out.append(Record(rec.name, np.asarray(rec[channel], float), float(rec.sample_rate),
-                          float(rec.nominal_speed), float(rec.load), speed, rec))
+                          float(rec.nominal_speed), float(rec.load), speed, rec, encoder))
     return out
 
 
@@ -138,10 +143,36 @@ def as_records(records, sample_rate: float | None = None, nominal_speed: float |
 # ---------------------------------------------------------------------------------------------
 # The model on a run-up
 
+#: Knot spacing [s] of the speed trend: a cubic spline with knots this far apart follows a drive's
+#: run-up ramp and leaves out what changes within a revolution (the gear's at 20 Hz lasts 0.14 s).
+TREND_KNOTS_S = 0.5
+
+
+def speed_trend(shaft_hz: np.ndarray, sample_rate: float, knots_s: float = TREND_KNOTS_S) -> np.ndarray:
+    """The trend (n,) [Hz] of a pinion-speed profile (n,): its least-squares cubic spline with
+    interior knots every ``knots_s`` s (a profile shorter than two knot spans: its cubic)."""
+    from scipy.interpolate import make_lsq_spline
+    v = np.asarray(shaft_hz, float)
+    n = v.size
+    t = np.arange(n) / sample_rate
+    inner = np.arange(knots_s, t[-1] - 0.5 * knots_s, knots_s) if n > 1 else np.empty(0)
+    if n < 8 or inner.size == 0:
+        return np.polyval(np.polyfit(t, v, min(3, n - 1)), t) if n > 1 else v.copy()
+    k = 3
+    knots = np.concatenate([np.full(k + 1, t[0]), inner, np.full(k + 1, t[-1])])
+    return make_lsq_spline(t, v, knots, k=k)(t)
+
+
 def simulate_runup(fmu_path, parameters: Mapping[str, float], shaft_hz: np.ndarray, load: float, sample_rate: float,
-                   channel: str, *, slip_hz: float = 0.0, settle: float = 0.15, chunk: float = 0.005,
+                   channel, *, slip_hz: float = 0.0, settle: float = 0.15, chunk: float = 0.005,
                    solver_step: float | None = 1e-5) -> np.ndarray:
-    """The model's ``channel`` (n,) with its drive following a measured pinion-speed profile.
+    """The model's ``channel`` (n,) with its drive following a measured pinion-speed profile
+    ((n, k) for a list of k channels).
+
+    The drive follows the profile's trend (:func:`speed_trend`), not the profile itself: a
+    speed read off an encoder carries the shafts' vibration too (a run-out's once-per-turn
+    wobble, a ripple), which the drive did not command, and a model driven with it would be
+    handed the very effect it is asked to explain.
 
     ``shaft_hz`` (n,) [Hz] per sample; the drive command is it plus ``slip_hz`` (the loaded
     motor's slip), updated every ``chunk`` s (linear within the record's speed profile). The run
@@ -151,7 +182,7 @@ def simulate_runup(fmu_path, parameters: Mapping[str, float], shaft_hz: np.ndarr
     from twin.operating import operating_point
     from twin.plausibility import check_parameters
 
-    shaft_hz = np.asarray(shaft_hz, float)
+    shaft_hz = speed_trend(np.asarray(shaft_hz, float), sample_rate)
     n = shaft_hz.size
     dt = 1.0 / sample_rate
     params = dict(parameters)
@@ -159,20 +190,21 @@ def simulate_runup(fmu_path, parameters: Mapping[str, float], shaft_hz: np.ndarr
         params["solver.step_size"] = solver_step
     start, inputs = operating_point(shaft_hz[0] + slip_hz, load)
     per = max(1, int(round(chunk * sample_rate)))
-    out = np.empty(n)
+    names = [channel] if isinstance(channel, str) else list(channel)
+    out = np.empty((n, len(names)))
     with reused(fmu_path) as fmu:
         params = {**params, **start}
         check_parameters(fmu, params)
         fmu.setup(0.0, parameters=params, inputs=inputs)
-        fmu.capture(settle, dt, [channel])
+        fmu.capture(settle, dt, names)
         t = settle
         for i0 in range(0, n, per):
             i1 = min(n, i0 + per)
             w = 2 * math.pi * (float(np.mean(shaft_hz[i0:i1])) + slip_hz)
             fmu.set({"motor_speed_ref": w})
             t = settle + i1 * dt
-            out[i0:i1] = fmu.capture(t, dt, [channel])[: i1 - i0, 0]
-    return out
+            out[i0:i1] = fmu.capture(t, dt, names)[: i1 - i0]
+    return out[:, 0] if isinstance(channel, str) else out
 
 
 # ---------------------------------------------------------------------------------------------
@@ -199,18 +231,21 @@ class HeldOutSpec:
     slip_hz: float = 0.0
     solver_step: float | None = 1e-5
     discrepancy: object = None          # the record's known model-form error (twin.effects.baseline)
+    angle: np.ndarray | None = field(default=None, repr=False)   # (n,) encoder angle [rad]: a second channel
 
 
 def held_out_lsd(spec: HeldOutSpec) -> float:
-    """LSD [dB] of the model run against the held-out stretch (the diagnosis's fit objective)."""
-    from twin.effects.fit import _Objective
+    """LSD [dB] of the model run against the held-out stretch (the diagnosis's fit objective:
+    both channels' joint LSD when the stretch has an encoder ``angle``)."""
+    from twin.effects.fit import _Objective, channels
     from twin.operating import simulate_at
-    objective = _Objective(spec.measured, spec.sample_rate, discrepancy=spec.discrepancy)
+    objective = _Objective(spec.measured, spec.sample_rate, discrepancy=spec.discrepancy, angle=spec.angle)
+    names = channels(spec.channel, spec.angle)
     if spec.shaft_hz is not None:
         sim = simulate_runup(spec.fmu_path, spec.parameters, spec.shaft_hz, spec.load, spec.sample_rate,
-                             spec.channel, slip_hz=spec.slip_hz, solver_step=spec.solver_step)
+                             names, slip_hz=spec.slip_hz, solver_step=spec.solver_step)
     else:
-        sim = simulate_at(spec.fmu_path, spec.parameters, spec.operating, spec.measured.size, spec.channel)
+        sim = simulate_at(spec.fmu_path, spec.parameters, spec.operating, spec.measured.size, names)
     return objective(sim)
 
 

@@ -202,6 +202,15 @@ def _band_error(comp: Comparison, band: tuple[float, float]) -> float:
     return float(np.sum(d2[sel]))
 
 
+def finding_error(comp: Comparison, fd: Finding) -> float:
+    """Sum of the squared dB differences in a finding's band, on the channel it was found on
+    (the encoder's for an ``angular_line``; 0 when the comparison has no encoder channel)."""
+    if fd.kind == "angular_line":
+        from twin.angular import band_error
+        return band_error(comp.angular, fd.band_hz) if comp.angular is not None else 0.0
+    return _band_error(comp, fd.band_hz)
+
+
 def _explained(before: Comparison, after: Comparison, eff: Effect) -> tuple[Evidence, ...]:
     out = []
     for fd in before.findings:
@@ -211,7 +220,7 @@ def _explained(before: Comparison, after: Comparison, eff: Effect) -> tuple[Evid
                 out.append(Evidence(fd.description, fd.kind, eff.evidence[fd.kind], fd.size_db,
                                     next((g.size_db for g in after.findings if g.kind == "impulsive"), 0.0)))
             continue
-        e0, e1 = _band_error(before, fd.band_hz), _band_error(after, fd.band_hz)
+        e0, e1 = finding_error(before, fd), finding_error(after, fd)
         if e0 > 0 and e1 <= 0.5 * e0:
             reason = eff.evidence.get(fd.kind, "fitting the effect removes this part of the error")
             out.append(Evidence(fd.description, fd.kind, reason, e0, e1))

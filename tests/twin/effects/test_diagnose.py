@@ -119,3 +119,32 @@ def test_a_search_on_a_shorter_coarser_run_is_scored_on_the_whole_record(candida
     # per amplitude (eccentricity, wobble) 7 grid points and at most 8 polishing runs, then at most
     # max_evals - those (at least 4) together, and one scoring run
     assert n <= 2 * (7 + 8) + 4 + 1
+
+
+def test_a_runout_only_the_encoder_sees_is_fitted_through_the_encoder_channel(candidates_fmu):
+    """A record whose casing channel is the gearbox without the run-out and whose encoder angle is
+    the gearbox with it (as on the beam rig, where the casing hardly sees it): fitted with the
+    encoder, the run-out comes out at half its size or more; on the casing alone far smaller."""
+    from twin.angular import ANGLE_OUTPUT
+    from twin.effects.diagnose import TrialSpec, fit_effect, record_conditions
+    from twin.effects.fit import _Objective
+    from twin.effects.synthetic import _neutral
+    from twin.operating import simulate_operating_point
+    rng = np.random.default_rng(0)
+    chans = ["accel_pinion_casing", ANGLE_OUTPUT]
+    run = dict(settle=0.15, duration=0.5, channels=chans, output_interval=5e-5)
+    healthy = simulate_operating_point(candidates_fmu, 20.0, 20.0, parameters=_neutral(), **run)
+    runout = simulate_operating_point(candidates_fmu, 20.0, 20.0,
+                                      parameters={**_neutral(), "pinion_eccentricity.eccentricity": 5e-5}, **run)
+    x = healthy[:, 0] + rng.normal(0, 0.05 * healthy[:, 0].std(), healthy.shape[0])
+    angle = runout[:, 1] + rng.normal(0, 1e-7, runout.shape[0])
+    op = record_conditions(candidates_fmu, x, 20000.0, 20.0, 20.0, {}, duration=0.5).operating
+    spec = dict(effect="pinion_eccentricity", fmu_path=str(candidates_fmu), channel="accel_pinion_casing",
+                measured=x, operating=op, parameters=_neutral(), guesses={}, max_evals=20)
+    fitted, lsd, _, sim = fit_effect(TrialSpec(**spec, angle=angle))
+    assert sim.shape == (x.size, 2) and lsd == pytest.approx(_Objective(x, 20000.0, angle=angle)(sim))
+    # the twin's own casing does show a run-out, so the fit settles between the channels
+    e = fitted["pinion_eccentricity.eccentricity"]
+    assert 2e-5 < e <= 5e-5 * 1.1
+    alone, _, _, _ = fit_effect(TrialSpec(**spec))
+    assert alone["pinion_eccentricity.eccentricity"] < e / 3

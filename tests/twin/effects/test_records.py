@@ -187,3 +187,75 @@ def test_a_hidden_mode_is_fitted_on_the_steady_record_and_held_out_on_the_runup(
     assert c.held_out_cut() > 0.5
     assert (d.verdict, d.missing) == ("missing_effect", "housing_mode"), d.message
     assert c.signature_present is None         # Records without the loaded run-up: no survey
+
+
+def _encoder_file(path, *, runout: float, seed: int):
+    """One steady record with an angle encoder: a pinion angle with a once-per-turn line of
+    ``runout`` rad over a small healthy one, a gear-speed line, and a casing signal without sidebands."""
+    from twin.measurements import Record, write_measurements
+    n = int(2 * FS)
+    t = np.arange(n) / FS
+    rng = np.random.default_rng(seed)
+    angle = (2 * np.pi * 20.0 * t + (2e-5 + runout) * np.sin(2 * np.pi * 20.0 * t)
+             + 1e-4 * np.sin(2 * np.pi * 20.0 * Z1 / Z2 * t + 0.3) + 1e-7 * rng.standard_normal(n))
+    x = _gearbox_signal(np.full(n, 20.0), seed=seed)
+    write_measurements([Record("steady", {"accel_pinion_casing": x, "encoder": angle},
+                               {"accel_pinion_casing": "m/s2", "encoder": "rad"}, FS, nominal_speed=20.0, load=20.0,
+                               tachometer="encoder", tachometer_kind="angle")], path)
+    return path
+
+
+def test_an_encoders_once_per_turn_line_is_a_runouts_signature_where_the_casing_shows_none(tmp_path):
+    """Below the first torsional mode a run-out turns the shafts (bench/encoder_rigs.py): the
+    encoder's line at the pinion speed that rose since the baseline is the pinion run-out's
+    signature although the casing has no sidebands; not the gear's, nor a local fault's."""
+    from twin.effects.records import read_records
+    from twin.effects.signatures import ENCODER_RISE_DB, signature, survey_records
+    base, = read_records(_encoder_file(tmp_path / "base.h5", runout=0.0, seed=1))
+    later, = read_records(_encoder_file(tmp_path / "later.h5", runout=4e-4, seed=2))
+    same, = read_records(_encoder_file(tmp_path / "same.h5", runout=0.0, seed=3))
+    assert base.angle is not None and base.angle.shape == base.signal.shape
+    assert read_records(_write(tmp_path / "m.h5"))[0].angle is None         # a speed channel is no encoder
+    for rec, seen in ((later, True), (same, False)):
+        s = survey_records([rec], None, "accel_pinion_casing", Z1, Z2, {"steady": 20.0}, encoder=True,
+                           baseline={"steady": base})
+        assert s.encoder_basis == "baseline"
+        assert (s.encoder_lines["steady"]["pinion"] >= ENCODER_RISE_DB) is seen
+        assert s.steady_sidebands["steady"]["pinion"] == 0                    # the casing shows nothing
+        present, text = signature("pinion_eccentricity", {}, s)
+        assert present is seen and "encoder" in text
+        assert signature("gear_eccentricity", {}, s)[0] is False
+        assert signature("local_tooth_damage", {}, s)[0] is False
+    # without the encoder the casing's test alone: absent
+    s = survey_records([later], None, "accel_pinion_casing", Z1, Z2, {"steady": 20.0})
+    assert signature("pinion_eccentricity", {}, s)[0] is False
+
+
+def test_the_encoder_is_compared_only_when_model_records_and_baseline_all_have_one(tmp_path):
+    from twin.angular import ANGLE_OUTPUT
+    from twin.effects.baseline import Discrepancy
+    from twin.effects.diagnose import uses_encoder
+    from twin.effects.records import read_records
+    enc, = read_records(_encoder_file(tmp_path / "e.h5", runout=0.0, seed=1))
+    plain, = read_records(_write(tmp_path / "m.h5"))
+    outputs = frozenset({"accel_pinion_casing", ANGLE_OUTPUT})
+    assert uses_encoder([enc], None, outputs) and uses_encoder([enc], [enc], outputs)
+    assert not uses_encoder([enc], None, frozenset({"accel_pinion_casing"}))     # a model without the output
+    assert not uses_encoder([enc, plain], None, outputs)
+    assert not uses_encoder([enc], [plain], outputs)                               # the baseline has none
+    d = Discrepancy("steady", np.zeros(2), np.zeros(2))
+    assert not uses_encoder([enc], {"steady": d}, outputs)
+    assert uses_encoder([enc], {"steady": Discrepancy("steady", np.zeros(2), np.zeros(2), d)}, outputs)
+
+
+def test_a_runups_drive_follows_the_speeds_trend_not_the_shafts_wobble():
+    """An encoder's speed carries the shaft's vibration (a run-out's once-per-turn wobble); the
+    model's drive follows the trend, which keeps a ramp and leaves the wobble out."""
+    from twin.effects.records import speed_trend
+    fs = 50_000.0
+    t = np.arange(int(2 * fs)) / fs
+    ramp = 14.0 + 3.0 * t + 0.2 * np.sin(2 * np.pi * 0.3 * t)
+    wobble = 0.5 * np.sin(2 * np.pi * 17.0 * t)
+    trend = speed_trend(ramp + wobble, fs)
+    assert np.sqrt(np.mean((trend - ramp) ** 2)) < 0.1 * np.sqrt(np.mean(wobble ** 2))      # 20 dB down
+    assert speed_trend(np.linspace(2.0, 20.0, int(6 * fs)), fs) == pytest.approx(np.linspace(2.0, 20.0, int(6 * fs)))
