@@ -91,3 +91,13 @@ def test_a_discrepancy_adds_what_the_model_lacks_and_scales_what_it_overstates()
     effect = np.array([0.0, 1e-8, 0.0])                 # an effect adds a line at 20 Hz
     assert d.apply(f, model + effect) == pytest.approx(baseline + effect)
     assert d.apply(f, 2 * model)[2] == pytest.approx(2 * baseline[2])
+
+
+def test_a_diagnosis_says_when_its_distance_is_both_channels():
+    from twin.effects.verdict import Diagnosis
+    from twin.operating import Operating
+    d = Diagnosis("steady", 2.5, (), (), "nothing_missing", None, (), "nothing missing", Operating(20, 20, 20, FS),
+                  1.0, encoder=True)
+    assert "2.50 dB on steady (casing and encoder, RMS of the two)" in d.table() and d.to_dict()["encoder"] is True
+    assert "encoder" not in Diagnosis("steady", 2.5, (), (), "nothing_missing", None, (), "", Operating(20, 20, 20, FS),
+                                      1.0).table()

@@ -73,11 +73,12 @@ class Diagnosis:
     runup: str | None = None                 # the run-up the signatures were read from
     tied: tuple[str, ...] = ()               # verdict "tie": the effects that explain the same thing
     baseline: tuple[str, ...] = ()           # baseline records whose model discrepancy was taken out
+    encoder: bool = False                    # the pinion encoder compared too: lsd_db is the two channels' RMS
 
     def to_dict(self) -> dict:
         return {"record": self.record, "held_out_records": list(self.held_out_records), "runup": self.runup,
                 "baseline": list(self.baseline),
-                "verdict": self.verdict, "missing": self.missing, "tied": list(self.tied),
+                "encoder": self.encoder, "verdict": self.verdict, "missing": self.missing, "tied": list(self.tied),
                 "message": self.message, "headline": {"log_spectral_distance_db": self.lsd_db},
                 "operating": asdict(self.operating),
                 "findings": [asdict(f) for f in self.findings],
@@ -93,7 +94,9 @@ class Diagnosis:
 
     def table(self) -> str:
         """Plain-text ranking for the terminal."""
-        rows = [f"baseline log-spectral distance {self.lsd_db:.2f} dB on {self.record}, {len(self.findings)} findings"
+        rows = [f"baseline log-spectral distance {self.lsd_db:.2f} dB on {self.record}"
+                + (" (casing and encoder, RMS of the two)" if self.encoder else "")
+                + f", {len(self.findings)} findings"
                 + (f"; held out: {', '.join(self.held_out_records)}" if self.held_out_records else "")
                 + (f"; the model's discrepancy on baseline {', '.join(self.baseline)} taken out" if self.baseline
                    else ""),
