@@ -28,6 +28,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from twin.signals.spectral import padded_spectrum
+
 #: FMU output the encoder is compared with (GearTwin.Gearbox21: theta7, the input shaft's free end).
 ANGLE_OUTPUT = "encoder_pinion_angle"
 #: Band of the angular-vibration comparison [Hz].
@@ -173,8 +175,7 @@ def compare_angles(model_angle: np.ndarray, measured_angle: np.ndarray, fs: floa
                  "in the encoder's angular vibration", order=m * fo / shaft_hz)
     # a line's frequency is read on a zero-padded FFT of the whole stretch, as twin.compare does:
     # the gear's orders are 7 Hz apart at 20 Hz, so a Welch bin would make every line look locked
-    from twin.effects.fit import _fine_spectrum
-    ffine, fine = _fine_spectrum(angular_vibration(np.asarray(measured_angle, float)[-n:], fs), fs)
+    ffine, fine = padded_spectrum(angular_vibration(np.asarray(measured_angle, float)[-n:], fs), fs)
     prom = lp - median_filter(lp, size=max(5, int(round(30.0 / df))) | 1, mode="nearest")
     lock_tol = max(0.1, 0.3 * fs / n)
     for j in find_peaks(prom, height=10.0)[0]:

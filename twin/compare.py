@@ -35,7 +35,7 @@ from scipy.ndimage import median_filter
 from scipy.signal import find_peaks
 from scipy.stats import kurtosis
 
-from twin.signals import shaft_angle_from_speed, synchronous_average, welch_psd
+from twin.signals import padded_spectrum, shaft_angle_from_speed, synchronous_average, welch_psd
 
 
 MAX_GAIN_DB = 1.0   # sensor sensitivity uncertainty absorbed by the level alignment (about +-12 %)
@@ -194,9 +194,7 @@ def compare_signals(model: np.ndarray, measured: np.ndarray, fs: float, shaft_hz
     # measured lines locked to no shaft. Locking is judged on the line frequency measured on a
     # zero-padded full-length FFT, not on the Welch bins: the gear's orders are only
     # shaft_hz * z1 / z2 apart (7 Hz at 20 Hz), so a Welch bin would make every line look locked.
-    nfft = 1 << int(np.ceil(np.log2(8 * n)))
-    fine = np.abs(np.fft.rfft((measured - measured.mean()) * np.hanning(n), n=nfft))
-    ffine = np.fft.rfftfreq(nfft, 1.0 / fs)
+    ffine, fine = padded_spectrum(measured, fs)
     # a strong line on a zero-padded FFT is located far better than 1/T: 0.3/T still separates a
     # ripple line from a shaft order 1 Hz away in a 1 s record
     lock_tol = max(0.1, 0.3 * fs / n)          # Hz

@@ -40,7 +40,9 @@ Dask), and the held-out runs too (candidates x records). All evaluations use one
 """
 from __future__ import annotations
 
+import functools
 import math
+import os
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
@@ -50,7 +52,7 @@ import numpy as np
 from twin.compare import Comparison, compare_signals
 from twin.effects.catalogue import CATALOGUE, Effect, effect as get_effect
 # the fit runs in the workers; its names stay importable from here
-from twin.effects.fit import (TrialSpec, _fine_spectrum, _guarded_fit, _Objective, channels, fit_effect,  # noqa: F401
+from twin.effects.fit import (TrialSpec, _guarded_fit, _Objective, channels, fit_effect,  # noqa: F401
                               simulate, starting_values)
 from twin.operating import Operating, simulate_settled
 from twin.effects.verdict import MIN_CUT, MIN_DB, Candidate, Diagnosis, _explained, fits, judge
@@ -64,9 +66,19 @@ SEARCH_STEP = 2e-5
 
 
 def fmu_outputs(fmu_path) -> frozenset:
-    """The output names an FMU declares."""
+    """The output names an FMU declares (read once per file version: the baseline, the
+    candidates and the verdict all ask)."""
+    try:
+        st = os.stat(fmu_path)
+    except (OSError, TypeError, ValueError):
+        return _fmu_outputs.__wrapped__(fmu_path, 0, 0)     # the FMU loader names what is wrong
+    return _fmu_outputs(os.path.realpath(fmu_path), st.st_mtime_ns, st.st_size)
+
+
+@functools.lru_cache(maxsize=32)
+def _fmu_outputs(path: str, mtime_ns: int, size: int) -> frozenset:
     from twin.fmu import FMU
-    with FMU(fmu_path) as fmu:
+    with FMU(path) as fmu:
         return frozenset(v.name for v in fmu.outputs)
 
 

@@ -14,6 +14,7 @@ import numpy as np
 from twin.compare import Comparison, spectral_levels
 from twin.effects.catalogue import CATALOGUE, FitParameter
 from twin.operating import Operating, simulate_at
+from twin.signals.spectral import padded_spectrum
 
 # ---------------------------------------------------------------------------------------------
 # Evaluation of one parameter set (runs in a worker)
@@ -237,20 +238,13 @@ def _guarded_fit(spec: TrialSpec):
 # ---------------------------------------------------------------------------------------------
 # Physics-based starting values
 
-def _fine_spectrum(x: np.ndarray, fs: float) -> tuple[np.ndarray, np.ndarray]:
-    n = x.size
-    nfft = 1 << int(np.ceil(np.log2(8 * n)))
-    amp = np.abs(np.fft.rfft((x - x.mean()) * np.hanning(n), n=nfft))
-    return np.fft.rfftfreq(nfft, 1.0 / fs), amp
-
-
 def starting_values(comp: Comparison, measured: np.ndarray, model: np.ndarray, fs: float,
                     shaft_hz: float, z1: int, z2: int) -> dict[str, dict[str, float]]:
     """Initial values of guessed fit parameters, per effect id, from the measured spectrum."""
     gear_hz = shaft_hz * z1 / z2
     gmf = z1 * shaft_hz
-    f, am = _fine_spectrum(measured, fs)
-    _, ao = _fine_spectrum(model, fs)
+    f, am = padded_spectrum(measured, fs)
+    _, ao = padded_spectrum(model, fs)
     excess = 20 * np.log10((am + 1e-30) / (ao + 1e-30))
     lock_tol = max(0.1, 0.3 * fs / measured.size)      # as in twin.compare
 

@@ -239,7 +239,8 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
     out = _out_dir(out_dir)
     build_dir = Path(build_dir) if build_dir is not None else modelica_dir.parent / "build"
     channel = (scenario.outputs or ("accel_pinion_casing",))[0]
-    rec = read_record(measurements, channel, record)
+    this = read_records(measurements, channel, [record] if record else None)
+    rec = this[0]
     current_fmu = scenario.fmu_path()
     base_params = dict(scenario.parameters)
     cond = record_conditions(current_fmu, rec.signal, rec.sample_rate, rec.nominal_speed, rec.load, base_params,
@@ -247,7 +248,6 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
     measured, current, z1, z2, op = cond.measured, cond.current, cond.z1, cond.z2, cond.operating
     shaft = op.shaft_hz
     known = given = None
-    this = read_records(measurements, channel, [rec.name])
     if baseline is not None:
         from collections.abc import Mapping
 

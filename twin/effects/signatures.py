@@ -32,6 +32,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from twin.signals.spectral import padded_spectrum
+
 #: A steady line is present when it stands this much above the median of the fine spectrum
 #: around it [dB]: a Rayleigh-distributed noise bin exceeds its median by 10 dB with
 #: probability exp(-10 ln 2) ~ 1e-3.
@@ -79,8 +81,7 @@ def steady_sidebands(x: np.ndarray, fs: float, shaft_hz: float, z1: int, z2: int
                      ) -> dict[str, int]:
     """Mesh harmonics (of the first ``n_harmonics`` below 0.4 fs) with a first sideband at the
     pinion / gear speed standing ``LINE_DB`` above the median spectrum within +-3 shaft speeds."""
-    from twin.effects.fit import _fine_spectrum
-    f, amp = _fine_spectrum(np.asarray(x, float), fs)
+    f, amp = padded_spectrum(np.asarray(x, float), fs)
     df = f[1] - f[0]
     gmf = z1 * shaft_hz
     out = {}
@@ -104,9 +105,8 @@ def encoder_line(angle: np.ndarray, fs: float, shaft_hz: float, spacing_hz: floa
     """(amplitude [rad], the median of the angular spectrum within +-3 pinion speeds [rad]) of the
     encoder's angular-vibration line at ``spacing_hz`` (a shaft's speed) [Hz]."""
     from twin.angular import angular_vibration
-    from twin.effects.fit import _fine_spectrum
     x = angular_vibration(angle, fs)
-    f, amp = _fine_spectrum(x, fs)
+    f, amp = padded_spectrum(x, fs)
     tol = max(2 * (f[1] - f[0]), 0.3 * fs / x.size)
     line = float(np.max(amp[(f >= spacing_hz - tol) & (f <= spacing_hz + tol)]))
     around = (f >= max(spacing_hz - 3 * shaft_hz, 0.5)) & (f <= spacing_hz + 3 * shaft_hz)

@@ -13,13 +13,13 @@ Typical use on a measured or simulated record (x [m/s**2] at fs [Hz], tacho puls
 from twin.signals._checks import SignalError
 from twin.signals.gearmesh import mesh_harmonics, sideband_energy_ratio
 from twin.signals.modes import frf_h1_h2, modal_peaks, remove_foundation_modes, runup_natural_frequencies
-from twin.signals.spectral import amplitude_spectrum, spectrum_db, welch_psd
+from twin.signals.spectral import amplitude_spectrum, padded_spectrum, spectrum_db, welch_psd
 from twin.signals.tsa import (angular_resample, order_spectrum, shaft_angle_from_encoder, shaft_angle_from_speed,
                               shaft_angle_from_tacho, synchronous_average)
 
 __all__ = [
     "SignalError", "amplitude_spectrum", "angular_resample", "frf_h1_h2", "mesh_harmonics", "modal_peaks",
-    "order_spectrum", "remove_foundation_modes", "runup_natural_frequencies", "shaft_angle_from_encoder",
+    "order_spectrum", "padded_spectrum", "remove_foundation_modes", "runup_natural_frequencies", "shaft_angle_from_encoder",
     "shaft_angle_from_speed", "shaft_angle_from_tacho", "sideband_energy_ratio", "spectrum_db",
     "synchronous_average", "welch_psd",
 ]

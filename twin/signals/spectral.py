@@ -1,4 +1,5 @@
-"""Spectra of sampled signals: Welch power spectral density, window-corrected amplitude spectrum, dB.
+"""Spectra of sampled signals: Welch power spectral density, window-corrected amplitude spectrum,
+zero-padded line spectrum, dB.
 
 Conventions used throughout ``twin.signals``
 --------------------------------------------
@@ -102,6 +103,45 @@ def amplitude_spectrum(x, fs: float, *, window: str = "hann") -> tuple[np.ndarra
     # Fold the negative frequencies onto the positive ones; DC and (even n) Nyquist have no mirror.
     spectrum[..., 1:(n + 1) // 2] *= 2.0
     return np.fft.rfftfreq(n, d=1.0 / fs), spectrum
+
+
+def padded_spectrum(x, fs: float, *, pad: int = 8) -> tuple[np.ndarray, np.ndarray]:
+    """Amplitude spectrum of the whole record, Hann-windowed and zero-padded to locate lines.
+
+    A line on a zero-padded FFT is located to a small fraction of ``1/T``: ``twin.compare`` and
+    the diagnosis judge whether a line is locked to a shaft with 0.3/T, and the gear's orders are
+    only ``shaft_hz * z1 / z2`` apart. The mean is removed first.
+
+    Parameters
+    ----------
+    x : (n,) array
+        Signal [unit].
+    fs : float
+        Sampling rate [Hz].
+    pad : int
+        The FFT length is the power of two at or above ``pad * n``.
+
+    Returns
+    -------
+    f : (m,) array
+        Frequencies [Hz], spacing ``fs / nfft``.
+    amplitude : (m,) array
+        Peak amplitude [unit] of a sinusoid at each frequency (the window's coherent gain undone;
+        between the record's own bins the Hann scalloping is at most 0.03 dB with ``pad`` 8).
+    """
+    fs = positive(fs, "fs")
+    x = np.asarray(x, dtype=float)
+    if x.ndim != 1 or x.size < 2:
+        raise SignalError(f"x needs to be one-dimensional with at least 2 samples, got shape {x.shape}")
+    if not np.all(np.isfinite(x)):
+        raise SignalError("x must be finite (it contains NaN or inf)")
+    if int(pad) < 1:
+        raise SignalError(f"pad must be at least 1, got {pad}")
+    n = x.size
+    nfft = 1 << int(np.ceil(np.log2(int(pad) * n)))
+    w = np.hanning(n)
+    amp = np.abs(np.fft.rfft((x - x.mean()) * w, n=nfft)) * (2.0 / np.sum(w))
+    return np.fft.rfftfreq(nfft, 1.0 / fs), amp
 
 
 def spectrum_db(spectrum, *, ref: float = 1.0, quantity: str = "amplitude") -> np.ndarray:

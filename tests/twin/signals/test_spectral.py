@@ -1,11 +1,11 @@
-"""Known-answer tests of the spectral estimators (Welch PSD, amplitude spectrum, dB)."""
+"""Known-answer tests of the spectral estimators (Welch PSD, amplitude and padded spectra, dB)."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
 from twin.errors import TwinError
-from twin.signals import SignalError, amplitude_spectrum, spectrum_db, welch_psd
+from twin.signals import SignalError, amplitude_spectrum, padded_spectrum, spectrum_db, welch_psd
 
 FS = 4096.0
 
@@ -77,3 +77,26 @@ def test_bad_arguments_name_the_value():
         amplitude_spectrum(np.zeros(10), -1.0)
     with pytest.raises(ValueError, match="quantity"):
         spectrum_db(np.ones(3), quantity="energy")
+
+
+def test_padded_spectrum_locates_an_off_bin_line_and_reads_its_amplitude():
+    # 0.5 s record: bins 2 Hz apart; a line 0.37 bin off and a second 1 Hz away (half a bin)
+    t = np.arange(int(0.5 * FS)) / FS
+    x = 2.0 + 0.8 * np.sin(2 * np.pi * 100.74 * t) + 0.3 * np.sin(2 * np.pi * 301.0 * t)
+    f, amp = padded_spectrum(x, FS)
+    assert f[1] - f[0] <= 2.0 / 8
+    j = int(np.argmax(amp))
+    assert f[j] == pytest.approx(100.74, abs=0.3 * FS / t.size)
+    assert amp[j] == pytest.approx(0.8, rel=0.01)      # scalloping below 0.03 dB with 8x padding
+    assert amp[np.argmin(np.abs(f - 301.0))] == pytest.approx(0.3, rel=0.02)
+    assert amp[0] < 0.05                               # the mean (2.0) is removed
+
+
+@pytest.mark.parametrize("x, kw, needle", [
+    (np.ones((2, 8)), {}, "shape (2, 8)"),
+    (np.array([0.0, np.nan, 1.0]), {}, "NaN"),
+    (np.arange(8.0), {"pad": 0}, "pad must be at least 1, got 0"),
+])
+def test_padded_spectrum_refuses_bad_input_by_name(x, kw, needle):
+    with pytest.raises(SignalError, match=needle.replace("(", r"\(").replace(")", r"\)")):
+        padded_spectrum(x, FS, **kw)
