@@ -12,7 +12,8 @@ input shaft's free end, where test rigs mount their encoders).
 drift) [rad]. Its Welch PSD over :data:`ANGLE_BAND` (the shaft orders, the drive's lines and
 the first torsional modes; above it the angle of a 2048-count encoder is mostly quantisation) is
 compared as the casing channel is (:func:`twin.compare.spectral_levels`: floor-aware, the gain
-aligned within 1 dB), giving its own log-spectral distance; a baseline record's discrepancy is
+aligned within 1 dB), giving its own distance: the RMS dB error over the bins where the record
+holds content, not over every bin of the band (:class:`AngularObjective`); a baseline record's discrepancy is
 learned as missing content added to the model (:class:`AngularDiscrepancy`). The diagnosis judges the two channels together by :func:`joint_lsd`, the RMS of the two
 distances, so a channel that does not change leaves the relative cut of the other unchanged, and
 the findings of both are ranked by their share of the joint squared distance (:func:`joint`).
@@ -83,7 +84,8 @@ class AngularDiscrepancy:
 
 @dataclass(frozen=True)
 class AngularComparison:
-    """The encoder channel's comparison: LSD [dB], findings and levels (m,) over :data:`ANGLE_BAND`."""
+    """The encoder channel's comparison: distance [dB] (RMS over the record's content bins,
+    :class:`AngularObjective`), findings and levels (m,) over :data:`ANGLE_BAND`."""
 
     lsd_db: float
     findings: tuple = ()
@@ -92,9 +94,28 @@ class AngularComparison:
     level_model: np.ndarray = field(default=None, repr=False)     # (m,) dB
 
 
+#: A bin of the encoder's spectrum holds content (a line, a torsional hump, the speed control's
+#: wander) where it stands this much above the spectrum's median, the encoder's noise [dB]:
+#: 7 averaged Welch segments of noise reach it with probability below 1e-6.
+CONTENT_DB = 10.0
+
+
+def content_threshold(psd: np.ndarray) -> float:
+    """The level [dB] above which a bin of the measured angular PSD (m,) holds content:
+    :data:`CONTENT_DB` over its median."""
+    return 10 * math.log10(max(float(np.median(np.asarray(psd, float))), 1e-30)) + CONTENT_DB
+
+
 class AngularObjective:
-    """LSD [dB] of a simulated angle's vibration against the measured one's, the measured PSD
-    computed once (the encoder's part of the diagnosis's objective)."""
+    """Distance [dB] of a simulated angle's vibration from the measured one's, the measured PSD
+    computed once (the encoder's part of the diagnosis's objective).
+
+    The encoder's spectrum is lines (shaft orders, drive lines) and torsional humps over its
+    noise. The distance is the RMS dB error of what it holds: the squared differences are summed
+    over the bins where the record or the model stands :data:`CONTENT_DB` over the measured
+    median, and divided by the number of the record's own such bins (its content), not by every
+    bin of :data:`ANGLE_BAND`, so it does not shrink when the band is widened; a line the model
+    adds where the record has none adds its squared error to the sum."""
 
     def __init__(self, angle: np.ndarray, fs: float, resolution: float, discrepancy=None):
         from twin.signals import welch_psd
@@ -102,6 +123,8 @@ class AngularObjective:
         self.frequencies, self.psd = welch_psd(angular_vibration(angle, fs), fs, resolution=self.resolution)
         self.band = (self.frequencies >= ANGLE_BAND[0]) & (self.frequencies <= min(ANGLE_BAND[1], fs / 2))
         self.pp = self.psd[self.band]
+        self.threshold = content_threshold(self.pp)
+        self.content = max(1, int(np.count_nonzero(10 * np.log10(np.maximum(self.pp, 1e-300)) >= self.threshold)))
         self.discrepancy = discrepancy
 
     def model_psd(self, simulated_angle: np.ndarray) -> np.ndarray:
@@ -122,8 +145,12 @@ class AngularObjective:
     def __call__(self, simulated_angle: np.ndarray) -> float:
         if not np.all(np.isfinite(simulated_angle)):
             return 1e3
-        lp, lm = self.levels(simulated_angle)
-        return float(np.sqrt(np.mean((lp - lm) ** 2)))
+        return self.distance(*self.levels(simulated_angle))
+
+    def distance(self, lp: np.ndarray, lm: np.ndarray) -> float:
+        """The RMS dB error [dB] over the content bins, from the measured and model levels (m,)."""
+        sel = (lp >= self.threshold) | (lm >= self.threshold)
+        return float(np.sqrt(np.sum((lp[sel] - lm[sel]) ** 2) / self.content))
 
 
 def joint_lsd(casing_db: float, angular_db: float | None) -> float:
@@ -188,7 +215,7 @@ def compare_angles(model_angle: np.ndarray, measured_angle: np.ndarray, fs: floa
         line(fl, lambda sz, fl=fl: f"a line at {fl:.1f} Hz locked to no shaft in the encoder's angular vibration "
                                    f"({sz:+.1f} dB above the model)", exact=True)
     findings.sort(key=lambda x: -x.share)
-    return AngularComparison(float(np.sqrt(np.mean(d2))), tuple(findings), f, lp, lm)
+    return AngularComparison(obj.distance(lp, lm), tuple(findings), f, lp, lm)
 
 
 def joint(casing, angular: AngularComparison | None):

@@ -79,6 +79,24 @@ def test_the_objective_with_an_encoder_scores_both_channels():
     assert obj(np.column_stack([casing, measured_angle])) < both
 
 
+def test_the_encoder_distance_is_the_error_of_its_content_not_of_its_band():
+    """A line the model lacks (or adds) weighs by the record's content bins, not by the 250 bins
+    of the 2-500 Hz band: widening the band would otherwise dilute it."""
+    from twin.angular import AngularObjective
+    n = int(2 * FS)
+    measured = _angle(n, ripple=5e-6, seed=2)              # a gear-speed line and a 113 Hz line
+    enc = AngularObjective(measured, FS, 2.0)
+    lp, lm = enc.levels(_angle(n, seed=1))                 # the model lacks the 113 Hz line
+    d2 = (lp - lm) ** 2
+    assert enc.content < 0.1 * lp.size
+    held = (lp >= enc.threshold) | (lm >= enc.threshold)
+    assert enc(_angle(n, seed=1)) == pytest.approx(np.sqrt(d2[held].sum() / enc.content))
+    assert enc(_angle(n, seed=1)) > 3 * np.sqrt(d2.mean()) and enc(_angle(n, seed=1)) > 10.0
+    # a model with a line the record lacks is as far off
+    plain = AngularObjective(_angle(n, seed=2), FS, 2.0)
+    assert plain(_angle(n, ripple=5e-6, seed=1)) > 10.0 > 1.0 > plain(_angle(n, seed=1))
+
+
 def test_a_discrepancy_adds_what_the_model_lacks_and_scales_what_it_overstates():
     """Learned on a baseline, the read model equals the baseline; what an effect adds to the model
     is added on top of the gearbox's own content, not scaled by its ratio to the model."""
