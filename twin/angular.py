@@ -124,7 +124,7 @@ class AngularObjective:
         self.band = (self.frequencies >= ANGLE_BAND[0]) & (self.frequencies <= min(ANGLE_BAND[1], fs / 2))
         self.pp = self.psd[self.band]
         self.threshold = content_threshold(self.pp)
-        self.content = max(1, int(np.count_nonzero(10 * np.log10(np.maximum(self.pp, 1e-300)) >= self.threshold)))
+        self.content = max(1, int(np.count_nonzero(self.pp >= 10 ** (self.threshold / 10))))
         self.discrepancy = discrepancy
 
     def model_psd(self, simulated_angle: np.ndarray) -> np.ndarray:
