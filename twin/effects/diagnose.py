@@ -82,6 +82,16 @@ def _fmu_outputs(path: str, mtime_ns: int, size: int) -> frozenset:
         return frozenset(v.name for v in fmu.outputs)
 
 
+def require_running(block: np.ndarray, record: str, op: Operating) -> np.ndarray:
+    """The base model's run ``block`` at a record's operating point, refused when it holds NaN
+    or Inf (a model that diverges there gives no comparison and no starting values)."""
+    if not np.all(np.isfinite(block)):
+        from twin.errors import ParameterError
+        raise ParameterError(f"the model does not run at the operating point of record {record} "
+                             f"({op.shaft_hz:.2f} Hz, {op.load:g} N.m): its signal holds NaN or Inf")
+    return block
+
+
 def uses_encoder(records: Sequence, baseline, outputs) -> bool:
     """Whether the diagnosis compares the encoder channel too (:mod:`twin.angular`): the model
     has the encoder output, every record has an encoder angle, and so has every baseline record
@@ -283,6 +293,7 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
     # the trials start from the drive command that gave the base model the measured speed: without
     # it a model whose slip differs from the estimate runs every trial twice (simulate_at)
     op, base_model = simulate_settled(fmu_path, parameters, op, measured.size, channels(channel, fit_angle))
+    require_running(base_model, fit_rec.name, op)
     ex = executor or LocalExecutor()
     discrepancy: dict = {}
     if given is not None:

@@ -21,7 +21,7 @@ import numpy as np
 from twin.compare import MeasuredRecord, read_record  # noqa: F401  (part of this module's API)
 from twin.effects.catalogue import RELATED_SPAN, effect as get_effect
 from twin.effects.diagnose import (TrialSpec, active_effects, diagnose, fit_effect, record_conditions,
-                                   related_values, simulate, split_fitted)
+                                   related_values, require_running, simulate, split_fitted)
 from twin.effects.verdict import Diagnosis
 
 
@@ -261,7 +261,7 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
         raise ParameterError(f"the model {scenario.fmu} already has {effect_id}")
     # carry the active effects' values into the new variant so it reproduces the current model
     values = {k: v for k, v in current.items() if any(k.startswith(a + ".") for a in active)}
-    sim0 = simulate(current_fmu, base_params, op, measured.size, channels(channel, angle))
+    sim0 = require_running(simulate(current_fmu, base_params, op, measured.size, channels(channel, angle)), rec.name, op)
     before = compare_record(sim0, measured, angle, rec.sample_rate, shaft, z1, z2, known)
     if sim0.ndim == 2:
         sim0 = sim0[:, 0]

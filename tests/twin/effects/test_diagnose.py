@@ -65,6 +65,16 @@ def test_bad_records_and_models_are_refused(gearbox_fmu, two_mass_fmu):
         diagnose(two_mass_fmu, np.zeros(20000), 20000.0, 20.0, 20.0)
 
 
+def test_a_model_that_diverges_at_the_operating_point_is_refused_by_record(gearbox_fmu, monkeypatch):
+    import twin.effects.diagnose as diag
+    t = np.arange(20000) / 20000.0
+    measured = np.sin(2 * np.pi * 19 * 20.0 * t) + 0.01 * np.random.default_rng(0).standard_normal(t.size)
+    monkeypatch.setattr(diag, "simulate_settled", lambda fmu, params, op, n, ch: (op, np.full(n, np.nan)))
+    with pytest.raises(ParameterError, match="does not run at the operating point of record shop_floor "
+                                             r"\(20\.\d\d Hz, 20 N\.m\).*NaN"):
+        diagnose(gearbox_fmu, measured, 20000.0, 20.0, 20.0, record="shop_floor")
+
+
 def test_starting_value_of_a_ripple_is_the_unlocked_line(gearbox_fmu):
     from twin.compare import compare_signals
     from twin.effects.diagnose import starting_values
