@@ -66,11 +66,13 @@ def spectral_levels(pm: np.ndarray, pp: np.ndarray, *, max_gain_db: float = MAX_
 @dataclass(frozen=True)
 class Finding:
     kind: str                    # mesh_harmonic, sideband, shaft_order, unlocked_line, resonance, impulsive,
-                                 # angular_line (the encoder's, twin.angular)
+                                 # envelope_line (a series in the envelope), angular_line (the encoder's,
+                                 # twin.angular)
     description: str
     frequency_hz: float          # centre (or the line)
     band_hz: tuple[float, float]
-    size_db: float               # measured minus model [dB] (kurtosis difference for impulsive)
+    size_db: float               # measured minus model [dB] (kurtosis difference for impulsive, the
+                                 # series' prominence in the envelope for envelope_line)
     share: float                 # share of the total squared log-spectral difference (0..1)
     order: float | None = None   # in pinion orders, when locked
 
@@ -246,11 +248,42 @@ def compare_signals(model: np.ndarray, measured: np.ndarray, fs: float, shaft_hz
         findings.append(Finding("impulsive", f"impulsive once per pinion revolution (TSA kurtosis {kp:.1f} "
                                              f"measured vs {km:.1f} model)", float(shaft_hz), (0.0, float(f[-1])),
                                 kp - km, float(np.sum(d2[~used]) / total), 1.0))
+    findings.extend(_envelope_findings(model, measured, fs, shaft_hz, z1, z2, f, d2, used, total, discrepancy))
     findings.sort(key=lambda x: -x.share)
     f1 = waveform_mismatch(model, measured, fs, shaft_hz)
     f2 = spectrum_mismatch(model, measured, fs, fmin=fmin, fmax=fmax, resolution=resolution)
     return Comparison(lsd, f1, f2, float(np.sqrt(np.mean(measured ** 2))), float(np.sqrt(np.mean(model ** 2))),
                       float(shaft_hz), tuple(findings), f, lp, lm)
+
+
+def _envelope_findings(model, measured, fs, shaft_hz, z1, z2, f, d2, used, total, discrepancy) -> list[Finding]:
+    """Harmonic series in the measured record's envelope, locked to neither shaft, that neither
+    the model's envelope nor the baseline's (``discrepancy.envelope_orders``) holds: repeated
+    impacts not synchronous with the gears, as a rolling-element bearing defect gives
+    (:mod:`twin.signals.envelope`). ``share``: of the squared level difference in the
+    demodulated band's bins not already explained by another finding (0 when it lies above the
+    compared band); the verdict counts such a finding whatever its share
+    (:data:`twin.effects.verdict.OWN_EVIDENCE`)."""
+    from twin.signals.envelope import envelope_series
+
+    ratio = z1 / z2
+    measured_series = [s for s in envelope_series(measured, fs, shaft_hz, gear_ratio=ratio) if s.locked_to is None]
+    if not measured_series:
+        return []
+    known = [s.order for s in envelope_series(model, fs, shaft_hz, gear_ratio=ratio)]
+    known += list(getattr(discrepancy, "envelope_orders", ()) or ())
+    out = []
+    for s in measured_series:
+        if any(abs(s.order - o) <= 0.02 * max(s.order, 1.0) for o in known):
+            continue
+        sel = (f >= s.band_hz[0]) & (f <= s.band_hz[1]) & ~used
+        out.append(Finding("envelope_line",
+                           f"a modulation at {s.frequency_hz:.1f} Hz ({s.order:.2f}x pinion speed, locked to neither "
+                           f"shaft) with {s.harmonics} harmonics, {s.prominence_db:+.0f} dB in the envelope of "
+                           f"{s.band_hz[0]:.0f}-{s.band_hz[1]:.0f} Hz: repeated impacts not synchronous with the "
+                           "gears, as a rolling-element bearing defect gives", s.frequency_hz, s.band_hz,
+                           s.prominence_db, float(np.sum(d2[sel]) / total), s.order))
+    return out
 
 
 @dataclass(frozen=True)

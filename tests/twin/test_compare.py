@@ -46,6 +46,32 @@ def test_line_not_locked_to_any_shaft_is_found(base):
     assert top.share > 0.5 and "not locked to any shaft" in top.description
 
 
+def test_repeated_impacts_locked_to_neither_shaft_are_an_envelope_finding(base):
+    """A bearing's ring-downs at a non-integer order, too weak to lift the spectrum, stand out
+    in the envelope; the same impacts in the model are no finding."""
+    rng = np.random.default_rng(1)
+    ring = np.exp(-np.arange(300) / 40.0) * np.sin(2 * np.pi * 12000.0 * np.arange(300) / 1e5)
+    hits = np.zeros(base.size)
+    t = 0.0
+    while (i := int((t := t + (1 + 0.01 * rng.standard_normal()) / (3.585 * SHAFT)) * 1e5)) + 300 < base.size:
+        hits[i:i + 300] += 0.5 * np.std(base) * ring
+    c = compare_signals(base, _noisy(base + hits), 1e5, SHAFT)
+    found = [f for f in c.findings if f.kind == "envelope_line"]
+    assert len(found) == 1 and found[0].order == pytest.approx(3.585, abs=0.01)
+    assert "locked to neither shaft" in found[0].description and found[0].band_hz[0] <= 12000 <= found[0].band_hz[1]
+    assert not [f for f in compare_signals(base + hits, _noisy(base + hits), 1e5, SHAFT).findings
+                if f.kind == "envelope_line"]
+
+    class Baseline:                      # the gearbox had the same impacts when calibrated
+        envelope_orders = (3.58,)
+
+        @staticmethod
+        def at(f):
+            return np.zeros(np.size(f))
+    assert not [f for f in compare_signals(base, _noisy(base + hits), 1e5, SHAFT, discrepancy=Baseline).findings
+                if f.kind == "envelope_line"]
+
+
 def test_weak_tooth_is_impulsive_with_sidebands(gearbox_fmu, base):
     c = compare_signals(base, _noisy(_sim(gearbox_fmu, {"tooth_stiffness_factor[5]": 0.5})), 1e5, SHAFT)
     kinds = [f.kind for f in c.findings]

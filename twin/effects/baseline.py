@@ -59,6 +59,9 @@ class Discrepancy:
     level_db: np.ndarray = field(repr=False)
     # the encoder channel's (twin.angular.AngularDiscrepancy), when both records have an encoder
     angle: object = field(default=None, repr=False)
+    # fundamentals [pinion orders] of the harmonic series in the baseline's envelope
+    # (twin.signals.envelope): repeated impacts the gearbox had when calibrated are not a change
+    envelope_orders: tuple[float, ...] = ()
 
     def at(self, frequencies: np.ndarray) -> np.ndarray:
         """The discrepancy [dB] at ``frequencies`` (m,) [Hz] of the record's analysis (linear
@@ -121,7 +124,11 @@ def learn(spec: DiscrepancySpec) -> Discrepancy:
         ao = AngularObjective(spec.angle[-n:], spec.sample_rate, objective.resolution)
         angle = AngularDiscrepancy.learn(spec.record, ao.frequencies[ao.band],
                                          at_speed(ao.frequencies, ao.psd, ratio)[ao.band], ao.model_psd(angle_model))
-    return Discrepancy(spec.record, f, np.clip(level, -MAX_DB, MAX_DB), angle)
+    envelope = ()
+    if spec.shaft_hz is None and spec.baseline_hz > 0:      # a run-up's stretch smears its series
+        from twin.signals.envelope import envelope_series
+        envelope = tuple(s.order for s in envelope_series(spec.measured, spec.sample_rate, spec.baseline_hz))
+    return Discrepancy(spec.record, f, np.clip(level, -MAX_DB, MAX_DB), angle, envelope)
 
 
 def at_speed(frequencies: np.ndarray, psd: np.ndarray, ratio: float, *, width_hz: float = 30.0,

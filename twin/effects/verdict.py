@@ -23,6 +23,9 @@ MIN_DB = 0.15       # and absolute cut [dB] (the LSD floor of a complete model i
 MIN_SHARE = 0.05    # findings below this share of the error are not reported as unexplained
 BASE_BANDS = 2      # separate bands of broadband level off by 6 dB or more ...
 BASE_SHARE = 0.5    # ... holding this share of the error: the base model, not an effect, is wrong
+#: findings measured in a domain of their own (not the log spectrum): a candidate explains one when
+#: it is gone from the candidate's comparison
+OWN_EVIDENCE = ("impulsive", "envelope_line")
 HELD_OUT_DB = 0.05  # LSD cut [dB] a candidate must keep on every record it was not fitted on
 TIE_RATIO = 0.8     # two candidates explaining the same findings within this score ratio are a tie
 
@@ -141,7 +144,9 @@ def judge(before: Comparison, candidates: Sequence[Candidate], *, min_cut: float
     any effect); ``unexplained`` for other large findings; else ``nothing_missing``. Candidates
     that fitted but did not earn their place are named in the message, with the reason.
     """
-    big = [fd for fd in before.findings if fd.share >= MIN_SHARE]
+    # an envelope series counts whatever its share of the spectral error: it is thresholded in the
+    # envelope, and its band often lies above the compared one
+    big = [fd for fd in before.findings if fd.share >= MIN_SHARE or fd.kind == "envelope_line"]
     fitted = [c for c in candidates if fits(before, c, min_cut, min_db)]
 
     def held_ok(c: Candidate) -> bool:
@@ -217,11 +222,11 @@ def finding_error(comp: Comparison, fd: Finding) -> float:
 def _explained(before: Comparison, after: Comparison, eff: Effect) -> tuple[Evidence, ...]:
     out = []
     for fd in before.findings:
-        if fd.kind == "impulsive":
-            gone = not any(g.kind == "impulsive" for g in after.findings)
-            if gone and fd.kind in eff.evidence:
-                out.append(Evidence(fd.description, fd.kind, eff.evidence[fd.kind], fd.size_db,
-                                    next((g.size_db for g in after.findings if g.kind == "impulsive"), 0.0)))
+        if fd.kind in OWN_EVIDENCE:
+            left = [g for g in after.findings if g.kind == fd.kind and (fd.order is None or g.order is None
+                                                                        or abs(g.order - fd.order) <= 0.02 * fd.order)]
+            if not left and fd.kind in eff.evidence:
+                out.append(Evidence(fd.description, fd.kind, eff.evidence[fd.kind], fd.size_db, 0.0))
             continue
         e0, e1 = finding_error(before, fd), finding_error(after, fd)
         if e0 > 0 and e1 <= 0.5 * e0:

@@ -51,6 +51,9 @@ def test_judge_tells_a_missing_effect_a_base_model_off_and_the_rest_apart():
     small = _comparison(("resonance", 636, 7.0, 0.2), ("resonance", 1728, 7.0, 0.2), ("unlocked_line", 113, 15, 0.5))
     assert judge(small, [weak])[0] == "unexplained"                   # the bands hold under half the error
     assert judge(_comparison(lsd=0.4), [weak])[:3] == ("nothing_missing", None, ())
+    # a series in the envelope counts though its band holds none of the spectral error
+    verdict, _, unexplained, _, _ = judge(_comparison(("envelope_line", 72, 30.0, 0.0), lsd=0.4), [weak])
+    assert (verdict, unexplained) == ("unexplained", ("envelope_line near 72 Hz",))
     assert judge(_comparison(lsd=0.4), [])[0] == "nothing_missing"
 
 
