@@ -429,12 +429,16 @@ def _plot(comp: Comparison, simulated, measured, fs, path) -> None:
 
     from twin._atomic import atomic_path
     from twin.signals import order_spectrum, shaft_angle_from_speed
-    fig, (a1, a2) = plt.subplots(2, 1, figsize=(11, 8))
+    envelope = [fd for fd in comp.findings if fd.kind == "envelope_line"]
+    fig, axes = plt.subplots(3 if envelope else 2, 1, figsize=(11, 11 if envelope else 8))
+    a1, a2 = axes[0], axes[1]
     a1.plot(comp.freqs, comp.level_measured, "k", lw=0.8, label="measured")
     a1.plot(comp.freqs, comp.level_model, "tab:blue", lw=0.8, label="model")
     colors = {"mesh_harmonic": "tab:orange", "sideband": "tab:purple", "shaft_order": "tab:green",
               "unlocked_line": "tab:red", "resonance": "tab:brown", "impulsive": "tab:pink"}
     for i, fd in enumerate(comp.findings[:8]):
+        if fd.kind == "envelope_line":           # an envelope frequency: drawn in its own panel
+            continue
         c = colors.get(fd.kind, "gray")
         if fd.kind in ("resonance",):
             a1.axvspan(*fd.band_hz, color=c, alpha=0.15)
@@ -458,10 +462,33 @@ def _plot(comp: Comparison, simulated, measured, fs, path) -> None:
     a2.set_ylabel("amplitude [m/s2]")
     a2.legend(loc="upper right")
     a2.grid(alpha=0.3)
+    if envelope:
+        _plot_envelope(axes[2], envelope[0], comp, simulated, measured, fs)
     fig.tight_layout()
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format="png", dpi=110)
     plt.close(fig)
+
+
+def _plot_envelope(ax, fd: Finding, comp: Comparison, simulated, measured, fs) -> None:
+    """The squared-envelope spectra of the band where the strongest envelope series was found,
+    its harmonics dashed, the pinion's orders dotted."""
+    from twin.signals.envelope import squared_envelope_spectrum
+    top = 6.5 * fd.frequency_hz
+    for x, lab, col in ((measured, "measured", "k"), (simulated, "model", "tab:blue")):
+        f, amp = squared_envelope_spectrum(x, fs, fd.band_hz, fmax=top)
+        ax.semilogy(f, amp + 1e-30, color=col, lw=0.8, label=lab)
+    for h in range(1, 7):
+        ax.axvline(h * fd.frequency_hz, color="tab:red", ls="--", lw=0.8)
+    for k in range(1, int(top / comp.shaft_hz) + 1):
+        ax.axvline(k * comp.shaft_hz, color="0.75", ls=":", lw=0.8)
+    ax.set_xlim(0, top)
+    ax.set_xlabel("envelope frequency [Hz] (dashed: the series found, "
+                  f"{fd.order:.2f}x pinion; dotted: pinion orders)")
+    ax.set_ylabel("squared envelope [(m/s2)^2]")
+    ax.set_title(f"Envelope of {fd.band_hz[0]:.0f}-{fd.band_hz[1]:.0f} Hz: repeated impacts locked to neither shaft")
+    ax.legend(loc="upper right")
+    ax.grid(alpha=0.3)
 
 
 def _html(comp: Comparison, scenario, rec, path) -> None:

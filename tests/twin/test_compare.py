@@ -46,7 +46,7 @@ def test_line_not_locked_to_any_shaft_is_found(base):
     assert top.share > 0.5 and "not locked to any shaft" in top.description
 
 
-def test_repeated_impacts_locked_to_neither_shaft_are_an_envelope_finding(base):
+def test_repeated_impacts_locked_to_neither_shaft_are_an_envelope_finding(base, tmp_path):
     """A bearing's ring-downs at a non-integer order, too weak to lift the spectrum, stand out
     in the envelope; the same impacts in the model are no finding."""
     rng = np.random.default_rng(1)
@@ -59,6 +59,9 @@ def test_repeated_impacts_locked_to_neither_shaft_are_an_envelope_finding(base):
     found = [f for f in c.findings if f.kind == "envelope_line"]
     assert len(found) == 1 and found[0].order == pytest.approx(3.585, abs=0.01)
     assert "locked to neither shaft" in found[0].description and found[0].band_hz[0] <= 12000 <= found[0].band_hz[1]
+    from twin.compare import _plot                 # the report draws the envelope in a panel of its own
+    _plot(c, base, base + hits, 1e5, tmp_path / "compare.png")
+    assert (tmp_path / "compare.png").stat().st_size > 10000
     assert not [f for f in compare_signals(base + hits, _noisy(base + hits), 1e5, SHAFT).findings
                 if f.kind == "envelope_line"]
 
