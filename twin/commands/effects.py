@@ -115,8 +115,7 @@ def _cmd_effects(args: argparse.Namespace) -> int:
             print(f"{model} -> {path}")
         return 0
     for e in effects.CATALOGUE.values():
-        fit = ", ".join(f"{p.name} [{-p.upper:g}, {p.upper:g}], |{p.name}| >= {p.lower:g}" if p.signed
-                        else f"{p.name} [{p.lower:g}, {p.upper:g}]" for p in e.fit)
+        fit = ", ".join(f"{p.name} [{p.lower:g}, {p.upper:g}]" for p in e.fit)
         print(f"{e.id:<24} {e.component:<40} fits: {fit}")
     return 0
 

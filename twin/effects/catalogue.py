@@ -37,9 +37,6 @@ class FitParameter:
     log: bool = False            # search on a log scale (amplitudes spanning decades)
     guess: str | None = None     # start from the spectrum: "unlocked_line", "slow_sideband", "resonance"
     grid: int = 7                # points of the coarse search before the local polish
-    # with ``log``: the value takes either sign, its magnitude from ``lower`` to ``upper`` on a log
-    # scale (a mode's residue at a sensor is signed); 0 is then reached as +-``lower``
-    signed: bool = False
 
 
 @dataclass(frozen=True)
@@ -128,9 +125,7 @@ CATALOGUE: dict[str, Effect] = {e.id: e for e in (
            inputs={"base_acceleration": "casing_acceleration_pinion + sensor_path_acceleration_pinion"},
            hooks={"effect_sensor_acceleration_pinion": "extra_acceleration"},
            fit=(FitParameter("frequency", 300.0, 4800.0, guess="resonance"),
-                # signed: the product of the mode's participation in the base motion and its
-                # shape at the sensor; negative puts an anti-resonance below the mode
-                FitParameter("participation", 0.02, 3.0, log=True, signed=True, grid=9),
+                FitParameter("participation", 0.02, 3.0, log=True),
                 FitParameter("damping_ratio", 0.005, 0.1, log=True)),
            related=("ky6",),               # the pedestal sets the casing motion the mode filters
            neutral={"participation": 0.0},

@@ -139,14 +139,14 @@ def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int, np.ndarra
 
     def start(p: FitParameter) -> float:
         default = math.sqrt(p.lower * p.upper) if p.log else 0.5 * (p.lower + p.upper)
-        # through the search coordinate, so a signed parameter keeps its sign (an earlier fit's value)
-        return from_unit(p, to_unit(p, float(spec.guesses.get(p.name, default))))
+        return float(np.clip(spec.guesses.get(p.name, default), p.lower, p.upper))
 
     def to_x(p: FitParameter, v: float) -> float:
-        return to_unit(p, v)
+        return (math.log(v / p.lower) / math.log(p.upper / p.lower)) if p.log else (v - p.lower) / (p.upper - p.lower)
 
     def from_x(p: FitParameter, z: float) -> float:
-        return from_unit(p, z)
+        z = min(max(z, 0.0), 1.0)
+        return p.lower * (p.upper / p.lower) ** z if p.log else p.lower + z * (p.upper - p.lower)
 
     def key_of(values: Mapping[str, float], base: Mapping[str, float]) -> tuple:
         return tuple(sorted((k, round(v, 12)) for k, v in values.items())) + \
@@ -226,28 +226,6 @@ def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int, np.ndarra
         except Exception:  # a fit that diverges on the whole stretch scores badly, as in the search
             sim, val = None, 1e3
     return fitted, val, count, sim
-
-
-def to_unit(p: FitParameter, v: float) -> float:
-    """A fit parameter's value as its search coordinate in [0, 1] (linear, log, or signed log:
-    [0, 0.5) the negative values from -upper to -lower, [0.5, 1] the positive from lower to upper)."""
-    if p.log and p.signed:
-        m = min(max(abs(v), p.lower), p.upper)
-        half = 0.5 * math.log(m / p.lower) / math.log(p.upper / p.lower)
-        return 0.5 + half if v >= 0 else 0.5 - half - 1e-12
-    if p.log:
-        return math.log(v / p.lower) / math.log(p.upper / p.lower) if v > 0 else 0.0
-    return (v - p.lower) / (p.upper - p.lower)
-
-
-def from_unit(p: FitParameter, z: float) -> float:
-    """The value at search coordinate ``z`` (clipped to [0, 1]); the inverse of :func:`to_unit`."""
-    z = min(max(float(z), 0.0), 1.0)
-    if p.log and p.signed:
-        if z >= 0.5:
-            return p.lower * (p.upper / p.lower) ** (2.0 * z - 1.0)
-        return -p.lower * (p.upper / p.lower) ** (1.0 - 2.0 * z)
-    return p.lower * (p.upper / p.lower) ** z if p.log else p.lower + z * (p.upper - p.lower)
 
 
 def _guarded_fit(spec: TrialSpec):

@@ -2,7 +2,7 @@ within GearTwin.Effects;
 block SensorMountMode "A structural mode between the bearing pedestal and the accelerometer (casing panel, sensor mount)"
   parameter Real frequency(unit = "Hz", min = 300, max = 4800) = 2500 "Natural frequency of the mode";
   parameter Real damping_ratio(min = 0.005, max = 0.1) = 0.02 "Modal damping ratio";
-  parameter Real participation(min = -3, max = 3) = 1 "Share of the modal response seen by the sensor (0: rigid mount, 1: sensor on the modal mass; negative: the mode's shape at the sensor opposite to its participation in the base motion)";
+  parameter Real participation(min = 0, max = 3) = 1 "Share of the modal response seen by the sensor (0: rigid mount, 1: sensor on the modal mass)";
   input Real base_acceleration(unit = "m/s2") "Acceleration reaching the sensor's mount along its axis (the pedestal's, or the transfer path's output)";
   output Real extra_acceleration(unit = "m/s2") "Acceleration the mode adds at the sensor";
   Real deflection(unit = "m", start = 0) "Modal deflection relative to the pedestal";

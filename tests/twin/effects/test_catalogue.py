@@ -201,26 +201,6 @@ def test_a_housing_mode_filters_what_reaches_the_sensor(shafts_fmu, fmu_dir, sha
         offs.append(off)
     assert np.std(added[0]) > 0.01 * np.std(offs[0])
     assert np.allclose(added[1], 3.0 * added[0], rtol=1e-6, atol=1e-6 * np.max(np.abs(added[1])))
-    # the participation is signed (the mode's shape at the sensor): negative adds the same motion
-    # in opposite phase
-    flipped = simulate_operating_point(str(cand), 20, 20, parameters={
-        "sensor_pinion.gain": 3.0, **mode, "housing_mode.participation": -1.0}, **kw)[:, 0]
-    assert np.allclose(flipped - offs[1], -added[1], rtol=1e-6, atol=1e-6 * np.max(np.abs(added[1])))
-
-
-def test_a_signed_fit_parameter_is_searched_on_both_sides_of_zero():
-    from twin.effects.catalogue import FitParameter
-    from twin.effects.fit import from_unit, to_unit
-    p = FitParameter("participation", 0.02, 3.0, log=True, signed=True)
-    assert from_unit(p, 0.0) == pytest.approx(-3.0) and from_unit(p, 1.0) == pytest.approx(3.0)
-    assert from_unit(p, 0.5) == pytest.approx(0.02) and from_unit(p, 0.4999) == pytest.approx(-0.02, rel=1e-2)
-    for v in (-2.0, -0.15, -0.02, 0.02, 0.4, 3.0):
-        assert from_unit(p, to_unit(p, v)) == pytest.approx(v, rel=1e-9)
-    assert from_unit(p, to_unit(p, -9.0)) == pytest.approx(-3.0)       # the magnitude is bounded, the sign kept
-    assert from_unit(p, to_unit(p, -1e-4)) == pytest.approx(-0.02)
-    unsigned = FitParameter("participation", 0.02, 3.0, log=True)
-    assert from_unit(unsigned, to_unit(unsigned, -0.15)) == pytest.approx(0.02)
-    assert from_unit(unsigned, to_unit(unsigned, 0.4)) == pytest.approx(0.4)
 
 
 def _mesh_states(fmu_path, parameters, calculated):
