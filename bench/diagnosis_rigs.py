@@ -120,7 +120,7 @@ def one_case(rig_name: str, seed: int, effect: str, calibrated, out: Path, ex, s
         from twin.effects.diagnose import record_conditions
         b = base_recs[0]
         op_ref = record_conditions(fmu, b.signal, b.sample_rate, b.nominal_speed, b.load, params,
-                                   duration=2.0).operating
+                                   duration=2.0, shaft_speed=b.shaft_hz).operating
         model_ref = simulate_at(fmu, params, op_ref, n, [CHANNEL])[:, 0]
         ref = b.signal[-n:]
         speeds_x = (encoder_speed(h5, "steady", n), encoder_speed(baseline, "steady", n))

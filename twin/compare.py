@@ -362,7 +362,8 @@ def compare(scenario, measurements, out_dir, *, record: str | None = None, durat
 
     The model runs where the record was taken, as ``twin diagnose`` runs it
     (:func:`twin.operating.measured_operating`): its pinion turns at the shaft speed measured on
-    the record (the record's ``nominal_speed`` [Hz] is only where that search starts), under the
+    the record (by its encoder, tachometer or speed channel when it has one, else off its gear-mesh
+    line, the record's ``nominal_speed`` [Hz] only where that search starts), under the
     record's ``load`` [N.m], sampled at the record's rate, on the RK4 step ``solver_step`` [s]
     (the model's own when None). The parameters are the scenario's.
 
@@ -399,8 +400,14 @@ def compare(scenario, measurements, out_dir, *, record: str | None = None, durat
     z1 = int(round(float(teeth.get("z1", 19))))
     z2 = int(round(float(teeth.get("z2", 52))))
     c_motor = params.get("c_motor", current.get("c_motor"))
+    # the pinion speed from the record's encoder, tachometer or speed channel when it has one (as
+    # twin diagnose takes it), else from its gear-mesh line
+    from twin.effects.records import read_records
+    speed = read_records(measurements, channel, [rec.name])[0].shaft_hz
+    shaft_hz = float(np.mean(speed[-measured.size:])) if speed is not None else None
     op = measured_operating(measured, rec.sample_rate, rec.nominal_speed, rec.load, teeth=z1, gear_teeth=z2,
-                            c_motor=c_motor, solver_step=solver_step if "solver.step_size" in current else None)
+                            c_motor=c_motor, solver_step=solver_step if "solver.step_size" in current else None,
+                            shaft_hz=shaft_hz)
     out_dir.mkdir(exist_ok=True)
     block = simulate_at(fmu_path, params, op, measured.size, [channel, "motor_speed"])
     simulated = block[:, 0]

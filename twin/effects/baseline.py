@@ -241,9 +241,9 @@ def learn_all(fmu_path, parameters: Mapping[str, float], records: Sequence, base
                                          baseline_hz=float(np.mean(b.shaft_hz[-m:]))))
         else:
             c = record_conditions(fmu_path, r.signal, r.sample_rate, r.nominal_speed, r.load, parameters,
-                                  record=r.name, duration=duration, solver_step=solver_step)
+                                  record=r.name, duration=duration, solver_step=solver_step, shaft_speed=r.shaft_hz)
             cb = record_conditions(fmu_path, b.signal, b.sample_rate, b.nominal_speed, b.load, parameters,
-                                   record=b.name, duration=duration, solver_step=solver_step)
+                                   record=b.name, duration=duration, solver_step=solver_step, shaft_speed=b.shaft_hz)
             specs.append(DiscrepancySpec(b.name, str(fmu_path), dict(parameters), channel, cb.measured, r.sample_rate,
                                          r.load, operating=c.operating, solver_step=solver_step,
                                          angle=_angle(b, cb.measured.size, encoder and r.angle is not None),

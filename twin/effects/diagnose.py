@@ -170,8 +170,14 @@ class Conditions:
 
 def record_conditions(fmu_path, measured: np.ndarray, sample_rate: float, nominal_speed: float, load: float,
                       parameters: Mapping[str, float], *, record: str = "record", duration: float = 2.0,
-                      solver_step: float | None = 1e-5) -> Conditions:
+                      solver_step: float | None = 1e-5, shaft_speed: np.ndarray | None = None) -> Conditions:
     """Check the record and the model, keep the last ``duration`` s, and find the operating point.
+
+    ``shaft_speed`` (n,) [Hz], the pinion speed per sample from the record's encoder, tachometer or
+    speed channel (:attr:`twin.effects.records.Record.shaft_hz`), gives the pinion speed (its mean
+    over the stretch kept); without it the speed is read off the gear-mesh line, which a strong
+    sideband can take for it (a local tooth fault's 20th order stood above the 19th on a rig record:
+    20.94 Hz read for 19.89 Hz).
 
     Raises :class:`MeasurementError` for a record that is not 1-D, shorter than 0.25 s or not
     finite, and :class:`ParameterError` for a ``duration`` under 0.25 s or a model that is not
@@ -189,7 +195,15 @@ def record_conditions(fmu_path, measured: np.ndarray, sample_rate: float, nomina
                                                   f"{measured.shape} at {sample_rate} Hz")
     if not np.all(np.isfinite(measured)):
         raise MeasurementError("<array>", record, "the measured signal holds NaN or Inf values")
-    measured = measured[-int(round(min(duration, measured.size / sample_rate) * sample_rate)):]
+    keep = int(round(min(duration, measured.size / sample_rate) * sample_rate))
+    measured = measured[-keep:]
+    shaft_hz = None
+    if shaft_speed is not None:
+        speed = np.asarray(shaft_speed, float)[-keep:]
+        shaft_hz = float(np.nanmean(speed)) if np.any(np.isfinite(speed)) else None
+        if shaft_hz is not None and not shaft_hz > 0:
+            raise MeasurementError("<array>", record, f"the record's pinion speed is {shaft_hz:g} Hz over the "
+                                                      "stretch diagnosed; the gearbox must turn")
     with FMU(fmu_path) as fmu:
         current = fmu.parameter_values()
         structural = fmu.structural_values()
@@ -202,7 +216,7 @@ def record_conditions(fmu_path, measured: np.ndarray, sample_rate: float, nomina
     z1, z2 = int(round(float(teeth["z1"]))), int(round(float(teeth["z2"])))
     op = measured_operating(measured, sample_rate, nominal_speed, load, teeth=z1, gear_teeth=z2,
                             c_motor=float(parameters.get("c_motor", current["c_motor"])),
-                            solver_step=solver_step if "solver.step_size" in current else None)
+                            solver_step=solver_step if "solver.step_size" in current else None, shaft_hz=shaft_hz)
     return Conditions(measured, current, z1, z2, op, structural, outputs)
 
 
@@ -274,7 +288,8 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
         from twin.effects.baseline import pair
         pair(recs, as_records(baseline))          # a record without a fitting baseline is refused first
     conds = {r.name: record_conditions(fmu_path, r.signal, r.sample_rate, r.nominal_speed, r.load, parameters,
-                                       record=r.name, duration=duration, solver_step=solver_step) for r in steady}
+                                       record=r.name, duration=duration, solver_step=solver_step,
+                                       shaft_speed=r.shaft_hz) for r in steady}
     cond = conds[fit_rec.name]
     measured, current, z1, z2, op = cond.measured, cond.current, cond.z1, cond.z2, cond.operating
     sample_rate = fit_rec.sample_rate

@@ -119,7 +119,7 @@ def learn_discrepancy(scenario, measurements, baseline, *, record=None, all_reco
     slip = load = 0.0
     if steady and len(steady) < len(recs):
         c = record_conditions(fmu, steady[0].signal, steady[0].sample_rate, steady[0].nominal_speed, steady[0].load,
-                              params, record=steady[0].name, duration=duration)
+                              params, record=steady[0].name, duration=duration, shaft_speed=steady[0].shaft_hz)
         op, _ = simulate_settled(fmu, params, c.operating, c.measured.size, channel)
         slip, load = op.drive_hz - op.shaft_hz, op.load
     return learn_all(fmu, params, recs, as_records(baseline), channel, duration=duration, slip_hz=slip,
@@ -244,7 +244,7 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
     current_fmu = scenario.fmu_path()
     base_params = dict(scenario.parameters)
     cond = record_conditions(current_fmu, rec.signal, rec.sample_rate, rec.nominal_speed, rec.load, base_params,
-                             record=rec.name, duration=duration)
+                             record=rec.name, duration=duration, shaft_speed=rec.shaft_hz)
     measured, current, z1, z2, op = cond.measured, cond.current, cond.z1, cond.z2, cond.operating
     shaft = op.shaft_hz
     known = given = None

@@ -161,3 +161,19 @@ def test_a_runout_only_the_encoder_sees_is_fitted_through_the_encoder_channel(ca
     assert 2e-5 < e <= 5e-5 * 1.1
     alone, _, _, _ = fit_effect(TrialSpec(**spec))
     assert alone["pinion_eccentricity.eccentricity"] < e / 3
+
+
+def test_the_records_own_speed_beats_a_sideband_taken_for_the_mesh_line(gearbox_fmu):
+    """A local fault's 20th pinion order can stand above the 19th (the mesh line): read off the
+    spectrum the speed would be 20/19 too high; the record's encoder speed is taken instead."""
+    from twin.effects.diagnose import record_conditions
+    fs, shaft = 20000.0, 19.9
+    t = np.arange(int(0.5 * fs)) / fs
+    x = 0.2 * np.sin(2 * np.pi * 19 * shaft * t) + np.sin(2 * np.pi * 20 * shaft * t)
+    by_line = record_conditions(gearbox_fmu, x, fs, 20.0, 20.0, {}, duration=0.5)
+    assert by_line.operating.shaft_hz == pytest.approx(20 * shaft / 19, rel=1e-3)
+    speed = np.r_[np.full(x.size, 5.0), np.full(x.size, shaft)]     # the stretch before the one kept does not count
+    kept = record_conditions(gearbox_fmu, np.r_[x, x], fs, 20.0, 20.0, {}, duration=0.5, shaft_speed=speed)
+    assert kept.operating.shaft_hz == pytest.approx(shaft, rel=1e-9)
+    with pytest.raises(MeasurementError, match="pinion speed is 0 Hz"):
+        record_conditions(gearbox_fmu, x, fs, 20.0, 20.0, {}, duration=0.5, shaft_speed=np.zeros(x.size))
