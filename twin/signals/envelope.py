@@ -106,7 +106,7 @@ def envelope_series(x, fs: float, shaft_hz: float, *, gear_ratio: float | None =
     it makes a series when at least ``min_harmonics`` of it and its multiples up to
     ``max_harmonic`` stand ``harmonic_db`` out (the multiples within 0.5 % plus the location
     tolerance: a bearing's rollers slip by about 1 %). A fundamental that is a multiple of a
-    lower series' is not a series of its own. Each fundamental is reported once, from the band
+    lower series' (in any band) is not a series of its own. Each fundamental is reported once, from the band
     where it stands out most, strongest first. ``shaft_hz`` [Hz] is the pinion's speed;
     ``gear_ratio`` (z1 / z2) classes fundamentals locked to the gear too.
     """
@@ -164,4 +164,11 @@ def envelope_series(x, fs: float, shaft_hz: float, *, gear_ratio: float | None =
             if key not in found or found[key].prominence_db < s.prominence_db:
                 found.pop(key, None)
                 found[f0] = s
-    return tuple(sorted(found.values(), key=lambda s: -s.prominence_db))
+    # a series found in one band at a multiple of a lower series found in another is that series
+    out = []
+    for s in sorted(found.values(), key=lambda s: s.frequency_hz):
+        if not any(round(s.frequency_hz / o.frequency_hz) >= 2 and abs(s.frequency_hz / o.frequency_hz
+                   - round(s.frequency_hz / o.frequency_hz)) * o.frequency_hz <= lock_tol + 0.005 * s.frequency_hz
+                   for o in out):
+            out.append(s)
+    return tuple(sorted(out, key=lambda s: -s.prominence_db))
