@@ -262,8 +262,8 @@ def _envelope_findings(model, measured, fs, shaft_hz, z1, z2, f, d2, used, total
     impacts not synchronous with the gears, as a rolling-element bearing defect gives
     (:mod:`twin.signals.envelope`). ``share``: of the squared level difference in the
     demodulated band's bins not already explained by another finding (0 when it lies above the
-    compared band); the verdict counts such a finding whatever its share
-    (:data:`twin.effects.verdict.OWN_EVIDENCE`)."""
+    compared band); the verdict (:func:`twin.effects.verdict.judge`) counts such a finding
+    whatever its share."""
     from twin.signals.envelope import envelope_series
 
     ratio = z1 / z2
@@ -375,9 +375,9 @@ def compare(scenario, measurements, out_dir, *, record: str | None = None, durat
     from dataclasses import asdict
     from pathlib import Path
 
-    from twin.errors import OutputPathError, ParameterError
+    from twin.errors import MeasurementError, OutputPathError, ParameterError
     from twin.fmu import FMU
-    from twin.operating import measured_operating, simulate_at
+    from twin.operating import measured_operating, simulate_at, stretch_speed
     from twin.results import SimulationResult, write_hdf5
 
     out_dir = Path(out_dir)
@@ -403,8 +403,10 @@ def compare(scenario, measurements, out_dir, *, record: str | None = None, durat
     # the pinion speed from the record's encoder, tachometer or speed channel when it has one (as
     # twin diagnose takes it), else from its gear-mesh line
     from twin.effects.records import read_records
-    speed = read_records(measurements, channel, [rec.name])[0].shaft_hz
-    shaft_hz = float(np.mean(speed[-measured.size:])) if speed is not None else None
+    shaft_hz = stretch_speed(read_records(measurements, channel, [rec.name])[0].shaft_hz, measured.size)
+    if shaft_hz is not None and not shaft_hz > 0:
+        raise MeasurementError(str(measurements), rec.name, f"its pinion speed is {shaft_hz:g} Hz over the stretch "
+                                                            "compared; the gearbox must turn")
     op = measured_operating(measured, rec.sample_rate, rec.nominal_speed, rec.load, teeth=z1, gear_teeth=z2,
                             c_motor=c_motor, solver_step=solver_step if "solver.step_size" in current else None,
                             shaft_hz=shaft_hz)

@@ -83,6 +83,16 @@ class Operating:
     teeth: int = 19          # pinion teeth, to read the shaft speed off the gear-mesh line
 
 
+def stretch_speed(shaft_speed, n: int) -> float | None:
+    """The mean pinion speed [Hz] over the last ``n`` samples of a record's per-sample speed
+    ``shaft_speed`` (its encoder, tachometer or speed channel), or None when there is none
+    (``shaft_speed`` None, or no finite sample in the stretch)."""
+    if shaft_speed is None:
+        return None
+    speed = np.asarray(shaft_speed, float)[-int(n):]
+    return float(np.nanmean(speed)) if np.any(np.isfinite(speed)) else None
+
+
 def measured_operating(measured: np.ndarray, sample_rate: float, nominal_speed: float, load: float, *,
                        teeth: int, gear_teeth: int, c_motor: float | None, solver_step: float | None = 1e-5,
                        shaft_hz: float | None = None) -> Operating:

@@ -136,3 +136,9 @@ def test_compare_simulates_at_the_measured_speed_as_diagnose_does(gearbox_fmu, t
     assert data["operating"]["shaft_hz"] == pytest.approx(cond.operating.shaft_hz)
     assert comp.shaft_hz == pytest.approx(20.2 * SHAFT / 20, rel=2e-3)      # not the nominal 20 Hz
     assert comp.lsd_db == pytest.approx(base.lsd_db, abs=1e-9)
+    # a record with a speed channel: its speed is the pinion's, not the mesh line's reading
+    write_measurements([Record("r", {"accel_pinion_casing": x, "tacho": np.full(x.size, 20.05)},
+                               {"accel_pinion_casing": "m/s2", "tacho": "Hz"}, 2e4, nominal_speed=20.0, load=20.0)],
+                       tmp_path / "t.h5")
+    assert compare(load_scenario(tmp_path / "s.yaml"), tmp_path / "t.h5", tmp_path / "rep_t").shaft_hz == \
+        pytest.approx(20.05, rel=1e-9)

@@ -185,7 +185,7 @@ def record_conditions(fmu_path, measured: np.ndarray, sample_rate: float, nomina
     """
     from twin.errors import MeasurementError, ParameterError
     from twin.fmu import FMU
-    from twin.operating import measured_operating
+    from twin.operating import measured_operating, stretch_speed
 
     if not (isinstance(duration, (int, float)) and math.isfinite(duration) and duration >= 0.25):
         raise ParameterError(f"duration must be at least 0.25 s of the record, got {duration!r}")
@@ -197,13 +197,10 @@ def record_conditions(fmu_path, measured: np.ndarray, sample_rate: float, nomina
         raise MeasurementError("<array>", record, "the measured signal holds NaN or Inf values")
     keep = int(round(min(duration, measured.size / sample_rate) * sample_rate))
     measured = measured[-keep:]
-    shaft_hz = None
-    if shaft_speed is not None:
-        speed = np.asarray(shaft_speed, float)[-keep:]
-        shaft_hz = float(np.nanmean(speed)) if np.any(np.isfinite(speed)) else None
-        if shaft_hz is not None and not shaft_hz > 0:
-            raise MeasurementError("<array>", record, f"the record's pinion speed is {shaft_hz:g} Hz over the "
-                                                      "stretch diagnosed; the gearbox must turn")
+    shaft_hz = stretch_speed(shaft_speed, keep)
+    if shaft_hz is not None and not shaft_hz > 0:
+        raise MeasurementError("<array>", record, f"the record's pinion speed is {shaft_hz:g} Hz over the "
+                                                  "stretch diagnosed; the gearbox must turn")
     with FMU(fmu_path) as fmu:
         current = fmu.parameter_values()
         structural = fmu.structural_values()
