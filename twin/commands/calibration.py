@@ -126,7 +126,9 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     if not comp.findings:
         print("no localised discrepancy above the thresholds: nothing appears to be missing")
     for i, f in enumerate(comp.findings, 1):
-        print(f"  {i:2d}. [{f.kind}] {f.description}  ({100 * f.share:.0f} % of the error)")
+        # a series in the envelope is measured there, not as a share of the spectral error
+        where = "in the envelope" if f.kind == "envelope_line" else f"{100 * f.share:.0f} % of the error"
+        print(f"  {i:2d}. [{f.kind}] {f.description}  ({where})")
     print(f"report -> {Path(args.out) / 'compare.html'}")
     return 0
 
