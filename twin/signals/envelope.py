@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from twin.signals._checks import SignalError, as_signal, frequency_band, positive
+from twin.signals.spectral import padded_spectrum
 
 #: lowest band edge [Hz]: below it the envelope is the mesh lines' own beating
 LOWEST_BAND_HZ = 1000.0
@@ -66,7 +67,8 @@ def squared_envelope_spectrum(x, fs: float, band: tuple[float, float], *, fmax: 
     fmax : float, optional
         Highest envelope frequency returned [Hz] (default: the band's width).
     pad : int
-        The envelope's FFT is zero-padded to ``pad`` times the record, to locate lines.
+        The envelope's FFT is zero-padded to ``pad`` times the record or more, to locate lines
+        (:func:`twin.signals.spectral.padded_spectrum`).
 
     Returns
     -------
@@ -84,12 +86,7 @@ def squared_envelope_spectrum(x, fs: float, band: tuple[float, float], *, fmax: 
     spec = np.fft.fft(x - x.mean())
     f = np.fft.fftfreq(n, 1.0 / fs)
     analytic = np.where((f >= lo) & (f <= hi), 2.0 * spec, 0.0)
-    env2 = np.abs(np.fft.ifft(analytic)) ** 2
-    env2 -= env2.mean()
-    w = np.hanning(n)
-    nfft = int(pad) * n
-    amp = np.abs(np.fft.rfft(env2 * w, nfft)) * 2.0 / np.sum(w)
-    fe = np.fft.rfftfreq(nfft, 1.0 / fs)
+    fe, amp = padded_spectrum(np.abs(np.fft.ifft(analytic)) ** 2, fs, pad=pad)
     keep = fe <= (hi - lo if fmax is None else float(fmax))
     return fe[keep], amp[keep]
 
@@ -120,6 +117,16 @@ def envelope_series(x, fs: float, shaft_hz: float, *, gear_ratio: float | None =
     n = x.size
     lock_tol = max(0.1, 0.3 * fs / n)                     # Hz, as twin.compare's line locking
     found: dict[float, EnvelopeSeries] = {}
+
+    def locked(fq: float) -> str | None:
+        # within lock_orders of an integer order of a shaft (in that shaft's orders): a line read
+        # on the envelope's grid at a high order drifts with the speed's own wobble
+        if abs(fq / shaft_hz - round(fq / shaft_hz)) <= lock_orders:
+            return "pinion"
+        if gear_hz is not None and abs(fq / gear_hz - round(fq / gear_hz)) <= lock_orders:
+            return "gear"
+        return None
+
     for band in (octave_bands(fs) if bands is None else bands):
         fmax = min(band[1] - band[0], (max_harmonic + 0.5) * max_order * shaft_hz)
         fe, amp = squared_envelope_spectrum(x, fs, band, fmax=fmax)
@@ -133,15 +140,6 @@ def envelope_series(x, fs: float, shaft_hz: float, *, gear_ratio: float | None =
             continue
         pf, pp = fe[peaks], prom[peaks]
         series = []
-
-        def locked(fq: float) -> str | None:
-            # within lock_orders of an integer order of a shaft (in that shaft's orders): a line
-            # read on the envelope's grid at a high order drifts with the speed's own wobble
-            if abs(fq / shaft_hz - round(fq / shaft_hz)) <= lock_orders:
-                return "pinion"
-            if gear_hz is not None and abs(fq / gear_hz - round(fq / gear_hz)) <= lock_orders:
-                return "gear"
-            return None
 
         for j in np.argsort(pf):
             f0 = float(pf[j])
