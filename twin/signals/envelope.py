@@ -82,12 +82,13 @@ def squared_envelope_spectrum(x, fs: float, band: tuple[float, float], *, fmax: 
     lo, hi = frequency_band(*band)
     if hi > fs / 2:
         raise SignalError(f"band {band!r} reaches above the Nyquist frequency {fs / 2:g} Hz")
+    top = hi - lo if fmax is None else positive(fmax, "fmax")
     n = x.size
     spec = np.fft.fft(x - x.mean())
     f = np.fft.fftfreq(n, 1.0 / fs)
     analytic = np.where((f >= lo) & (f <= hi), 2.0 * spec, 0.0)
     fe, amp = padded_spectrum(np.abs(np.fft.ifft(analytic)) ** 2, fs, pad=pad)
-    keep = fe <= (hi - lo if fmax is None else float(fmax))
+    keep = fe <= top
     return fe[keep], amp[keep]
 
 

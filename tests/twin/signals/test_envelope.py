@@ -74,6 +74,8 @@ def test_bands_and_bad_input():
         squared_envelope_spectrum(x, 10000.0, (4000.0, 6000.0))
     with pytest.raises(SignalError, match="fmin=3000"):
         squared_envelope_spectrum(x, 10000.0, (3000.0, 2000.0))
+    with pytest.raises(SignalError, match="fmax"):
+        squared_envelope_spectrum(x, 10000.0, (2000.0, 3000.0), fmax=0.0)
     with pytest.raises(SignalError, match="shaft_hz"):
         envelope_series(x, 10000.0, -20.0)
     x[7] = np.nan
