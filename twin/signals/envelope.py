@@ -79,13 +79,26 @@ def squared_envelope_spectrum(x, fs: float, band: tuple[float, float], *, fmax: 
     """
     x = as_signal(x, "x", min_length=16)
     fs = positive(fs, "fs")
+    lo, hi = _band(band, fs)
+    top = hi - lo if fmax is None else positive(fmax, "fmax")
+    return _envelope(_spectrum(x, fs), fs, lo, hi, top, pad)
+
+
+def _band(band, fs: float) -> tuple[float, float]:
     lo, hi = frequency_band(*band)
     if hi > fs / 2:
         raise SignalError(f"band {band!r} reaches above the Nyquist frequency {fs / 2:g} Hz")
-    top = hi - lo if fmax is None else positive(fmax, "fmax")
-    n = x.size
-    spec = np.fft.fft(x - x.mean())
-    f = np.fft.fftfreq(n, 1.0 / fs)
+    return lo, hi
+
+
+def _spectrum(x: np.ndarray, fs: float) -> tuple[np.ndarray, np.ndarray]:
+    """The two-sided FFT of ``x`` less its mean and its frequencies [Hz]: computed once for every
+    band demodulated."""
+    return np.fft.fft(x - x.mean()), np.fft.fftfreq(x.size, 1.0 / fs)
+
+
+def _envelope(spectrum, fs: float, lo: float, hi: float, top: float, pad: int) -> tuple[np.ndarray, np.ndarray]:
+    spec, f = spectrum
     analytic = np.where((f >= lo) & (f <= hi), 2.0 * spec, 0.0)
     fe, amp = padded_spectrum(np.abs(np.fft.ifft(analytic)) ** 2, fs, pad=pad)
     keep = fe <= top
@@ -118,6 +131,15 @@ def envelope_series(x, fs: float, shaft_hz: float, *, gear_ratio: float | None =
     n = x.size
     lock_tol = max(0.1, 0.3 * fs / n)                     # Hz, as twin.compare's line locking
     found: dict[float, EnvelopeSeries] = {}
+    spectrum = _spectrum(x, fs)
+
+    def tol(fq: float) -> float:
+        # where a line of frequency fq [Hz] is looked for: the location tolerance and 0.5 %, as
+        # a bearing's rollers slip by about 1 %
+        return lock_tol + 0.005 * fq
+
+    def multiple(fq: float, base: float) -> bool:
+        return abs(fq / base - round(fq / base)) * base <= tol(fq)
 
     def locked(fq: float) -> str | None:
         # within lock_orders of an integer order of a shaft (in that shaft's orders): a line read
@@ -129,8 +151,8 @@ def envelope_series(x, fs: float, shaft_hz: float, *, gear_ratio: float | None =
         return None
 
     for band in (octave_bands(fs) if bands is None else bands):
-        fmax = min(band[1] - band[0], (max_harmonic + 0.5) * max_order * shaft_hz)
-        fe, amp = squared_envelope_spectrum(x, fs, band, fmax=fmax)
+        lo, hi = _band(band, fs)
+        fe, amp = _envelope(spectrum, fs, lo, hi, min(hi - lo, (max_harmonic + 0.5) * max_order * shaft_hz), 4)
         if fe.size < 16 or not np.any(amp > 0):
             continue
         df = float(fe[1] - fe[0])
@@ -146,10 +168,10 @@ def envelope_series(x, fs: float, shaft_hz: float, *, gear_ratio: float | None =
             f0 = float(pf[j])
             if pp[j] < min_db or f0 < 0.5 * (gear_hz or shaft_hz) or f0 > max_order * shaft_hz:
                 continue
-            if any(abs(f0 / s - round(f0 / s)) * s <= lock_tol + 0.005 * f0 for s in series):
+            if any(multiple(f0, s) for s in series):
                 continue                                  # a harmonic of a lower series
             lines = [h * f0 for h in range(1, max_harmonic + 1) if h * f0 <= fe[-1]
-                     and np.any((np.abs(pf - h * f0) <= lock_tol + 0.005 * h * f0))]
+                     and np.any((np.abs(pf - h * f0) <= tol(h * f0)))]
             if len(lines) < min_harmonics:
                 continue
             series.append(f0)
@@ -158,16 +180,15 @@ def envelope_series(x, fs: float, shaft_hz: float, *, gear_ratio: float | None =
             # not a shaft's needs min_unlocked of its lines off every shaft order
             if lock is None and sum(locked(fq) is None for fq in lines) < min_unlocked:
                 continue
-            s = EnvelopeSeries(f0, f0 / shaft_hz, len(lines), float(pp[j]), (float(band[0]), float(band[1])), lock)
-            key = next((k for k in found if abs(k - f0) <= lock_tol + 0.005 * f0), f0)
+            s = EnvelopeSeries(f0, f0 / shaft_hz, len(lines), float(pp[j]), (lo, hi), lock)
+            key = next((k for k in found if abs(k - f0) <= tol(f0)), f0)
             if key not in found or found[key].prominence_db < s.prominence_db:
                 found.pop(key, None)
                 found[f0] = s
     # a series found in one band at a multiple of a lower series found in another is that series
     out = []
     for s in sorted(found.values(), key=lambda s: s.frequency_hz):
-        if not any(round(s.frequency_hz / o.frequency_hz) >= 2 and abs(s.frequency_hz / o.frequency_hz
-                   - round(s.frequency_hz / o.frequency_hz)) * o.frequency_hz <= lock_tol + 0.005 * s.frequency_hz
+        if not any(round(s.frequency_hz / o.frequency_hz) >= 2 and multiple(s.frequency_hz, o.frequency_hz)
                    for o in out):
             out.append(s)
     return tuple(sorted(out, key=lambda s: -s.prominence_db))
