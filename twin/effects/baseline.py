@@ -126,11 +126,8 @@ def learn(spec: DiscrepancySpec) -> Discrepancy:
                                          at_speed(ao.frequencies, ao.psd, ratio)[ao.band], ao.model_psd(angle_model))
     envelope = ()
     if spec.shaft_hz is None and spec.baseline_hz > 0:      # a run-up's stretch smears its series
-        # at the weaker level a run-up may confirm (twin.compare): a series the gearbox had when
-        # calibrated is not a change, however strong
-        from twin.signals.envelope import CONFIRMED_DB, envelope_series
-        envelope = tuple(s.order for s in envelope_series(spec.measured, spec.sample_rate, spec.baseline_hz,
-                                                          min_db=CONFIRMED_DB))
+        from twin.signals.envelope import envelope_series
+        envelope = tuple(s.order for s in envelope_series(spec.measured, spec.sample_rate, spec.baseline_hz))
     return Discrepancy(spec.record, f, np.clip(level, -MAX_DB, MAX_DB), angle, envelope)
 
 
