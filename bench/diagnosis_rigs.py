@@ -1,7 +1,8 @@
 """Benchmark: `twin diagnose` on gearboxes the twin did not generate (rigs/pedestal, rigs/beam).
 
     python bench/diagnosis_rigs.py --calibrated bench_out/calibration_rigs [--rigs pedestal beam]
-                                   [--seed 1] [--effects ...] [--no-baseline] [--out bench_out/diagnosis_rigs]
+                                   [--seed 1] [--effects ...] [--no-baseline] [--repeats 0]
+                                   [--out bench_out/diagnosis_rigs]
 
 Per rig: the gearbox ``Rig().scattered(seed, 0.12)`` that ``bench/calibration_rigs.py`` calibrated
 (its ``<rig>_<seed>_cal/calibrated.yaml`` under ``--calibrated``: the twin as well calibrated as
@@ -23,7 +24,10 @@ The diagnosis is given the records the gearbox was calibrated on (the file
 ``bench/calibration_rigs.py`` wrote beside ``<rig>_<seed>_cal``) as its baseline (``twin
 diagnose --baseline``; ``--no-baseline``: without, the control), and the change distance of
 ``bench/spectral_distance.py`` (the change since the calibration's steady record against the
-change the model shows) is reported beside the distance to the record.
+change the model shows) is reported beside the distance to the record. ``--repeats N`` gives the
+baseline N more healthy steady records of the gearbox at the same operating point (the rig's
+record seeds 300, 301, ...): their record-to-record scatter raises the comparison's line
+threshold (``twin.effects.baseline``).
 
 Cases already in --out/results.json for other rigs or effects are kept. Run once per method change; every figure goes to BENCHMARKS.md as measured. Prints a Markdown
 table; writes results.json under --out.
@@ -81,8 +85,25 @@ def calibration_records(calibrated_dir: Path, rig_name: str, seed: int) -> Path:
     return found[0]
 
 
+def repeat_records(rig_name: str, seed: int, out: Path, count: int) -> list:
+    """``count`` more healthy 2 s steady records of the gearbox at the calibration's operating
+    point (the rig's record seeds 300, 301, ...; written once to ``<rig>_<seed>_repeats.h5``),
+    as :class:`twin.effects.records.Record`: repeats of the baseline for the diagnosis."""
+    from twin.effects.records import read_records
+    if count <= 0:
+        return []
+    h5 = out / f"{rig_name}_{seed}_repeats{count}.h5"
+    names = [f"steady_repeat{k + 1}" for k in range(count)]
+    if not h5.exists():
+        rigmod = importlib.import_module(f"rigs.{rig_name}")
+        box = rigmod.Rig().scattered(seed=seed, scatter=0.12)
+        rigmod.write(h5, [box.steady(speed=SPEED, load=LOAD, duration=2.0, effect=None, seed=300 + k, name=nm)
+                          for k, nm in enumerate(names)])
+    return list(read_records(h5, CHANNEL, names))
+
+
 def one_case(rig_name: str, seed: int, effect: str, calibrated, out: Path, ex, search: dict | None = None,
-             baseline: Path | None = None, encoder: bool = True) -> dict:
+             baseline: Path | None = None, encoder: bool = True, repeats: int = 0) -> dict:
     from spectral_distance import change_distance_report, spectral_distance_report
 
     from twin.effects.catalogue import CATALOGUE
@@ -108,8 +129,9 @@ def one_case(rig_name: str, seed: int, effect: str, calibrated, out: Path, ex, s
     fmu, params = calibrated.fmu_path(), dict(calibrated.parameters)
     t0 = time.perf_counter()
     base_recs = read_records(baseline, CHANNEL, ["steady", "runup"]) if baseline else None
+    given = base_recs + repeat_records(rig_name, seed, out, repeats) if base_recs else None
     d = diagnose(fmu, read_records(h5, CHANNEL, ["steady", "runup"]), parameters=params, executor=ex,
-                 duration=2.0, baseline=base_recs, encoder=encoder, **(search or {}))
+                 duration=2.0, baseline=given, encoder=encoder, **(search or {}))
     wall = time.perf_counter() - t0
     n = int(round(2.0 * fs))
     xm = x[-n:]
@@ -156,7 +178,7 @@ def one_case(rig_name: str, seed: int, effect: str, calibrated, out: Path, ex, s
            "twin_lsd_before": d.lsd_db, "twin_lsd_after_top": top.lsd_after_db,
            "distance_before_db": dist0, "distance_after_top_db": dist1, "baseline": str(baseline or ""),
            "change_before": change0, "change_after_top": change1, "diagnose_s": wall, "rig_s": rig_s,
-           "search": search or "default", "encoder": encoder, "load_average": os.getloadavg()[0],
+           "search": search or "default", "encoder": encoder, "repeats": repeats, "load_average": os.getloadavg()[0],
            "truth_effect": next((r.get("effect") for r in truth.get("records", [truth]) if isinstance(r, dict)
                                  and r.get("effect")), None) if isinstance(truth, dict) else None}
     return row
@@ -201,6 +223,10 @@ def main() -> None:
     ap.add_argument("--encoder", action=argparse.BooleanOptionalAction, default=True,
                     help="compare the records' pinion encoder as a second channel (twin diagnose's default; "
                          "--no-encoder: the casing channel alone, the control)")
+    ap.add_argument("--repeats", type=int, default=0,
+                    help="more healthy steady records of the gearbox given with the baseline "
+                         "(twin.effects.baseline: their record-to-record scatter raises the line threshold; "
+                         "default 0)")
     ap.add_argument("--out", type=Path, default=REPO / "bench_out" / "diagnosis_rigs")
     args = ap.parse_args()
 
@@ -222,7 +248,7 @@ def main() -> None:
             for effect in args.effects:
                 rows.append(one_case(rig, args.seed, effect, calibrated, args.out, ex, search,
                                      calibration_records(args.calibrated, rig, args.seed) if args.baseline else None,
-                                     args.encoder))
+                                     args.encoder, args.repeats))
                 print(json.dumps({k: v for k, v in rows[-1].items() if k != "top_fitted"}), flush=True)
                 (args.out / "results.json").write_text(json.dumps(rows, indent=1, default=str))
     print(f"Machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, {args.workers} workers, "

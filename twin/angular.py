@@ -66,6 +66,8 @@ class AngularDiscrepancy:
     frequencies: np.ndarray = field(repr=False)
     gain: np.ndarray = field(repr=False)          # (m,) [1]
     added: np.ndarray = field(repr=False)         # (m,) [rad^2/Hz]
+    # (m,) [dB] how far repeated baseline records differ (twin.effects.baseline); None with one
+    scatter_db: np.ndarray | None = field(default=None, repr=False)
 
     @classmethod
     def learn(cls, record: str, frequencies: np.ndarray, baseline_psd: np.ndarray, model_psd: np.ndarray
@@ -75,6 +77,13 @@ class AngularDiscrepancy:
         more = pb >= pm
         gain = np.where(more, 1.0, pb / np.where(pm > 0, pm, 1.0))
         return cls(record, np.asarray(frequencies, float), gain, np.where(more, pb - pm, 0.0))
+
+    def scatter_at(self, frequencies: np.ndarray) -> np.ndarray:
+        """The baseline's record-to-record scatter [dB] at ``frequencies`` (m,) [Hz] (0 without
+        repeated baseline records)."""
+        if self.scatter_db is None:
+            return np.zeros(np.size(frequencies))
+        return np.interp(np.asarray(frequencies, float), self.frequencies, self.scatter_db)
 
     def apply(self, frequencies: np.ndarray, model_psd: np.ndarray) -> np.ndarray:
         """The model PSD (m,) on ``frequencies`` read as the baseline's gearbox would show it."""
@@ -183,6 +192,8 @@ def compare_angles(model_angle: np.ndarray, measured_angle: np.ndarray, fs: floa
     gear_hz = shaft_hz * z1 / z2
     used = np.zeros(f.size, bool)
     findings = []
+    # a line counts when it differs by line_db beyond what repeated baseline records differ there
+    need = line_db + (discrepancy.scatter_at(f) if discrepancy is not None else np.zeros(f.size))
 
     def line(fc: float, text, order=None, exact: bool = False):
         idx = np.flatnonzero(np.abs(f - fc) <= tol)
@@ -190,7 +201,7 @@ def compare_angles(model_angle: np.ndarray, measured_angle: np.ndarray, fs: floa
         if idx.size == 0:
             return
         j = idx[np.argmax(np.abs(d[idx]))]
-        if abs(d[j]) < line_db:
+        if abs(d[j]) < need[j]:
             return
         used[idx] = True
         findings.append(Finding(KIND, text(float(d[j])), fc if exact else float(f[j]), (float(f[idx[0]]), float(f[idx[-1]])),
@@ -206,7 +217,7 @@ def compare_angles(model_angle: np.ndarray, measured_angle: np.ndarray, fs: floa
     prom = lp - median_filter(lp, size=max(5, int(round(30.0 / df))) | 1, mode="nearest")
     lock_tol = max(0.1, 0.3 * fs / n)
     for j in find_peaks(prom, height=10.0)[0]:
-        if used[j] or abs(d[j]) < line_db:
+        if used[j] or abs(d[j]) < need[j]:
             continue
         win = (ffine >= f[j] - df) & (ffine <= f[j] + df)
         fl = float(ffine[win][np.argmax(fine[win])]) if win.any() else float(f[j])

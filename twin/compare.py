@@ -136,8 +136,13 @@ def compare_signals(model: np.ndarray, measured: np.ndarray, fs: float, shaft_hz
     band = (f >= fmin) & (f <= min(fmax, fs / 2))
     f, pm, pp = f[band], pm[band], pp[band]
     lp, lm, gain_db = spectral_levels(pm, pp)
+    # a line counts when it differs by line_db beyond what repeated baseline records differ there
+    need = np.full(f.size, float(line_db))
     if discrepancy is not None:
         lp = lp - discrepancy.at(f)
+        scatter_at = getattr(discrepancy, "scatter_at", None)
+        if scatter_at is not None:
+            need = need + scatter_at(f)
     d = lp - lm                                   # measured minus model [dB]
     d2 = d ** 2
     total = float(np.sum(d2)) or 1.0
@@ -160,7 +165,7 @@ def compare_signals(model: np.ndarray, measured: np.ndarray, fs: float, shaft_hz
             return
         j = idx[np.argmax(np.abs(d[idx]))]
         size = float(d[j])
-        if abs(size) < line_db:
+        if abs(size) < need[j]:
             return
         used[idx] = True
         findings.append(Finding(kind, describe(size), float(f[j]), (float(f[idx[0]]), float(f[idx[-1]])), size,
@@ -179,7 +184,7 @@ def compare_signals(model: np.ndarray, measured: np.ndarray, fs: float, shaft_hz
             idx = idx[~used[idx]]
             if idx.size == 0:
                 continue
-            big = idx[np.abs(d[idx]) >= line_db]
+            big = idx[np.abs(d[idx]) >= need[idx]]
             if big.size == 0:
                 continue
             size = float(np.mean(d[big]))
@@ -203,7 +208,7 @@ def compare_signals(model: np.ndarray, measured: np.ndarray, fs: float, shaft_hz
     prom = lp - median_filter(lp, size=max(5, int(round(30.0 / df))) | 1, mode="nearest")
     peaks, _ = find_peaks(prom, height=10.0)
     for j in peaks:
-        if used[j] or d[j] < line_db:
+        if used[j] or d[j] < need[j]:
             continue
         win = (ffine >= f[j] - df) & (ffine <= f[j] + df)
         fl = float(ffine[win][np.argmax(fine[win])]) if win.any() else float(f[j])

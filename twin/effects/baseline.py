@@ -29,12 +29,22 @@ is a model-discrepancy term learned on reference data (Kennedy and O'Hagan, J. R
 63, 2001, 425-464), kept fixed while the effect is sought: learned on the calibrated model, it
 anchors every later model (an effect added) to the calibrated one.
 
+**Several records of the healthy gearbox.** One baseline record cannot say how much two healthy
+records differ: on the rigs the encoder's line at the gear's speed reads -59 and -53 dB re 1 rad
+in two healthy records of one gearbox, so a +7 dB change there is no effect. Further steady
+baseline records at the same operating point (:func:`repeated`) are repeats: the largest level
+difference between the paired baseline record and each repeat, per bin of each channel
+(``Discrepancy.scatter_db``, ``AngularDiscrepancy.scatter_db``; both read at the record's speed
+in shaft orders, as the comparison reads them), is added to the line threshold of the
+comparison's findings (:func:`twin.compare.compare_signals`, :func:`twin.angular.compare_angles`).
+The distance and the candidates' fit are unchanged.
+
 Frequencies in Hz, speeds in Hz (pinion), levels in dB.
 """
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -62,6 +72,17 @@ class Discrepancy:
     # fundamentals [pinion orders] of the harmonic series in the baseline's envelope
     # (twin.signals.envelope): repeated impacts the gearbox had when calibrated are not a change
     envelope_orders: tuple[float, ...] = ()
+    # (m,) [dB] how far repeated baseline records of the same operating point differ at each bin
+    # (largest over the repeats; None with one baseline record): a line changed by no more than
+    # that is within the healthy gearbox's record-to-record scatter (twin.compare)
+    scatter_db: np.ndarray | None = field(default=None, repr=False)
+
+    def scatter_at(self, frequencies: np.ndarray) -> np.ndarray:
+        """The baseline's record-to-record scatter [dB] at ``frequencies`` (m,) [Hz] (0 without
+        repeated baseline records)."""
+        if self.scatter_db is None:
+            return np.zeros(np.size(frequencies))
+        return np.interp(np.asarray(frequencies, float), self.frequencies, self.scatter_db)
 
     def at(self, frequencies: np.ndarray) -> np.ndarray:
         """The discrepancy [dB] at ``frequencies`` (m,) [Hz] of the record's analysis (linear
@@ -79,6 +100,9 @@ class DiscrepancySpec(HeldOutSpec):
     """
 
     baseline_hz: float = 0.0
+    # other baseline records of the same operating point: ((n,) measured stretch, (n,) angle or
+    # None, mean pinion speed [Hz]) each, for the record-to-record scatter
+    repeats: tuple = ()
 
 
 def learn(spec: DiscrepancySpec) -> Discrepancy:
@@ -124,11 +148,46 @@ def learn(spec: DiscrepancySpec) -> Discrepancy:
         ao = AngularObjective(spec.angle[-n:], spec.sample_rate, objective.resolution)
         angle = AngularDiscrepancy.learn(spec.record, ao.frequencies[ao.band],
                                          at_speed(ao.frequencies, ao.psd, ratio)[ao.band], ao.model_psd(angle_model))
+    scatter = angle_scatter = None
+    if spec.repeats:
+        scatter, angle_scatter = _scatter(spec, objective, speed)
+        if angle is not None and angle_scatter is not None:
+            angle = replace(angle, scatter_db=angle_scatter)
     envelope = ()
     if spec.shaft_hz is None and spec.baseline_hz > 0:      # a run-up's stretch smears its series
         from twin.signals.envelope import envelope_series
         envelope = tuple(s.order for s in envelope_series(spec.measured, spec.sample_rate, spec.baseline_hz))
-    return Discrepancy(spec.record, f, np.clip(level, -MAX_DB, MAX_DB), angle, envelope)
+    return Discrepancy(spec.record, f, np.clip(level, -MAX_DB, MAX_DB), angle, envelope, scatter)
+
+
+def _scatter(spec: DiscrepancySpec, objective, speed: float) -> tuple[np.ndarray, np.ndarray | None]:
+    """The largest level difference [dB] between the baseline record and each repeat, per bin of
+    the casing's objective grid (m,) and of the encoder's band (when every record has an angle),
+    both carried to the record's speed ``speed`` [Hz] in shaft orders and read as the levels the
+    comparison reads (floored at the measured noise, the gain aligned)."""
+    from twin.angular import AngularObjective
+    from twin.compare import spectral_levels
+    from twin.signals import welch_psd
+
+    f = objective.frequencies
+    base = at_speed(f, objective.psd, spec.baseline_hz / speed if spec.baseline_hz > 0 else 1.0)[objective.band]
+    scatter = np.zeros(f.size)
+    angle_scatter = None
+    ab = None
+    if spec.angle is not None and all(a is not None for _, a, _ in spec.repeats):
+        ab = AngularObjective(spec.angle, spec.sample_rate, objective.resolution)
+        b_angle = at_speed(ab.frequencies, ab.psd, spec.baseline_hz / speed if spec.baseline_hz > 0 else 1.0)[ab.band]
+        angle_scatter = np.zeros(int(np.count_nonzero(ab.band)))
+    for x, a, hz in spec.repeats:
+        n = min(x.size, spec.measured.size)
+        _, pr = welch_psd(np.asarray(x, float)[-n:], spec.sample_rate, resolution=objective.resolution)
+        lb, lr, _ = spectral_levels(at_speed(f, pr, hz / speed)[objective.band], base)
+        scatter[objective.band] = np.maximum(scatter[objective.band], np.abs(lb - lr))
+        if ab is not None:
+            ar = AngularObjective(np.asarray(a, float)[-n:], spec.sample_rate, objective.resolution)
+            lb, lr, _ = spectral_levels(at_speed(ar.frequencies, ar.psd, hz / speed)[ar.band], b_angle)
+            angle_scatter = np.maximum(angle_scatter, np.abs(lb - lr))
+    return scatter, angle_scatter
 
 
 def at_speed(frequencies: np.ndarray, psd: np.ndarray, ratio: float, *, width_hz: float = 30.0,
@@ -189,6 +248,15 @@ def pair(records: Sequence, baseline: Sequence) -> dict[str, object]:
     return out
 
 
+def repeated(b, baseline: Sequence) -> list:
+    """The other steady baseline records taken at ``b``'s operating point (drive speed within
+    ``SPEED_TOL``, load within ``LOAD_TOL``, the same sample rate): repeats of the healthy
+    gearbox, whose differences from ``b`` are its record-to-record scatter."""
+    return [o for o in baseline if o is not b and not o.runup and o.sample_rate == b.sample_rate
+            and b.nominal_speed > 0 and abs(o.nominal_speed / b.nominal_speed - 1) <= SPEED_TOL
+            and abs(o.load - b.load) <= LOAD_TOL * max(b.load, 1e-9)]
+
+
 def _angle(record, n: int, wanted: bool) -> np.ndarray | None:
     """The last n samples of a record's encoder angle [rad], if wanted and it has one."""
     return record.angle[-n:] if wanted and record.angle is not None else None
@@ -244,10 +312,17 @@ def learn_all(fmu_path, parameters: Mapping[str, float], records: Sequence, base
                                   record=r.name, duration=duration, solver_step=solver_step, shaft_speed=r.shaft_hz)
             cb = record_conditions(fmu_path, b.signal, b.sample_rate, b.nominal_speed, b.load, parameters,
                                    record=b.name, duration=duration, solver_step=solver_step, shaft_speed=b.shaft_hz)
+            repeats = []
+            for o in repeated(b, baseline):
+                co = record_conditions(fmu_path, o.signal, o.sample_rate, o.nominal_speed, o.load, parameters,
+                                       record=o.name, duration=duration, solver_step=solver_step,
+                                       shaft_speed=o.shaft_hz)
+                repeats.append((co.measured, _angle(o, co.measured.size, encoder and r.angle is not None),
+                                float(co.operating.shaft_hz)))
             specs.append(DiscrepancySpec(b.name, str(fmu_path), dict(parameters), channel, cb.measured, r.sample_rate,
                                          r.load, operating=c.operating, solver_step=solver_step,
                                          angle=_angle(b, cb.measured.size, encoder and r.angle is not None),
-                                         baseline_hz=float(cb.operating.shaft_hz)))
+                                         baseline_hz=float(cb.operating.shaft_hz), repeats=tuple(repeats)))
     out = (executor.map(guarded_learn, specs, progress=progress, desc="baseline records") if executor is not None
            else [guarded_learn(sp) for sp in specs])
     bad = [(s.record, v) for s, v in zip(specs, out) if isinstance(v, Exception)]

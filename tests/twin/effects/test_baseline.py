@@ -185,3 +185,43 @@ def test_the_cli_refuses_a_baseline_it_cannot_use_by_name(tmp_path, gearbox_fmu,
     assert main([*cmd, "--baseline", str(other), "--baseline-record", "healthy"]) == 2
     err = capsys.readouterr().err
     assert "baseline healthy was taken at 10 Hz" in err and "record steady at 20 Hz" in err
+
+
+def test_repeated_baseline_records_give_the_record_to_record_scatter_that_raises_the_line_threshold():
+    """A line that reads 6 dB apart in two healthy records is scatter there, not elsewhere; a
+    change of 8 dB at that line is then no finding, while the same change at a steady line is."""
+    from twin.compare import compare_signals
+    from twin.effects.baseline import DiscrepancySpec, _scatter, repeated
+    from twin.effects.fit import _Objective
+
+    fs, n = 20000.0, 40000
+    rng = np.random.default_rng(4)
+
+    def healthy(seed, wander=1.0):
+        r = np.random.default_rng(seed)
+        return r.standard_normal(n) + _line(380.0, amp=30.0) + _line(700.0, amp=10.0 * wander)
+
+    b, again = healthy(1), healthy(2, wander=2.0)            # the 700 Hz line 6 dB apart
+    spec = DiscrepancySpec("steady", "unused.fmu", {}, "accel", b, fs, 20.0, baseline_hz=20.0,
+                           repeats=((again, None, 20.0),))
+    objective = _Objective(b, fs)
+    scatter, angle_scatter = _scatter(spec, objective, 20.0)
+    f = objective.frequencies
+    assert angle_scatter is None
+    assert scatter[np.argmin(np.abs(f - 700.0))] == pytest.approx(6.0, abs=1.0)
+    assert np.median(scatter[objective.band]) < 1.0 and scatter[np.argmin(np.abs(f - 380.0))] < 1.5
+
+    d = Discrepancy("steady", f, np.zeros(f.size), scatter_db=scatter)
+    later = healthy(3, wander=2.5) + _line(380.0, amp=75.0)    # 700 Hz +8 dB, 380 Hz +8 dB
+    model = healthy(1)
+    without = compare_signals(model, later, fs, 20.0, z1=19, z2=52, discrepancy=Discrepancy("steady", f,
+                                                                                            np.zeros(f.size)))
+    found = compare_signals(model, later, fs, 20.0, z1=19, z2=52, discrepancy=d)
+    near = lambda c, fc: [x for x in c.findings if x.band_hz[0] - 2 <= fc <= x.band_hz[1] + 2]  # noqa: E731
+    assert near(without, 700.0) and near(without, 380.0)
+    assert not near(found, 700.0) and near(found, 380.0)
+
+    steady = Record("steady", b, fs, 20.0, 20.0)
+    others = [Record("steady_2", again, fs, 20.0, 20.0), Record("light", again, fs, 20.0, 5.0),
+              Record("runup", again, fs, 20.0, 20.0, np.linspace(5.0, 20.0, n)), steady]
+    assert [o.name for o in repeated(steady, others)] == ["steady_2"]
