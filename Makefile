@@ -31,11 +31,12 @@ demo: venv
 	$(VENV)/bin/python -m rigs.pedestal impact --gearbox 3 --scatter 0.12 --seed 3 --speed 0.5 --duration 8 --location pinion_pedestal --out $(DEMO)/rigs/pedestal_hammer.h5
 	$(VENV)/bin/python -m rigs.pedestal impact --gearbox 3 --scatter 0.12 --seed 3 --speed 0.5 --duration 8 --location gear_pedestal --out $(DEMO)/rigs/pedestal_hammer_gear.h5
 	$(VENV)/bin/python -m rigs.pedestal steady --gearbox 3 --scatter 0.12 --seed 5 --duration 2 --load 5 --out $(DEMO)/rigs/pedestal_light.h5
+	$(VENV)/bin/python -m rigs.pedestal steady --gearbox 3 --scatter 0.12 --seed 7 --duration 2 --out $(DEMO)/rigs/pedestal_steady_again.h5
 	$(VENV)/bin/python -m rigs.pedestal steady --gearbox 3 --scatter 0.12 --seed 4 --duration 2 --effect casing_resonance --out $(DEMO)/rigs/pedestal_casing_steady.h5
 	$(VENV)/bin/python -m rigs.pedestal runup --gearbox 3 --scatter 0.12 --seed 4 --from 2 --to 20 --duration 6 --effect casing_resonance --out $(DEMO)/rigs/pedestal_casing_runup.h5
 	$(VENV)/bin/python -m rigs.pedestal steady --gearbox 3 --scatter 0.12 --seed 6 --duration 2 --effect bearing_outer_race --out $(DEMO)/rigs/pedestal_bearing.h5
 	$(VENV)/bin/twin demo --out $(DEMO) --rig-records $(DEMO)/rigs/lumped.h5 $(DEMO)/rigs/ltca.h5 \
-		--calibration-records $(DEMO)/rigs/pedestal_steady.h5 $(DEMO)/rigs/pedestal_runup.h5 $(DEMO)/rigs/pedestal_hammer.h5 $(DEMO)/rigs/pedestal_hammer_gear.h5 $(DEMO)/rigs/pedestal_light.h5 \
+		--calibration-records $(DEMO)/rigs/pedestal_steady.h5 $(DEMO)/rigs/pedestal_runup.h5 $(DEMO)/rigs/pedestal_hammer.h5 $(DEMO)/rigs/pedestal_hammer_gear.h5 $(DEMO)/rigs/pedestal_light.h5 $(DEMO)/rigs/pedestal_steady_again.h5 \
 		--hidden-effect-records $(DEMO)/rigs/pedestal_casing_steady.h5 $(DEMO)/rigs/pedestal_casing_runup.h5
 	@printf '\n[6/9, continued] step 6: its calibrated twin against a record of the same gearbox with a rolling-bearing defect (outside the effect catalogue): twin compare names the series of its impacts in the envelope (envelope_line, drawn in compare_bearing/compare.png)\n'
 	$(VENV)/bin/twin compare $(DEMO)/calibration_rig/calibrated.yaml --measurements $(DEMO)/rigs/pedestal_bearing.h5 --out $(DEMO)/compare_bearing

@@ -1,7 +1,7 @@
 """Benchmark: `twin diagnose` on gearboxes the twin did not generate (rigs/pedestal, rigs/beam).
 
     python bench/diagnosis_rigs.py --calibrated bench_out/calibration_rigs [--rigs pedestal beam]
-                                   [--seed 1] [--effects ...] [--no-baseline] [--repeats 0]
+                                   [--seed 1] [--effects ...] [--no-baseline] [--repeats 1]
                                    [--out bench_out/diagnosis_rigs]
 
 Per rig: the gearbox ``Rig().scattered(seed, 0.12)`` that ``bench/calibration_rigs.py`` calibrated
@@ -223,10 +223,10 @@ def main() -> None:
     ap.add_argument("--encoder", action=argparse.BooleanOptionalAction, default=True,
                     help="compare the records' pinion encoder as a second channel (twin diagnose's default; "
                          "--no-encoder: the casing channel alone, the control)")
-    ap.add_argument("--repeats", type=int, default=0,
+    ap.add_argument("--repeats", type=int, default=1,
                     help="more healthy steady records of the gearbox given with the baseline "
                          "(twin.effects.baseline: their record-to-record scatter raises the line threshold; "
-                         "default 0)")
+                         "default 1, adopted 2026-11-29; 0: the baseline's own records alone)")
     ap.add_argument("--out", type=Path, default=REPO / "bench_out" / "diagnosis_rigs")
     args = ap.parse_args()
 

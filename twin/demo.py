@@ -83,8 +83,9 @@ def run_demo(out_dir: Path | str = "demo_out", *, stop_time: float = 10.0,
 
     ``calibration_records``: a steady and a run-up record of a rig of ``rigs/`` (two files, in
     that order; ``make demo`` writes them with ``python -m rigs.pedestal``), and optionally hammer
-    tests of the same gearbox (at the pinion's pedestal, then the gear's) and a steady record at
-    another load (``face_contact_from``), for step 6, which is skipped without them.
+    tests of the same gearbox (at the pinion's pedestal, then the gear's), a steady record at
+    another load (``face_contact_from``) and another healthy steady record at the first one's
+    operating point (step 8's baseline repeat), for step 6, which is skipped without them.
 
     ``hidden_effect_records``: a steady and a run-up record of step 6's gearbox with one of the
     rig's own effects hidden (two files, in that order; ``make demo`` writes them with ``python -m
@@ -107,9 +108,10 @@ def run_demo(out_dir: Path | str = "demo_out", *, stop_time: float = 10.0,
     rig_records = [Path(f) for f in rig_records]
     calibration_records = [Path(f) for f in calibration_records]
     hidden_effect_records = [Path(f) for f in hidden_effect_records]
-    if calibration_records and len(calibration_records) not in (2, 3, 4, 5):
+    if calibration_records and len(calibration_records) not in (2, 3, 4, 5, 6):
         raise ParameterError(f"calibration records: give a steady and a run-up file (and optionally one or two hammer "
-                             f"tests, then a steady record at another load), got {len(calibration_records)}")
+                             f"tests, a steady record at another load, then another healthy steady record), got "
+                             f"{len(calibration_records)}")
     if hidden_effect_records and len(hidden_effect_records) != 2:
         raise ParameterError(f"hidden-effect records: give a steady and a run-up file, got {len(hidden_effect_records)}")
     missing = [f for f in (*rig_records, *calibration_records, *hidden_effect_records) if not f.is_file()]

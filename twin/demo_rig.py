@@ -36,14 +36,16 @@ STRUCK = {"hammer": "input", "hammer_gear": "output"}
 PATH_FROM = {"hammer": "bearing_force_input_y", "hammer_gear": "bearing_force_output_y"}
 
 
-#: The names of the optional records after the steady one and the run-up, in the order given.
-EXTRA = (*STRUCK, "light")
+#: The names of the optional records after the steady one and the run-up, in the order given
+#: (``steady_again``: another healthy steady record, step 8's baseline repeat).
+EXTRA = (*STRUCK, "light", "steady_again")
 
 
 def merge_records(steady_file: Path, runup_file: Path, out: Path, *more_files: Path) -> Path:
     """One measurement file holding the first record of each file, named ``steady``, ``runup`` and
-    (when given) ``hammer`` and ``hammer_gear`` (blows at the pinion's, then the gear's pedestal) and
-    ``light`` (a steady record at the same speed and another load)."""
+    (when given) ``hammer`` and ``hammer_gear`` (blows at the pinion's, then the gear's pedestal),
+    ``light`` (a steady record at the same speed and another load) and ``steady_again`` (another
+    healthy steady record at the steady one's operating point)."""
     from twin.measurements import load_measurements, write_measurements
 
     records = [replace(load_measurements(steady_file)[0], name="steady"),
@@ -144,7 +146,9 @@ def loop_demo(out_dir: Path, records, calibrated, baseline=None) -> dict:
     gearbox of ``rigs/pedestal`` with one of the rig's own effects hidden (``records``: the two
     files, written by ``python -m rigs.pedestal ... --effect casing_resonance``), against step 6's
     calibrated scenario ``calibrated``, with step 6's records (``baseline``: the file holding its
-    ``steady`` and ``runup``) as the baseline (``--baseline``): what changed since calibration.
+    ``steady`` and ``runup``, and ``steady_again`` when given: a repeat whose record-to-record
+    scatter raises the line threshold) as the baseline (``--baseline``): what changed since
+    calibration.
 
     Writes ``loop/models.h5``: the model before (record ``before``) and after ``twin improve``
     (``after``; the same model when nothing was added), at the operating point the diagnosis
@@ -156,7 +160,7 @@ def loop_demo(out_dir: Path, records, calibrated, baseline=None) -> dict:
     from twin.demo import REPO, _heading, _lines, _written
     from twin.effects.loop import diagnose_scenario, history_table, improve, learn_discrepancy, read_baseline
     from twin.executor import LocalExecutor
-    from twin.measurements import Record, write_measurements
+    from twin.measurements import Record, load_measurements, write_measurements
     from twin.operating import simulate_at
     from twin.scenario import load_scenario
 
@@ -166,9 +170,12 @@ def loop_demo(out_dir: Path, records, calibrated, baseline=None) -> dict:
     (out_dir / "rig").mkdir(exist_ok=True)
     h5 = merge_records(Path(records[0]), Path(records[1]), out_dir / "rig" / "pedestal_hidden.h5")
     scenario = load_scenario(calibrated)
+    base_names = ["steady", "runup"]
+    if baseline is not None and "steady_again" in load_measurements(baseline).names:
+        base_names.append("steady_again")
     with LocalExecutor() as ex:
         # the discrepancy learned once on the calibrated model, kept by the diagnosis and improve
-        known = (learn_discrepancy(scenario, h5, read_baseline(baseline, scenario, ["steady", "runup"]),
+        known = (learn_discrepancy(scenario, h5, read_baseline(baseline, scenario, base_names),
                                    record=["steady", "runup"], executor=ex) if baseline is not None else None)
         diag = diagnose_scenario(scenario, h5, record=["steady", "runup"], json_path=loop / "diagnosis.json",
                                  executor=ex, progress=False, baseline=known)
@@ -189,7 +196,8 @@ def loop_demo(out_dir: Path, records, calibrated, baseline=None) -> dict:
               for name, s in (("before", scenario), ("after", after))]
     write_measurements(models, loop / "models.h5")
     _heading(8, "The loop on a gearbox the twin did not generate: step 6's rigs/pedestal gearbox with a "
-                "casing resonance hidden; twin diagnose --record steady --record runup --baseline (step 6's records), "
+                "casing resonance hidden; twin diagnose --record steady --record runup --baseline (step 6's records, "
+                f"{' '.join(base_names)}), "
                 "then twin improve",
              time.perf_counter() - t)
     _lines(f"twin diagnose ({took:.0f} s; candidates searched on 1 s at a 20 us step, scored on 2 s at 10 us):")

@@ -17,9 +17,9 @@ def test_hidden_effect_records_are_a_steady_and_a_runup_file_that_exist(tmp_path
     assert not (tmp_path / "out").exists()
 
 
-def test_calibration_records_are_two_to_five_files(tmp_path):
-    files = [tmp_path / f"{i}.h5" for i in range(6)]
-    with pytest.raises(ParameterError, match="then a steady record at another load\\), got 6"):
+def test_calibration_records_are_two_to_six_files(tmp_path):
+    files = [tmp_path / f"{i}.h5" for i in range(7)]
+    with pytest.raises(ParameterError, match="then another healthy steady record\\), got 7"):
         run_demo(tmp_path / "out", calibration_records=files)
     assert not (tmp_path / "out").exists()
 

@@ -54,7 +54,8 @@ def add_schema_and_demo(sub) -> None:
     p.add_argument("--calibration-records", nargs="+", default=(), metavar="FILE",
                    help="a steady and a run-up record of an independent simulator (python -m rigs.pedestal ...) "
                         "for step 6, and optionally hammer tests of the same gearbox at the pinion's and the gear's "
-                        "pedestal, then a steady record at another load (STEADY RUNUP [HAMMER [HAMMER_GEAR [LIGHT]]])")
+                        "pedestal, a steady record at another load, then another healthy steady record (STEADY RUNUP "
+                        "[HAMMER [HAMMER_GEAR [LIGHT [STEADY_AGAIN]]]])")
     p.add_argument("--hidden-effect-records", nargs=2, default=(), metavar=("STEADY", "RUNUP"),
                    help="a steady and a run-up record of step 6's gearbox with one of the rig's own effects "
                         "(python -m rigs.pedestal ... --effect casing_resonance) for step 8")
