@@ -135,7 +135,9 @@ def _loop_arguments(p: argparse.ArgumentParser, *, out: bool, several: bool = Fa
                    help="measurement file of the gearbox as the scenario's model was calibrated on it (before the "
                         "effect sought): the model's discrepancy on it is taken out of the compared levels first")
     p.add_argument("--baseline-record", action="append", metavar="NAME",
-                   help="record of --baseline, repeatable (default: those named like --record)")
+                   help="record of --baseline, repeatable (default: those named like --record); a further "
+                        "steady record at the same operating point is a repeat of the healthy gearbox: what the "
+                        "two differ by raises the threshold of a line finding there")
     p.add_argument("--no-encoder", dest="encoder", action="store_false",
                    help="compare the casing channel alone, not the records' pinion encoder angle as well "
                         "(default: both, where every record has an angle encoder)")
