@@ -87,7 +87,7 @@ def calibration_records(calibrated_dir: Path, rig_name: str, seed: int) -> Path:
 
 def repeat_records(rig_name: str, seed: int, out: Path, count: int) -> list:
     """``count`` more healthy 2 s steady records of the gearbox at the calibration's operating
-    point (the rig's record seeds 300, 301, ...; written once to ``<rig>_<seed>_repeats.h5``),
+    point (the rig's record seeds 300, 301, ...; written once to ``<rig>_<seed>_repeats<count>.h5``),
     as :class:`twin.effects.records.Record`: repeats of the baseline for the diagnosis."""
     from twin.effects.records import read_records
     if count <= 0:

@@ -141,16 +141,16 @@ def learn(spec: DiscrepancySpec) -> Discrepancy:
     lp, lm, _ = spectral_levels(pm[objective.band], pp[objective.band])
     level = np.zeros(f.size)
     level[objective.band] = lp - lm
-    angle = None
+    angle = ao = None
     if spec.angle is not None:
         # the encoder's: what the baseline holds beyond the model, added to it (twin.angular)
         from twin.angular import AngularDiscrepancy, AngularObjective
         ao = AngularObjective(spec.angle[-n:], spec.sample_rate, objective.resolution)
         angle = AngularDiscrepancy.learn(spec.record, ao.frequencies[ao.band],
                                          at_speed(ao.frequencies, ao.psd, ratio)[ao.band], ao.model_psd(angle_model))
-    scatter = angle_scatter = None
+    scatter = None
     if spec.repeats:
-        scatter, angle_scatter = _scatter(spec, objective, speed)
+        scatter, angle_scatter = _scatter(spec, objective, pp[objective.band], ao, speed)
         if angle is not None and angle_scatter is not None:
             angle = replace(angle, scatter_db=angle_scatter)
     envelope = ()
@@ -160,30 +160,31 @@ def learn(spec: DiscrepancySpec) -> Discrepancy:
     return Discrepancy(spec.record, f, np.clip(level, -MAX_DB, MAX_DB), angle, envelope, scatter)
 
 
-def _scatter(spec: DiscrepancySpec, objective, speed: float) -> tuple[np.ndarray, np.ndarray | None]:
+def _scatter(spec: DiscrepancySpec, objective, base_psd: np.ndarray, angle_objective, speed: float
+             ) -> tuple[np.ndarray, np.ndarray | None]:
     """The largest level difference [dB] between the baseline record and each repeat, per bin of
-    the casing's objective grid (m,) and of the encoder's band (when every record has an angle),
-    both carried to the record's speed ``speed`` [Hz] in shaft orders and read as the levels the
+    the casing's objective grid (m,) and of the encoder's band (``angle_objective``, the
+    baseline's :class:`twin.angular.AngularObjective`, when every repeat has an angle too), the
+    repeats carried to the record's speed ``speed`` [Hz] in shaft orders as the baseline is
+    (``base_psd``: its PSD over the objective's band, already carried) and read as the levels the
     comparison reads (floored at the measured noise, the gain aligned)."""
     from twin.angular import AngularObjective
     from twin.compare import spectral_levels
     from twin.signals import welch_psd
 
     f = objective.frequencies
-    base = at_speed(f, objective.psd, spec.baseline_hz / speed if spec.baseline_hz > 0 else 1.0)[objective.band]
     scatter = np.zeros(f.size)
-    angle_scatter = None
-    ab = None
-    if spec.angle is not None and all(a is not None for _, a, _ in spec.repeats):
-        ab = AngularObjective(spec.angle, spec.sample_rate, objective.resolution)
-        b_angle = at_speed(ab.frequencies, ab.psd, spec.baseline_hz / speed if spec.baseline_hz > 0 else 1.0)[ab.band]
-        angle_scatter = np.zeros(int(np.count_nonzero(ab.band)))
+    angle_scatter = b_angle = None
+    if angle_objective is not None and all(a is not None for _, a, _ in spec.repeats):
+        ratio = spec.baseline_hz / speed if spec.baseline_hz > 0 else 1.0
+        b_angle = at_speed(angle_objective.frequencies, angle_objective.psd, ratio)[angle_objective.band]
+        angle_scatter = np.zeros(b_angle.size)
     for x, a, hz in spec.repeats:
         n = min(x.size, spec.measured.size)
         _, pr = welch_psd(np.asarray(x, float)[-n:], spec.sample_rate, resolution=objective.resolution)
-        lb, lr, _ = spectral_levels(at_speed(f, pr, hz / speed)[objective.band], base)
+        lb, lr, _ = spectral_levels(at_speed(f, pr, hz / speed)[objective.band], base_psd)
         scatter[objective.band] = np.maximum(scatter[objective.band], np.abs(lb - lr))
-        if ab is not None:
+        if b_angle is not None:
             ar = AngularObjective(np.asarray(a, float)[-n:], spec.sample_rate, objective.resolution)
             lb, lr, _ = spectral_levels(at_speed(ar.frequencies, ar.psd, hz / speed)[ar.band], b_angle)
             angle_scatter = np.maximum(angle_scatter, np.abs(lb - lr))

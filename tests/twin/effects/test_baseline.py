@@ -205,7 +205,7 @@ def test_repeated_baseline_records_give_the_record_to_record_scatter_that_raises
     spec = DiscrepancySpec("steady", "unused.fmu", {}, "accel", b, fs, 20.0, baseline_hz=20.0,
                            repeats=((again, None, 20.0),))
     objective = _Objective(b, fs)
-    scatter, angle_scatter = _scatter(spec, objective, 20.0)
+    scatter, angle_scatter = _scatter(spec, objective, objective.psd[objective.band], None, 20.0)
     f = objective.frequencies
     assert angle_scatter is None
     assert scatter[np.argmin(np.abs(f - 700.0))] == pytest.approx(6.0, abs=1.0)
@@ -225,3 +225,32 @@ def test_repeated_baseline_records_give_the_record_to_record_scatter_that_raises
     others = [Record("steady_2", again, fs, 20.0, 20.0), Record("light", again, fs, 20.0, 5.0),
               Record("runup", again, fs, 20.0, 20.0, np.linspace(5.0, 20.0, n)), steady]
     assert [o.name for o in repeated(steady, others)] == ["steady_2"]
+
+
+def test_the_encoder_channel_learns_its_own_scatter_from_repeats_with_an_angle():
+    """The angle's line at the gear's speed 6 dB apart in two healthy records: the encoder's
+    scatter reads it there and little elsewhere; without an angle in a repeat there is none."""
+    from twin.angular import AngularObjective
+    from twin.effects.baseline import DiscrepancySpec, _scatter
+    from twin.effects.fit import _Objective
+
+    fs, n = 20000.0, 40000
+    t = np.arange(n) / fs
+
+    def angle(size, seed):
+        r = np.random.default_rng(seed)
+        return (2 * np.pi * 20.0 * t + size * np.sin(2 * np.pi * 7.31 * t) + 1e-4 * np.sin(2 * np.pi * 40.0 * t)
+                + 1e-7 * r.standard_normal(n))
+
+    x = np.random.default_rng(0).standard_normal(n)
+    spec = DiscrepancySpec("steady", "unused.fmu", {}, "accel", x, fs, 20.0, baseline_hz=20.0,
+                           angle=angle(1e-3, 1), repeats=((x, angle(2e-3, 2), 20.0),))
+    objective = _Objective(x, fs)
+    ao = AngularObjective(spec.angle, fs, objective.resolution)
+    _, scatter = _scatter(spec, objective, objective.psd[objective.band], ao, 20.0)
+    f = ao.frequencies[ao.band]
+    assert scatter[np.argmin(np.abs(f - 7.31))] == pytest.approx(6.0, abs=1.5)
+    assert scatter[np.argmin(np.abs(f - 40.0))] < 1.5
+    no_angle = DiscrepancySpec("steady", "unused.fmu", {}, "accel", x, fs, 20.0, baseline_hz=20.0,
+                               angle=spec.angle, repeats=((x, None, 20.0),))
+    assert _scatter(no_angle, objective, objective.psd[objective.band], ao, 20.0)[1] is None
