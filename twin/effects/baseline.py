@@ -76,6 +76,7 @@ class Discrepancy:
     # (largest over the repeats; None with one baseline record): a line changed by no more than
     # that is within the healthy gearbox's record-to-record scatter (twin.compare)
     scatter_db: np.ndarray | None = field(default=None, repr=False)
+    repeats: tuple[str, ...] = ()      # the names of those repeats
 
     def scatter_at(self, frequencies: np.ndarray) -> np.ndarray:
         """The baseline's record-to-record scatter [dB] at ``frequencies`` (m,) [Hz] (0 without
@@ -101,8 +102,9 @@ class DiscrepancySpec(HeldOutSpec):
 
     baseline_hz: float = 0.0
     # other baseline records of the same operating point: ((n,) measured stretch, (n,) angle or
-    # None, mean pinion speed [Hz]) each, for the record-to-record scatter
+    # None, mean pinion speed [Hz]) each, for the record-to-record scatter, and their names
     repeats: tuple = ()
+    repeat_names: tuple[str, ...] = ()
 
 
 def learn(spec: DiscrepancySpec) -> Discrepancy:
@@ -157,7 +159,8 @@ def learn(spec: DiscrepancySpec) -> Discrepancy:
     if spec.shaft_hz is None and spec.baseline_hz > 0:      # a run-up's stretch smears its series
         from twin.signals.envelope import envelope_series
         envelope = tuple(s.order for s in envelope_series(spec.measured, spec.sample_rate, spec.baseline_hz))
-    return Discrepancy(spec.record, f, np.clip(level, -MAX_DB, MAX_DB), angle, envelope, scatter)
+    return Discrepancy(spec.record, f, np.clip(level, -MAX_DB, MAX_DB), angle, envelope, scatter,
+                       tuple(spec.repeat_names) if spec.repeats else ())
 
 
 def _scatter(spec: DiscrepancySpec, objective, base_psd: np.ndarray, angle_objective, speed: float
@@ -313,8 +316,9 @@ def learn_all(fmu_path, parameters: Mapping[str, float], records: Sequence, base
                                   record=r.name, duration=duration, solver_step=solver_step, shaft_speed=r.shaft_hz)
             cb = record_conditions(fmu_path, b.signal, b.sample_rate, b.nominal_speed, b.load, parameters,
                                    record=b.name, duration=duration, solver_step=solver_step, shaft_speed=b.shaft_hz)
-            repeats = []
+            repeats, names = [], []
             for o in repeated(b, baseline):
+                names.append(o.name)
                 co = record_conditions(fmu_path, o.signal, o.sample_rate, o.nominal_speed, o.load, parameters,
                                        record=o.name, duration=duration, solver_step=solver_step,
                                        shaft_speed=o.shaft_hz)
@@ -323,7 +327,8 @@ def learn_all(fmu_path, parameters: Mapping[str, float], records: Sequence, base
             specs.append(DiscrepancySpec(b.name, str(fmu_path), dict(parameters), channel, cb.measured, r.sample_rate,
                                          r.load, operating=c.operating, solver_step=solver_step,
                                          angle=_angle(b, cb.measured.size, encoder and r.angle is not None),
-                                         baseline_hz=float(cb.operating.shaft_hz), repeats=tuple(repeats)))
+                                         baseline_hz=float(cb.operating.shaft_hz), repeats=tuple(repeats),
+                                         repeat_names=tuple(names)))
     out = (executor.map(guarded_learn, specs, progress=progress, desc="baseline records") if executor is not None
            else [guarded_learn(sp) for sp in specs])
     bad = [(s.record, v) for s, v in zip(specs, out) if isinstance(v, Exception)]

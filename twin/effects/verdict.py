@@ -77,10 +77,11 @@ class Diagnosis:
     tied: tuple[str, ...] = ()               # verdict "tie": the effects that explain the same thing
     baseline: tuple[str, ...] = ()           # baseline records whose model discrepancy was taken out
     encoder: bool = False                    # the pinion encoder compared too: lsd_db is the two channels' RMS
+    baseline_repeats: tuple[str, ...] = ()   # baseline records whose scatter raised the line threshold
 
     def to_dict(self) -> dict:
         return {"record": self.record, "held_out_records": list(self.held_out_records), "runup": self.runup,
-                "baseline": list(self.baseline),
+                "baseline": list(self.baseline), "baseline_repeats": list(self.baseline_repeats),
                 "encoder": self.encoder, "verdict": self.verdict, "missing": self.missing, "tied": list(self.tied),
                 "message": self.message, "headline": {"log_spectral_distance_db": self.lsd_db},
                 "operating": asdict(self.operating),
@@ -102,7 +103,9 @@ class Diagnosis:
                 + f", {len(self.findings)} findings"
                 + (f"; held out: {', '.join(self.held_out_records)}" if self.held_out_records else "")
                 + (f"; the model's discrepancy on baseline {', '.join(self.baseline)} taken out" if self.baseline
-                   else ""),
+                   else "")
+                + (f", the line threshold raised by how far {', '.join(self.baseline_repeats)} differs"
+                   if self.baseline_repeats else ""),
                 f"{'rank':>4}  {'effect':<24} {'score':>6}  {'LSD after':>9}  {'held-out cut':>12}  signature  explains"]
         for i, c in enumerate(self.candidates):
             ex = "; ".join(e.kind for e in c.evidence) or ("failed: " + c.error if c.error else "-")

@@ -254,3 +254,27 @@ def test_the_encoder_channel_learns_its_own_scatter_from_repeats_with_an_angle()
     no_angle = DiscrepancySpec("steady", "unused.fmu", {}, "accel", x, fs, 20.0, baseline_hz=20.0,
                                angle=spec.angle, repeats=((x, None, 20.0),))
     assert _scatter(no_angle, objective, objective.psd[objective.band], ao, 20.0)[1] is None
+
+
+def test_learn_all_names_the_repeats_and_the_diagnosis_reports_them(gearbox_fmu):
+    """A further steady baseline record at the same operating point is learned as a repeat (its
+    name kept with the discrepancy); one at another load is not; the diagnosis's table says so."""
+    from twin.effects.baseline import learn_all
+    from twin.effects.verdict import Diagnosis
+    from twin.operating import Operating
+
+    fs, n = 50000.0, 25000
+    rng = np.random.default_rng(7)
+
+    def rec(name, load=20.0):
+        return Record(name, rng.standard_normal(n), fs, 20.0, load, np.full(n, 19.6))
+
+    out = learn_all(gearbox_fmu, {}, [rec("later")], [rec("steady"), rec("steady_again"), rec("light", 5.0)],
+                    "accel_pinion_casing", duration=0.5)
+    d = out["later"]
+    assert d.record == "steady" and d.repeats == ("steady_again",)
+    assert d.scatter_db is not None and np.all(d.scatter_db >= 0)
+    diag = Diagnosis("later", 2.0, (), (), "nothing_missing", None, (), "", Operating(20, 20, 19.6, fs), 1.0,
+                     baseline=("steady",), baseline_repeats=d.repeats)
+    assert "the line threshold raised by how far steady_again differs" in diag.table()
+    assert diag.to_dict()["baseline_repeats"] == ["steady_again"]
