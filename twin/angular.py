@@ -48,6 +48,14 @@ def angular_vibration(angle: np.ndarray, fs: float) -> np.ndarray:
     return angle - np.polyval(np.polyfit(t, angle, 2), t)
 
 
+def read_scatter(frequencies: np.ndarray, grid: np.ndarray, scatter_db: np.ndarray | None) -> np.ndarray:
+    """A baseline's record-to-record scatter [dB], learned on ``grid`` (m,) [Hz], read at
+    ``frequencies`` (k,) [Hz] (linear between bins); 0 without repeated baseline records (None)."""
+    if scatter_db is None:
+        return np.zeros(np.size(frequencies))
+    return np.interp(np.asarray(frequencies, float), grid, scatter_db)
+
+
 @dataclass(frozen=True)
 class AngularDiscrepancy:
     """The model's discrepancy on the encoder channel, learned on a baseline record: per bin of
@@ -81,9 +89,7 @@ class AngularDiscrepancy:
     def scatter_at(self, frequencies: np.ndarray) -> np.ndarray:
         """The baseline's record-to-record scatter [dB] at ``frequencies`` (m,) [Hz] (0 without
         repeated baseline records)."""
-        if self.scatter_db is None:
-            return np.zeros(np.size(frequencies))
-        return np.interp(np.asarray(frequencies, float), self.frequencies, self.scatter_db)
+        return read_scatter(frequencies, self.frequencies, self.scatter_db)
 
     def apply(self, frequencies: np.ndarray, model_psd: np.ndarray) -> np.ndarray:
         """The model PSD (m,) on ``frequencies`` read as the baseline's gearbox would show it."""

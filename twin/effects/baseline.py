@@ -81,9 +81,8 @@ class Discrepancy:
     def scatter_at(self, frequencies: np.ndarray) -> np.ndarray:
         """The baseline's record-to-record scatter [dB] at ``frequencies`` (m,) [Hz] (0 without
         repeated baseline records)."""
-        if self.scatter_db is None:
-            return np.zeros(np.size(frequencies))
-        return np.interp(np.asarray(frequencies, float), self.frequencies, self.scatter_db)
+        from twin.angular import read_scatter
+        return read_scatter(frequencies, self.frequencies, self.scatter_db)
 
     def at(self, frequencies: np.ndarray) -> np.ndarray:
         """The discrepancy [dB] at ``frequencies`` (m,) [Hz] of the record's analysis (linear

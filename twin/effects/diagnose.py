@@ -423,4 +423,4 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
     return Diagnosis(fit_rec.name, before.lsd_db, before.findings, tuple(cands), verdict, missing, unexplained, msg,
                      op, time.perf_counter() - t0, held_names, runup_name, tied,
                      tuple(sorted({d.record for d in discrepancy.values()})), encoder,
-                     tuple(sorted({n for d in discrepancy.values() for n in getattr(d, "repeats", ())})))
+                     tuple(sorted({n for d in discrepancy.values() for n in d.repeats})))
