@@ -47,6 +47,9 @@ class TrialSpec:
     discrepancy: object = None
     # the record's pinion encoder angle (n,) [rad], a second channel (twin.angular), or None
     angle: np.ndarray | None = field(default=None, repr=False)
+    # the record is impulsive once per pinion revolution where the base model is not: the
+    # synchronous average's impulsiveness is one more channel of the objective
+    impulsive: bool = False
 
     @property
     def channels(self) -> str | list[str]:
@@ -66,10 +69,13 @@ class _Objective:
     With the record's encoder ``angle`` (n,) [rad] the simulation is (n, 2), the casing channel
     and the model's encoder angle, and the objective is both channels' joint LSD
     (:func:`twin.angular.joint_lsd`); ``discrepancy.angle`` is the encoder's known model-form error.
+    With ``shaft_hz`` (the pinion speed [Hz], a constant or (n,) per sample) the impulsiveness of
+    the casing's synchronous average over the pinion revolution is one more channel
+    (:func:`twin.compare.fold_impulsiveness`).
     """
 
     def __init__(self, measured: np.ndarray, fs: float, fmin: float = 10.0, fmax: float = 5000.0,
-                 resolution: float = 2.0, discrepancy=None, angle: np.ndarray | None = None):
+                 resolution: float = 2.0, discrepancy=None, angle: np.ndarray | None = None, shaft_hz=None):
         from twin.signals import welch_psd
         self.fs, self.n = fs, measured.size
         self.resolution = max(resolution, 4.0 * fs / self.n)
@@ -84,6 +90,11 @@ class _Objective:
             from twin.angular import AngularObjective
             self.angular = AngularObjective(np.asarray(angle, float)[-self.n:], fs, self.resolution,
                                             getattr(discrepancy, "angle", None))
+        self.shaft_hz = None
+        if shaft_hz is not None:
+            from twin.signals.tsa import impulsiveness_db
+            self.shaft_hz = shaft_hz if np.ndim(shaft_hz) == 0 else np.asarray(shaft_hz, float)[-self.n:]
+            self.impulsiveness = impulsiveness_db(measured, fs, self.shaft_hz)
 
     def __call__(self, simulated: np.ndarray) -> float:
         from twin.angular import joint_lsd
@@ -94,9 +105,14 @@ class _Objective:
         _, pm = welch_psd(casing[: self.n], self.fs, resolution=self.resolution)
         lp, lm, _ = spectral_levels(pm[self.band], self.pp)
         lsd = float(np.sqrt(np.mean((lp - self.offset - lm) ** 2)))
-        if self.angular is None:
+        if self.angular is not None:
+            lsd = joint_lsd(lsd, self.angular(simulated[:, 1]))
+        if self.shaft_hz is None:
             return lsd
-        return joint_lsd(lsd, self.angular(simulated[:, 1]))
+        from twin.compare import fold_impulsiveness
+        from twin.signals.tsa import impulsiveness_db
+        return fold_impulsiveness(lsd, 1 if self.angular is None else 2, self.impulsiveness,
+                                  impulsiveness_db(casing[: self.n], self.fs, self.shaft_hz))
 
 
 def simulate(fmu_path, parameters: Mapping[str, float], op: Operating, n: int, channel, *,
@@ -130,7 +146,8 @@ def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int, np.ndarra
         op = replace(op, solver_step=spec.search_step)
     short = n_search < n or op != spec.operating        # search on a shorter or coarser run, score on the whole
     objective = _Objective(spec.measured[-n_search:], spec.operating.sample_rate, discrepancy=spec.discrepancy,
-                           angle=None if spec.angle is None else spec.angle[-n_search:])
+                           angle=None if spec.angle is None else spec.angle[-n_search:],
+                           shaft_hz=spec.operating.shaft_hz if spec.impulsive else None)
     fixed = dict(spec.parameters)
     params = list(eff.fit)
     free = [p for p in params if p.guess is None]
@@ -222,7 +239,7 @@ def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int, np.ndarra
         try:
             sim = simulate(spec.fmu_path, {**fixed, **fitted}, spec.operating, n, spec.channels)
             val = _Objective(spec.measured, spec.operating.sample_rate, discrepancy=spec.discrepancy,
-                             angle=spec.angle)(sim)
+                             angle=spec.angle, shaft_hz=spec.operating.shaft_hz if spec.impulsive else None)(sim)
         except Exception:  # a fit that diverges on the whole stretch scores badly, as in the search
             sim, val = None, 1e3
     return fitted, val, count, sim
