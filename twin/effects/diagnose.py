@@ -150,6 +150,15 @@ def compare_record(sim: np.ndarray, measured: np.ndarray, angle: np.ndarray | No
                                         discrepancy=getattr(discrepancy, "angle", None)))
 
 
+def impulse_folded(comp: Comparison) -> Comparison:
+    """The base model's comparison with the synchronous average's impulsiveness folded in
+    (:func:`twin.compare.with_impulsiveness`) when it holds the ``impulsive`` finding: a record
+    that strikes once per pinion revolution where the model does not spreads that impulse over
+    many small sidebands of its spectrum, so the impulsiveness is compared as a channel of its own
+    (and the candidates are fitted, scored and held out on it too). Unchanged otherwise."""
+    return with_impulsiveness(comp) if any(fd.kind == "impulsive" for fd in comp.findings) else comp
+
+
 def _candidate(eff: Effect, before: Comparison, fitted: dict, n_eval: int, sim: np.ndarray, measured: np.ndarray,
                op: Operating, z1: int, z2: int, discrepancy=None, angle: np.ndarray | None = None) -> Candidate:
     """Score a fitted candidate against the baseline comparison (``discrepancy``: the record's
@@ -323,12 +332,8 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
                                 slip_hz=op.drive_hz - op.shaft_hz, fit_load=op.load, executor=ex, progress=progress,
                                 encoder=encoder)
     known = discrepancy.get(fit_rec.name)
-    before = compare_record(base_model, measured, fit_angle, sample_rate, shaft, z1, z2, known)
-    # a record impulsive once per pinion revolution where the model is not: its spectrum spreads
-    # the impulse over many small sidebands, so the impulsiveness is compared as a channel of its own
-    impulsive = any(fd.kind == "impulsive" for fd in before.findings)
-    if impulsive:
-        before = with_impulsiveness(before)
+    before = impulse_folded(compare_record(base_model, measured, fit_angle, sample_rate, shaft, z1, z2, known))
+    impulsive = before.impulsiveness_folded
     if base_model.ndim == 2:
         base_model = base_model[:, 0]
 

@@ -125,7 +125,8 @@ def simulate(fmu_path, parameters: Mapping[str, float], op: Operating, n: int, c
 def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int, np.ndarray]:
     """Fit one effect's parameters, then (with ``spec.related``) them and the related base ones.
 
-    1. amplitude-like parameters on a coarse grid, then Brent;
+    1. amplitude-like parameters on a coarse grid, then Brent, one after the other, and each later
+       one alone; the best of these starts 2.;
     2. all effect parameters together (Nelder-Mead);
     3. the effect parameters and the related base parameters together (Nelder-Mead, the base
        ones within +-``RELATED_SPAN`` of their calibrated values), kept only if it lowers the LSD.
@@ -186,16 +187,28 @@ def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int, np.ndarra
     values = {p.name: start(p) for p in params} if spec.polish_only else \
         {p.name: start(p) for p in params if p.guess is not None}
     if not spec.polish_only:
-        # 1) amplitude-like parameters on a coarse grid with the guessed ones held, then Brent
-        for p in free:
+        def sweep(p: FitParameter, held: dict) -> dict:
+            """``held`` with ``p`` at the best of a coarse grid, polished by Brent."""
             grid = np.linspace(0.0, 1.0, p.grid)
-            scores = [lsd({**values, p.name: from_x(p, z)}) for z in grid]
+            scores = [lsd({**held, p.name: from_x(p, z)}) for z in grid]
             j = int(np.argmin(scores))
             lo, hi = grid[max(j - 1, 0)], grid[min(j + 1, grid.size - 1)]
-            res = minimize_scalar(lambda z: lsd({**values, p.name: from_x(p, z)}), bounds=(lo, hi),
+            res = minimize_scalar(lambda z: lsd({**held, p.name: from_x(p, z)}), bounds=(lo, hi),
                                   method="bounded", options={"xatol": 0.01, "maxiter": 8})
-            best_z = res.x if res.fun < scores[j] else grid[j]
-            values[p.name] = from_x(p, best_z)
+            return {**held, p.name: from_x(p, res.x if res.fun < scores[j] else grid[j])}
+
+        # 1) amplitude-like parameters on a coarse grid with the guessed ones held, then Brent, one
+        # after the other; and each later one alone, since two parameters may each give what the
+        # record shows (a tooth's stiffness loss and its spall both strike once a turn) and the one
+        # searched first would otherwise take it all: the joint polish starts from the best of these
+        held = {**{p.name: float(eff.neutral.get(p.name, p.lower)) for p in free}, **values}
+        values = dict(held)
+        starts = []
+        for p in free:
+            values = sweep(p, values)
+            starts.append(values)
+        starts += [sweep(p, held) for p in free[1:]]
+        values = min(starts, key=lsd) if starts else values
         # 2) all parameters together (frequency-like ones move within +-5 % of their range)
         if len(params) > 1 and count < spec.max_evals:
             z0 = np.array([to_x(p, values[p.name]) for p in params])
