@@ -28,8 +28,7 @@ measurements from any rig.
 """
 from __future__ import annotations
 
-import math
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 from scipy.ndimage import median_filter
@@ -37,7 +36,6 @@ from scipy.signal import find_peaks
 from scipy.stats import kurtosis
 
 from twin.signals import padded_spectrum, shaft_angle_from_speed, synchronous_average, welch_psd
-from twin.signals.tsa import fourth_moment_db
 
 
 MAX_GAIN_DB = 1.0   # sensor sensitivity uncertainty absorbed by the level alignment (about +-12 %)
@@ -94,10 +92,6 @@ class Comparison:
     # the encoder channel folded in (twin.angular.joint): lsd_db and the findings' shares are then
     # the two channels' together
     angular: object = field(default=None, repr=False)
-    # (measured, model) impulsiveness of the synchronous average over the pinion revolution [dB]
-    # (:func:`impulsiveness_db`), and whether it is folded into lsd_db (:func:`with_impulsiveness`)
-    impulsiveness_db: tuple[float, float] | None = None
-    impulsiveness_folded: bool = False
 
     def to_dict(self) -> dict:
         return {"headline": {"log_spectral_distance_db": self.lsd_db,
@@ -112,10 +106,7 @@ class Comparison:
                 **({"encoder": {"log_spectral_distance_db": self.angular.lsd_db,
                                 "definition": "the same over the encoder's angular vibration (the angle less a "
                                               "quadratic in time), 2-500 Hz; the headline is then the RMS of the "
-                                              "casing's and the encoder's"}} if self.angular is not None else {}),
-                **({"impulsiveness_db": {"measured": self.impulsiveness_db[0], "model": self.impulsiveness_db[1],
-                                         "folded_into_headline": self.impulsiveness_folded}}
-                   if self.impulsiveness_db is not None else {})}
+                                              "casing's and the encoder's"}} if self.angular is not None else {})}
 
 
 def compare_signals(model: np.ndarray, measured: np.ndarray, fs: float, shaft_hz: float, *,
@@ -255,10 +246,9 @@ def compare_signals(model: np.ndarray, measured: np.ndarray, fs: float, shaft_hz
                 start = None
     # impulsiveness of the synchronous average over the pinion revolution
     angle = shaft_angle_from_speed(n, fs, shaft_hz)
-    _, tsa_p, _ = synchronous_average(measured, fs, angle, samples_per_rev=TSA_SAMPLES)
-    _, tsa_m, _ = synchronous_average(model, fs, angle, samples_per_rev=TSA_SAMPLES)
+    _, tsa_p, _ = synchronous_average(measured, fs, angle, samples_per_rev=512)
+    _, tsa_m, _ = synchronous_average(model, fs, angle, samples_per_rev=512)
     kp, km = float(kurtosis(tsa_p)), float(kurtosis(tsa_m))
-    impulsiveness = (fourth_moment_db(tsa_p), fourth_moment_db(tsa_m))
     if kp - km > 1.5 and kp > 1.0:
         findings.append(Finding("impulsive", f"impulsive once per pinion revolution (TSA kurtosis {kp:.1f} "
                                              f"measured vs {km:.1f} model)", float(shaft_hz), (0.0, float(f[-1])),
@@ -268,39 +258,7 @@ def compare_signals(model: np.ndarray, measured: np.ndarray, fs: float, shaft_hz
     f1 = waveform_mismatch(model, measured, fs, shaft_hz)
     f2 = spectrum_mismatch(model, measured, fs, fmin=fmin, fmax=fmax, resolution=resolution)
     return Comparison(lsd, f1, f2, float(np.sqrt(np.mean(measured ** 2))), float(np.sqrt(np.mean(model ** 2))),
-                      float(shaft_hz), tuple(findings), f, lp, lm, impulsiveness_db=impulsiveness)
-
-
-#: Angular samples per pinion revolution of the synchronous averages compared.
-TSA_SAMPLES = 512
-
-
-def fold_impulsiveness(distance_db: float, channels: int, measured_db: float, model_db: float) -> float:
-    """A distance over ``channels`` spectra [dB] (their RMS) with the synchronous average's
-    impulsiveness difference as one more channel: ``sqrt((channels d^2 + (measured - model)^2)
-    / (channels + 1))``."""
-    return float(math.sqrt((channels * distance_db ** 2 + (measured_db - model_db) ** 2) / (channels + 1)))
-
-
-def with_impulsiveness(comp: Comparison) -> Comparison:
-    """The comparison with the synchronous average's impulsiveness
-    (:func:`twin.signals.tsa.impulsiveness_db`) folded into its distance
-    (:func:`fold_impulsiveness`; one channel more than the casing, and the encoder when folded
-    in), the ``impulsive`` finding's share then its part of the squared distance, the other
-    findings' shares scaled to the rest. A record whose impulse once per revolution the model
-    lacks (a local tooth fault) differs there far more than its spectrum shows: a spectral
-    distance spreads it over many small sidebands. Unchanged when already folded."""
-    if comp.impulsiveness_db is None or comp.impulsiveness_folded:
-        return comp
-    k = 1 if comp.angular is None else 2
-    spectra = k * comp.lsd_db ** 2
-    d2 = (comp.impulsiveness_db[0] - comp.impulsiveness_db[1]) ** 2
-    total = spectra + d2
-    w = spectra / total if total > 0 else 1.0
-    findings = sorted((replace(fd, share=(d2 / total if total > 0 else 0.0)) if fd.kind == "impulsive"
-                       else replace(fd, share=fd.share * w) for fd in comp.findings), key=lambda x: -x.share)
-    return replace(comp, lsd_db=fold_impulsiveness(comp.lsd_db, k, *comp.impulsiveness_db),
-                   findings=tuple(findings), impulsiveness_folded=True)
+                      float(shaft_hz), tuple(findings), f, lp, lm)
 
 
 def _envelope_findings(model, measured, fs, shaft_hz, z1, z2, f, d2, used, total, discrepancy) -> list[Finding]:

@@ -83,29 +83,6 @@ def test_weak_tooth_is_impulsive_with_sidebands(gearbox_fmu, base):
     assert c.lsd_db > 3.0 and abs(sum(f.share for f in c.findings) - 1.0) < 0.5
 
 
-def test_an_impulse_the_model_lacks_weighs_as_a_channel_of_its_own(gearbox_fmu, base):
-    """A weak tooth's impulse once per revolution is folded into the distance as the synchronous
-    average's impulsiveness (one channel more than the spectrum): the distance rises beyond the
-    spectral one, the impulsive finding holds its part of it, the shares still sum as before."""
-    from twin.compare import fold_impulsiveness, with_impulsiveness
-    c = compare_signals(base, _noisy(_sim(gearbox_fmu, {"tooth_stiffness_factor[5]": 0.5})), 1e5, SHAFT)
-    measured_db, model_db = c.impulsiveness_db
-    assert measured_db > model_db + 1.0 and not c.impulsiveness_folded
-    f = with_impulsiveness(c)
-    assert f.impulsiveness_folded and with_impulsiveness(f) is f
-    assert f.lsd_db == pytest.approx(math.sqrt((c.lsd_db ** 2 + (measured_db - model_db) ** 2) / 2))
-    assert f.lsd_db == pytest.approx(fold_impulsiveness(c.lsd_db, 1, measured_db, model_db))
-    imp = next(fd for fd in f.findings if fd.kind == "impulsive")
-    assert imp.share == pytest.approx((measured_db - model_db) ** 2 / (2 * f.lsd_db ** 2))
-    rest = [fd.share for fd in f.findings if fd.kind != "impulsive"]
-    assert sum(rest) == pytest.approx(sum(fd.share for fd in c.findings if fd.kind != "impulsive")
-                                      * c.lsd_db ** 2 / (2 * f.lsd_db ** 2))
-    assert f.to_dict()["impulsiveness_db"]["folded_into_headline"] is True
-    # the same record against itself: no impulsiveness difference, the fold only dilutes
-    same = with_impulsiveness(compare_signals(base, _noisy(base), 1e5, SHAFT))
-    assert same.lsd_db < compare_signals(base, _noisy(base), 1e5, SHAFT).lsd_db
-
-
 def test_cli_writes_json_html_and_signals(gearbox_fmu, base, tmp_path):
     t = np.arange(base.size) / 1e5
     x = _noisy(base + 0.3 * np.std(base) * np.sin(2 * np.pi * 247.3 * t))

@@ -6,11 +6,6 @@ For one measured record:
    so that the model's pinion turns at the *measured* shaft speed (from the gear-mesh line),
    because a 1 % speed error moves the 10th mesh harmonic by several bins. Compare
    (:func:`twin.compare.compare_signals`): headline log-spectral distance (LSD, dB) and findings.
-   When the record is impulsive once per pinion revolution and the model is not (an
-   ``impulsive`` finding), the impulsiveness of the synchronous average (dB,
-   :func:`twin.signals.tsa.impulsiveness_db`) is one more channel of the distance that every
-   candidate is fitted, scored and held out on (:func:`twin.compare.with_impulsiveness`): a
-   spectrum spreads one tooth's impulse over many small sidebands.
 2. **Try every candidate.** In ``GearTwin.Variants.Gearbox21Candidates``, the base model with
    every catalogue effect switched off, turn one effect on and refit its few parameters by
    minimising the LSD. Starting values come from the physics of the measured spectrum: an
@@ -36,8 +31,7 @@ For one measured record:
    on (another steady record at its own operating point; the end of a run-up along its measured
    speed), and must still cut the LSD there (``HELD_OUT_DB``): this held-out test is the
    penalty for a candidate's added freedom. Its physical signature must not be absent from the
-   data (:mod:`twin.effects.signatures`: shaft-order sidebands for a run-out, an impulse once per
-   pinion revolution in every steady record for a local tooth fault, a band fixed in
+   data (:mod:`twin.effects.signatures`: shaft-order sidebands for a run-out, a band fixed in
    frequency across the run-up for a resonance, a fixed narrow line for a drive ripple). Two
    that earn their place and explain the same findings are a tie.
 
@@ -55,7 +49,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from twin.compare import Comparison, compare_signals, with_impulsiveness
+from twin.compare import Comparison, compare_signals
 from twin.effects.catalogue import CATALOGUE, Effect, effect as get_effect
 # the fit runs in the workers; its names stay importable from here
 from twin.effects.fit import (TrialSpec, _guarded_fit, _Objective, channels, fit_effect,  # noqa: F401
@@ -150,23 +144,12 @@ def compare_record(sim: np.ndarray, measured: np.ndarray, angle: np.ndarray | No
                                         discrepancy=getattr(discrepancy, "angle", None)))
 
 
-def impulse_folded(comp: Comparison) -> Comparison:
-    """The base model's comparison with the synchronous average's impulsiveness folded in
-    (:func:`twin.compare.with_impulsiveness`) when it holds the ``impulsive`` finding: a record
-    that strikes once per pinion revolution where the model does not spreads that impulse over
-    many small sidebands of its spectrum, so the impulsiveness is compared as a channel of its own
-    (and the candidates are fitted, scored and held out on it too). Unchanged otherwise."""
-    return with_impulsiveness(comp) if any(fd.kind == "impulsive" for fd in comp.findings) else comp
-
-
 def _candidate(eff: Effect, before: Comparison, fitted: dict, n_eval: int, sim: np.ndarray, measured: np.ndarray,
                op: Operating, z1: int, z2: int, discrepancy=None, angle: np.ndarray | None = None) -> Candidate:
     """Score a fitted candidate against the baseline comparison (``discrepancy``: the record's
     known model-form error, taken out of the compared levels as in ``before``; ``angle``: the
-    record's encoder angle, compared as in ``before``; the impulsiveness folded in as in ``before``)."""
+    record's encoder angle, compared as in ``before``)."""
     after = compare_record(sim, measured, angle, op.sample_rate, op.shaft_hz, z1, z2, discrepancy)
-    if before.impulsiveness_folded:
-        after = with_impulsiveness(after)
     score = max(0.0, (before.lsd_db - after.lsd_db) / before.lsd_db) if before.lsd_db > 0 else 0.0
     return Candidate(eff.id, eff.title, score, after.lsd_db, fitted, _explained(before, after, eff), after.findings,
                      n_eval)
@@ -332,8 +315,7 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
                                 slip_hz=op.drive_hz - op.shaft_hz, fit_load=op.load, executor=ex, progress=progress,
                                 encoder=encoder)
     known = discrepancy.get(fit_rec.name)
-    before = impulse_folded(compare_record(base_model, measured, fit_angle, sample_rate, shaft, z1, z2, known))
-    impulsive = before.impulsiveness_folded
+    before = compare_record(base_model, measured, fit_angle, sample_rate, shaft, z1, z2, known)
     if base_model.ndim == 2:
         base_model = base_model[:, 0]
 
@@ -352,7 +334,7 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
     guesses = starting_values(before, measured, base_model, sample_rate, shaft, z1, z2)
     short = dict(search_samples=int(round(search * sample_rate)) if search else None, search_step=search_step)
     specs = [TrialSpec(e, str(candidates_fmu), channel, measured, op, probe, guesses.get(e, {}), max_evals, **short,
-                       discrepancy=known, angle=fit_angle, impulsive=impulsive)
+                       discrepancy=known, angle=fit_angle)
              for e in ids]
     # the candidates with the most trials first, so that no worker is left with a long one at the end
     specs.sort(key=lambda sp: -_trials(CATALOGUE[sp.effect]))
@@ -375,8 +357,7 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
     lead = [c for c in cands[:related_leaders] if c.error is None and c.score > 0 and CATALOGUE[c.effect].related]
     specs2 = [TrialSpec(c.effect, str(candidates_fmu), channel, measured, op, probe, split_fitted(c.effect, c.fitted)[0],
                         max_evals, related=related_values(CATALOGUE[c.effect], probe, current), polish_only=True,
-                        related_anchor=dict(anchors or {}), **short, discrepancy=known, angle=fit_angle,
-                        impulsive=impulsive)
+                        related_anchor=dict(anchors or {}), **short, discrepancy=known, angle=fit_angle)
               for c in lead]
     for c, r in zip(lead, ex.map(_guarded_fit, specs2, progress=progress, desc="related base parameters")
                     if specs2 else ()):
@@ -411,10 +392,10 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
                                       discrepancy=discrepancy.get(r.name), angle=angle_of(r, m))))
         fitting = [c for c in cands if fits(before, c, min_cut, min_db)]
         # nothing to test when no candidate fits: the base model is not run on the held-out records
-        tasks = [HeldOutSpec(name, str(candidates_fmu), dict(probe), channel, solver_step=solver_step,
-                             impulsive=impulsive, **kw) for name, kw in held] if fitting else []
-        tasks += [HeldOutSpec(name, str(candidates_fmu), {**probe, **c.fitted}, channel, solver_step=solver_step,
-                              impulsive=impulsive, **kw) for c in fitting for name, kw in held]
+        tasks = [HeldOutSpec(name, str(candidates_fmu), dict(probe), channel, solver_step=solver_step, **kw)
+                 for name, kw in held] if fitting else []
+        tasks += [HeldOutSpec(name, str(candidates_fmu), {**probe, **c.fitted}, channel, solver_step=solver_step, **kw)
+                  for c in fitting for name, kw in held]
         out = ex.map(guarded_held_out, tasks, progress=progress, desc="held-out records") if tasks else []
         base_lsd = {name: out[i] for i, (name, _) in enumerate(held)} if fitting else {}
         bad = [f"{n}: {v}" for n, v in base_lsd.items() if isinstance(v, Exception)]
@@ -428,7 +409,7 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
         held_names = tuple(name for name, _ in held)
         shafts = {r.name: conds[r.name].operating.shaft_hz for r in steady}
         base_recs = None
-        if given is not None and not isinstance(given, Mapping):
+        if encoder and given is not None and not isinstance(given, Mapping):
             from twin.effects.baseline import pair
             base_recs = pair(recs, given)
         survey = survey_records(steady, runups[0] if runups else None, channel, z1, z2, shafts,
@@ -442,4 +423,4 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
     return Diagnosis(fit_rec.name, before.lsd_db, before.findings, tuple(cands), verdict, missing, unexplained, msg,
                      op, time.perf_counter() - t0, held_names, runup_name, tied,
                      tuple(sorted({d.record for d in discrepancy.values()})), encoder,
-                     tuple(sorted({n for d in discrepancy.values() for n in d.repeats})), impulsive)
+                     tuple(sorted({n for d in discrepancy.values() for n in d.repeats})))

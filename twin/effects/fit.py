@@ -47,9 +47,6 @@ class TrialSpec:
     discrepancy: object = None
     # the record's pinion encoder angle (n,) [rad], a second channel (twin.angular), or None
     angle: np.ndarray | None = field(default=None, repr=False)
-    # the record is impulsive once per pinion revolution where the base model is not: the
-    # synchronous average's impulsiveness is one more channel of the objective
-    impulsive: bool = False
 
     @property
     def channels(self) -> str | list[str]:
@@ -69,13 +66,10 @@ class _Objective:
     With the record's encoder ``angle`` (n,) [rad] the simulation is (n, 2), the casing channel
     and the model's encoder angle, and the objective is both channels' joint LSD
     (:func:`twin.angular.joint_lsd`); ``discrepancy.angle`` is the encoder's known model-form error.
-    With ``shaft_hz`` (the pinion speed [Hz], a constant or (n,) per sample) the impulsiveness of
-    the casing's synchronous average over the pinion revolution is one more channel
-    (:func:`twin.compare.fold_impulsiveness`).
     """
 
     def __init__(self, measured: np.ndarray, fs: float, fmin: float = 10.0, fmax: float = 5000.0,
-                 resolution: float = 2.0, discrepancy=None, angle: np.ndarray | None = None, shaft_hz=None):
+                 resolution: float = 2.0, discrepancy=None, angle: np.ndarray | None = None):
         from twin.signals import welch_psd
         self.fs, self.n = fs, measured.size
         self.resolution = max(resolution, 4.0 * fs / self.n)
@@ -90,11 +84,6 @@ class _Objective:
             from twin.angular import AngularObjective
             self.angular = AngularObjective(np.asarray(angle, float)[-self.n:], fs, self.resolution,
                                             getattr(discrepancy, "angle", None))
-        self.shaft_hz = None
-        if shaft_hz is not None:
-            from twin.signals.tsa import impulsiveness_db
-            self.shaft_hz = shaft_hz if np.ndim(shaft_hz) == 0 else np.asarray(shaft_hz, float)[-self.n:]
-            self.impulsiveness = impulsiveness_db(measured, fs, self.shaft_hz)
 
     def __call__(self, simulated: np.ndarray) -> float:
         from twin.angular import joint_lsd
@@ -105,14 +94,9 @@ class _Objective:
         _, pm = welch_psd(casing[: self.n], self.fs, resolution=self.resolution)
         lp, lm, _ = spectral_levels(pm[self.band], self.pp)
         lsd = float(np.sqrt(np.mean((lp - self.offset - lm) ** 2)))
-        if self.angular is not None:
-            lsd = joint_lsd(lsd, self.angular(simulated[:, 1]))
-        if self.shaft_hz is None:
+        if self.angular is None:
             return lsd
-        from twin.compare import fold_impulsiveness
-        from twin.signals.tsa import impulsiveness_db
-        return fold_impulsiveness(lsd, 1 if self.angular is None else 2, self.impulsiveness,
-                                  impulsiveness_db(casing[: self.n], self.fs, self.shaft_hz))
+        return joint_lsd(lsd, self.angular(simulated[:, 1]))
 
 
 def simulate(fmu_path, parameters: Mapping[str, float], op: Operating, n: int, channel, *,
@@ -125,8 +109,7 @@ def simulate(fmu_path, parameters: Mapping[str, float], op: Operating, n: int, c
 def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int, np.ndarray]:
     """Fit one effect's parameters, then (with ``spec.related``) them and the related base ones.
 
-    1. amplitude-like parameters on a coarse grid, then Brent, one after the other, and each later
-       one alone; the best of these starts 2.;
+    1. amplitude-like parameters on a coarse grid, then Brent;
     2. all effect parameters together (Nelder-Mead);
     3. the effect parameters and the related base parameters together (Nelder-Mead, the base
        ones within +-``RELATED_SPAN`` of their calibrated values), kept only if it lowers the LSD.
@@ -147,8 +130,7 @@ def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int, np.ndarra
         op = replace(op, solver_step=spec.search_step)
     short = n_search < n or op != spec.operating        # search on a shorter or coarser run, score on the whole
     objective = _Objective(spec.measured[-n_search:], spec.operating.sample_rate, discrepancy=spec.discrepancy,
-                           angle=None if spec.angle is None else spec.angle[-n_search:],
-                           shaft_hz=spec.operating.shaft_hz if spec.impulsive else None)
+                           angle=None if spec.angle is None else spec.angle[-n_search:])
     fixed = dict(spec.parameters)
     params = list(eff.fit)
     free = [p for p in params if p.guess is None]
@@ -187,28 +169,16 @@ def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int, np.ndarra
     values = {p.name: start(p) for p in params} if spec.polish_only else \
         {p.name: start(p) for p in params if p.guess is not None}
     if not spec.polish_only:
-        def sweep(p: FitParameter, held: dict) -> dict:
-            """``held`` with ``p`` at the best of a coarse grid, polished by Brent."""
+        # 1) amplitude-like parameters on a coarse grid with the guessed ones held, then Brent
+        for p in free:
             grid = np.linspace(0.0, 1.0, p.grid)
-            scores = [lsd({**held, p.name: from_x(p, z)}) for z in grid]
+            scores = [lsd({**values, p.name: from_x(p, z)}) for z in grid]
             j = int(np.argmin(scores))
             lo, hi = grid[max(j - 1, 0)], grid[min(j + 1, grid.size - 1)]
-            res = minimize_scalar(lambda z: lsd({**held, p.name: from_x(p, z)}), bounds=(lo, hi),
+            res = minimize_scalar(lambda z: lsd({**values, p.name: from_x(p, z)}), bounds=(lo, hi),
                                   method="bounded", options={"xatol": 0.01, "maxiter": 8})
-            return {**held, p.name: from_x(p, res.x if res.fun < scores[j] else grid[j])}
-
-        # 1) amplitude-like parameters on a coarse grid with the guessed ones held, then Brent, one
-        # after the other; and each later one alone, since two parameters may each give what the
-        # record shows (a tooth's stiffness loss and its spall both strike once a turn) and the one
-        # searched first would otherwise take it all: the joint polish starts from the best of these
-        held = {**{p.name: float(eff.neutral.get(p.name, p.lower)) for p in free}, **values}
-        values = dict(held)
-        starts = []
-        for p in free:
-            values = sweep(p, values)
-            starts.append(values)
-        starts += [sweep(p, held) for p in free[1:]]
-        values = min(starts, key=lsd) if starts else values
+            best_z = res.x if res.fun < scores[j] else grid[j]
+            values[p.name] = from_x(p, best_z)
         # 2) all parameters together (frequency-like ones move within +-5 % of their range)
         if len(params) > 1 and count < spec.max_evals:
             z0 = np.array([to_x(p, values[p.name]) for p in params])
@@ -252,7 +222,7 @@ def fit_effect(spec: TrialSpec) -> tuple[dict[str, float], float, int, np.ndarra
         try:
             sim = simulate(spec.fmu_path, {**fixed, **fitted}, spec.operating, n, spec.channels)
             val = _Objective(spec.measured, spec.operating.sample_rate, discrepancy=spec.discrepancy,
-                             angle=spec.angle, shaft_hz=spec.operating.shaft_hz if spec.impulsive else None)(sim)
+                             angle=spec.angle)(sim)
         except Exception:  # a fit that diverges on the whole stretch scores badly, as in the search
             sim, val = None, 1e3
     return fitted, val, count, sim

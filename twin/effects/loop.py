@@ -226,8 +226,7 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
 
     from twin._atomic import atomic_path
     from twin.calibration.problem import write_parameter_set
-    from twin.compare import with_impulsiveness
-    from twin.effects.diagnose import compare_record, impulse_folded, starting_values, uses_encoder
+    from twin.effects.diagnose import compare_record, starting_values, uses_encoder
     from twin.effects.fit import channels
     from twin.effects.records import as_records, read_records
     from twin.effects.verdict import finding_error
@@ -263,7 +262,7 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
     # carry the active effects' values into the new variant so it reproduces the current model
     values = {k: v for k, v in current.items() if any(k.startswith(a + ".") for a in active)}
     sim0 = require_running(simulate(current_fmu, base_params, op, measured.size, channels(channel, angle)), rec.name, op)
-    before = impulse_folded(compare_record(sim0, measured, angle, rec.sample_rate, shaft, z1, z2, known))
+    before = compare_record(sim0, measured, angle, rec.sample_rate, shaft, z1, z2, known)
     if sim0.ndim == 2:
         sim0 = sim0[:, 0]
     anchors, now = related_anchors(scenario, eff, base_params, current)
@@ -279,8 +278,7 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
                                         _REPO_MODELICA.parent / "build", cond.structural)
         probe = {**base_params, **values, **neutral_values(active)}
         spec = TrialSpec(effect_id, str(candidates_fmu), channel, measured, op, probe, guesses, max_evals,
-                         related=now, related_anchor=anchors, discrepancy=known, angle=angle,
-                         impulsive=before.impulsiveness_folded)
+                         related=now, related_anchor=anchors, discrepancy=known, angle=angle)
         fitted, _, _, _ = fit_effect(spec)
     else:
         fitted = {**{eff.parameter(k): float(v) for k, v in guesses.items()},
@@ -297,8 +295,6 @@ def add_effect(scenario, measurements, effect_id: str, out_dir, *, record: str |
     fmu_path = build_like(model, modelica_dir, build_dir, cond.structural)
     sim1 = simulate(fmu_path, base_params, op, measured.size, channels(channel, angle))
     after = compare_record(sim1, measured, angle, rec.sample_rate, shaft, z1, z2, known)
-    if before.impulsiveness_folded:
-        after = with_impulsiveness(after)
     per = tuple((f.description, finding_error(before, f), finding_error(after, f)) for f in before.findings)
     # 3) a scenario for the variant, so the next step (or twin run) starts from it; the model name
     # resolves through the repository's modelica/, a variant written elsewhere by its FMU file

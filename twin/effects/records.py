@@ -232,20 +232,14 @@ class HeldOutSpec:
     solver_step: float | None = 1e-5
     discrepancy: object = None          # the record's known model-form error (twin.effects.baseline)
     angle: np.ndarray | None = field(default=None, repr=False)   # (n,) encoder angle [rad]: a second channel
-    impulsive: bool = False             # the synchronous average's impulsiveness one more channel (twin.effects.fit)
 
 
 def held_out_lsd(spec: HeldOutSpec) -> float:
     """LSD [dB] of the model run against the held-out stretch (the diagnosis's fit objective:
-    both channels' joint LSD when the stretch has an encoder ``angle``, the synchronous average's
-    impulsiveness folded in when ``impulsive``, along the stretch's own speed)."""
+    both channels' joint LSD when the stretch has an encoder ``angle``)."""
     from twin.effects.fit import _Objective, channels
     from twin.operating import simulate_at
-    speed = None
-    if spec.impulsive:
-        speed = spec.shaft_hz if spec.shaft_hz is not None else spec.operating.shaft_hz
-    objective = _Objective(spec.measured, spec.sample_rate, discrepancy=spec.discrepancy, angle=spec.angle,
-                           shaft_hz=speed)
+    objective = _Objective(spec.measured, spec.sample_rate, discrepancy=spec.discrepancy, angle=spec.angle)
     names = channels(spec.channel, spec.angle)
     if spec.shaft_hz is not None:
         sim = simulate_runup(spec.fmu_path, spec.parameters, spec.shaft_hz, spec.load, spec.sample_rate,

@@ -10,12 +10,7 @@ Each catalogue effect leaves a signature that a run-up separates from others:
 * a **resonance** (``housing_mode``) is a band fixed in frequency across the run-up, excited by
   broadband content: a mode of the run-up analysis near the fitted frequency;
 * a **drive ripple** (``motor_torque_ripple``) is a narrow line fixed in frequency across the
-  run-up, not a hump: a fixed line of the run-up analysis at the fitted frequency;
-* a **local tooth fault** (``local_tooth_damage``) strikes once per pinion revolution: the
-  synchronous average over the pinion revolution is impulsive (its fourth moment,
-  :func:`twin.signals.tsa.impulsiveness_db`) in every steady record, risen by
-  :data:`IMPULSE_RISE_DB` since the baseline record, or :data:`IMPULSE_DB` above a Gaussian's
-  without one (McFadden's FM4). Either this or the pinion's sideband test is enough.
+  run-up, not a hump: a fixed line of the run-up analysis at the fitted frequency.
 
 With a pinion encoder (:mod:`twin.angular`) a run-out has a second signature: below the first
 torsional mode the shafts turn to follow it, so the encoder's angular vibration carries a line at
@@ -54,12 +49,6 @@ FREQ_TOL = 0.02
 #: Rise [dB] of the encoder's line at a shaft's speed since the baseline record that counts as a
 #: run-out's signature (the compare's line threshold).
 ENCODER_RISE_DB = 6.0
-#: Rise [dB] of the impulsiveness of a steady record's synchronous average since its baseline
-#: record that counts as a local tooth fault's impulse (a kurtosis up from 0 to 1.5, the
-#: compare's ``impulsive`` threshold).
-IMPULSE_RISE_DB = 1.8
-#: The same without a baseline record: the fourth moment twice a Gaussian's (kurtosis 3).
-IMPULSE_DB = 3.0
 
 
 @dataclass(frozen=True)
@@ -86,10 +75,6 @@ class Survey:
     # the local median of its spectrum ("median")
     encoder_lines: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
     encoder_basis: str = ""
-    # per steady record, the impulsiveness of its synchronous average over the pinion revolution
-    # [dB], risen since its baseline record (impulse_basis "baseline") or against a Gaussian's
-    impulsiveness: Mapping[str, float] = field(default_factory=dict)
-    impulse_basis: str = ""
 
 
 def steady_sidebands(x: np.ndarray, fs: float, shaft_hz: float, z1: int, z2: int, n_harmonics: int = 10
@@ -131,20 +116,11 @@ def encoder_line(angle: np.ndarray, fs: float, shaft_hz: float, spacing_hz: floa
 def survey_records(fit: Sequence, runup, channel: str, z1: int, z2: int, shaft_hz: Mapping[str, float], *,
                    encoder: bool = False, baseline: Mapping | None = None) -> Survey:
     """The :class:`Survey` of the steady records ``fit`` (their measured pinion speeds in
-    ``shaft_hz`` by name) and of a run-up record (or None). The steady records' impulsiveness is
-    read against ``baseline`` (record name -> its baseline record) when given; with ``encoder``
-    their encoder lines too."""
+    ``shaft_hz`` by name) and of a run-up record (or None). With ``encoder`` the steady records'
+    encoder lines are read too, against ``baseline`` (record name -> its baseline record) when
+    given."""
     from twin.modes import MIN_CONFIDENCE, survey_record
-    from twin.signals.tsa import impulsiveness_db
     steady = {r.name: steady_sidebands(r.signal, r.sample_rate, shaft_hz[r.name], z1, z2) for r in fit}
-    impulse = {}
-    for r in fit:
-        b = baseline.get(r.name) if baseline else None
-        impulse[r.name] = impulsiveness_db(r.signal, r.sample_rate, shaft_hz[r.name])
-        if b is not None:
-            speed = float(np.median(b.shaft_hz)) if b.shaft_hz is not None else shaft_hz[r.name]
-            impulse[r.name] -= impulsiveness_db(b.signal[-r.signal.size:], b.sample_rate, speed)
-    impulse_basis = "baseline" if baseline else "gaussian"
     lines: dict[str, dict[str, float]] = {}
     basis = ""
     if encoder:
@@ -164,12 +140,11 @@ def survey_records(fit: Sequence, runup, channel: str, z1: int, z2: int, shaft_h
                     out[name] = float(20 * np.log10(max(amp, 1e-30) / max(med, 1e-30)))
             lines[r.name] = out
     if runup is None or runup.raw is None:
-        return Survey(None, steady_sidebands=steady, z1=z1, z2=z2, encoder_lines=lines, encoder_basis=basis,
-                      impulsiveness=impulse, impulse_basis=impulse_basis)
+        return Survey(None, steady_sidebands=steady, z1=z1, z2=z2, encoder_lines=lines, encoder_basis=basis)
     s = survey_record(runup.raw, channels=[channel])
     modes = tuple((m.frequency, m.damping) for m in s.modes if m.confidence >= MIN_CONFIDENCE)
     return Survey(runup.name, tuple(ln.frequency for ln in s.lines), modes, tuple(o.order for o in s.orders),
-                  float(s.resolution), steady, z1, z2, lines, basis, impulse, impulse_basis)
+                  float(s.resolution), steady, z1, z2, lines, basis)
 
 
 def _locked_sidebands(orders: Sequence[float], z1: int, spacing: float, max_order: float) -> int:
@@ -206,14 +181,6 @@ def signature(effect_id: str, fitted: Mapping[str, float], survey: Survey | None
             text += ("; the encoder's line at the " + shaft + " speed "
                      + ", ".join(f"{v:+.1f} dB" for v in rise.values())
                      + (" since the baseline" if survey.encoder_basis == "baseline" else " above its surroundings")
-                     + (" (present)" if seen else ""))
-            ok = ok or seen
-        if effect_id == "local_tooth_damage" and survey.impulsiveness:
-            need = IMPULSE_RISE_DB if survey.impulse_basis == "baseline" else IMPULSE_DB
-            seen = all(v >= need for v in survey.impulsiveness.values())
-            text += ("; the synchronous average's impulsiveness "
-                     + ", ".join(f"{v:+.1f} dB" for v in survey.impulsiveness.values())
-                     + (" since the baseline" if survey.impulse_basis == "baseline" else " against a Gaussian's")
                      + (" (present)" if seen else ""))
             ok = ok or seen
         return ok, text

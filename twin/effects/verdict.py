@@ -78,12 +78,11 @@ class Diagnosis:
     baseline: tuple[str, ...] = ()           # baseline records whose model discrepancy was taken out
     encoder: bool = False                    # the pinion encoder compared too: lsd_db is the two channels' RMS
     baseline_repeats: tuple[str, ...] = ()   # baseline records whose scatter raised the line threshold
-    impulsiveness: bool = False              # the synchronous average's impulsiveness folded into lsd_db
 
     def to_dict(self) -> dict:
         return {"record": self.record, "held_out_records": list(self.held_out_records), "runup": self.runup,
                 "baseline": list(self.baseline), "baseline_repeats": list(self.baseline_repeats),
-                "encoder": self.encoder, "impulsiveness": self.impulsiveness, "verdict": self.verdict, "missing": self.missing, "tied": list(self.tied),
+                "encoder": self.encoder, "verdict": self.verdict, "missing": self.missing, "tied": list(self.tied),
                 "message": self.message, "headline": {"log_spectral_distance_db": self.lsd_db},
                 "operating": asdict(self.operating),
                 "findings": [asdict(f) for f in self.findings],
@@ -101,8 +100,6 @@ class Diagnosis:
         """Plain-text ranking for the terminal."""
         rows = [f"baseline log-spectral distance {self.lsd_db:.2f} dB on {self.record}"
                 + (" (casing and encoder, RMS of the two)" if self.encoder else "")
-                + (", the synchronous average's impulsiveness folded in as one more channel" if self.impulsiveness
-                   else "")
                 + f", {len(self.findings)} findings"
                 + (f"; held out: {', '.join(self.held_out_records)}" if self.held_out_records else "")
                 + (f"; the model's discrepancy on baseline {', '.join(self.baseline)} taken out" if self.baseline

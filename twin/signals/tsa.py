@@ -292,22 +292,3 @@ def order_spectrum(x, fs: float, shaft_angle, *, samples_per_rev: int, max_order
     orders, amplitude = amplitude_spectrum(x_angle, spr, window=window)
     keep = orders <= max_order * (1 + 1e-12)
     return orders[keep], amplitude[keep]
-
-
-def fourth_moment_db(tsa) -> float:
-    """Impulsiveness of a synchronous average (n,) [dB]: its normalised fourth moment m4 / m2^2
-    against a Gaussian's 3 (McFadden's FM4 as a level), ``10 log10((kurtosis + 3) / 3)``: 0 dB for
-    a Gaussian revolution, +4.9 dB at a kurtosis of 6 (one tooth's impact per revolution)."""
-    d = np.asarray(tsa, float) - float(np.mean(tsa))
-    m2 = float(np.mean(d ** 2))
-    if not m2 > 0:
-        return 0.0
-    return float(10 * np.log10(float(np.mean(d ** 4)) / m2 ** 2 / 3.0))
-
-
-def impulsiveness_db(x, fs: float, shaft_hz, samples_per_rev: int = 512) -> float:
-    """:func:`fourth_moment_db` of the synchronous average of ``x`` (n,) over the revolution of a
-    shaft turning at ``shaft_hz`` [Hz] (a constant, or (n,) per sample along a run-up)."""
-    x = np.asarray(x, float)
-    _, tsa, _ = synchronous_average(x, fs, shaft_angle_from_speed(x.size, fs, shaft_hz), samples_per_rev)
-    return fourth_moment_db(tsa)

@@ -143,19 +143,3 @@ def test_errors_name_the_bad_input():
         shaft_angle_from_speed(N, FS, -SPEED)
     with pytest.raises(SignalError, match="whole revolution"):
         angular_resample(np.zeros(100), FS, np.linspace(0.1, 1.0, 100), SPR)
-
-
-def test_the_fourth_moment_level_is_zero_for_gaussian_content_and_rises_with_one_impact_per_turn():
-    """FM4 as a level: 10 log10((kurtosis + 3) / 3); a sine -3.01 dB, Gaussian content 0 dB, one
-    impact per revolution well above; along a run-up the angle comes from the speed per sample."""
-    from twin.signals.tsa import fourth_moment_db, impulsiveness_db
-    assert fourth_moment_db(np.sin(2 * np.pi * np.arange(512) / 512)) == pytest.approx(10 * np.log10(0.5), abs=1e-6)
-    g = np.random.default_rng(0).standard_normal(200_000)
-    assert abs(fourth_moment_db(g)) < 0.1
-    assert fourth_moment_db(np.zeros(8)) == 0.0
-    fs = 10_000.0
-    speed = np.linspace(10.0, 20.0, int(4 * fs))
-    angle = 2 * np.pi * np.cumsum(speed) / fs
-    x = np.sin(19 * angle)
-    struck = x + 10.0 * np.exp(-((np.mod(angle, 2 * np.pi) - 1.0) / 0.02) ** 2)
-    assert impulsiveness_db(x, fs, speed) < 0.0 < 4.0 < impulsiveness_db(struck, fs, speed)
