@@ -75,6 +75,56 @@ def test_repeated_impacts_locked_to_neither_shaft_are_an_envelope_finding(base, 
                 if f.kind == "envelope_line"]
 
 
+def test_a_weaker_series_counts_when_a_run_up_holds_it_at_the_same_order(base):
+    """Ring-downs whose series stands 15 dB (under the 18 dB one record is held to) are a finding
+    only when a run-up's envelope holds a series at the same order."""
+    from twin.signals.envelope import EnvelopeSeries
+
+    rng = np.random.default_rng(1)
+    ring = np.exp(-np.arange(300) / 40.0) * np.sin(2 * np.pi * 12000.0 * np.arange(300) / 1e5)
+    hits = np.zeros(base.size)
+    t = 0.0
+    while (i := int((t := t + (1 + 0.01 * rng.standard_normal()) / (3.585 * SHAFT)) * 1e5)) + 300 < base.size:
+        hits[i:i + 300] += 0.25 * np.std(base) * ring
+    measured = _noisy(base + hits)
+
+    def envelope(runup_orders):
+        series = tuple(EnvelopeSeries(o * SHAFT, o, 4, 20.0, (8000.0, 16000.0), None, 0.006) for o in runup_orders)
+        return [f for f in compare_signals(base, measured, 1e5, SHAFT, runup_series=series).findings
+                if f.kind == "envelope_line"]
+    assert envelope(()) == [] and envelope((3.70,)) == []
+    found = envelope((3.587,))
+    assert len(found) == 1 and 12.0 <= found[0].size_db < 18.0
+    assert found[0].order == pytest.approx(3.585, abs=0.01) and "through the run-up" in found[0].description
+
+
+def test_a_series_is_taken_out_only_by_one_at_the_same_order_within_the_location_tolerance(base):
+    """The baseline's envelope held a series 1.5 % away (the gear's 10th order sits 1.9 % from a
+    6205 outer race's 3.586x): other impacts, so the record's series is still a finding; at the
+    same order it is the gearbox's own and taken out."""
+    rng = np.random.default_rng(2)
+    ring = np.exp(-np.arange(300) / 40.0) * np.sin(2 * np.pi * 12000.0 * np.arange(300) / 1e5)
+    hits = np.zeros(base.size)
+    t = 0.0
+    while (i := int((t := t + (1 + 0.01 * rng.standard_normal()) / (3.585 * SHAFT)) * 1e5)) + 300 < base.size:
+        hits[i:i + 300] += 0.5 * np.std(base) * ring
+    record = _noisy(base + hits)
+
+    def baseline(order):
+        class Baseline:
+            envelope_orders = (order,)
+
+            @staticmethod
+            def at(f):
+                return np.zeros(np.size(f))
+        return Baseline
+    near = [f for f in compare_signals(base, record, 1e5, SHAFT, discrepancy=baseline(3.585 * 1.015)).findings
+            if f.kind == "envelope_line"]
+    assert len(near) == 1 and near[0].order == pytest.approx(3.585, abs=0.01)
+    assert not [f for f in compare_signals(base, record, 1e5, SHAFT, discrepancy=baseline(3.59)).findings
+                if f.kind == "envelope_line"]
+
+
 def test_weak_tooth_is_impulsive_with_sidebands(gearbox_fmu, base):
     c = compare_signals(base, _noisy(_sim(gearbox_fmu, {"tooth_stiffness_factor[5]": 0.5})), 1e5, SHAFT)
     kinds = [f.kind for f in c.findings]
