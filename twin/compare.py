@@ -113,14 +113,12 @@ def compare_signals(model: np.ndarray, measured: np.ndarray, fs: float, shaft_hz
                     z1: int = 19, z2: int = 52, fmin: float = 10.0, fmax: float = 5000.0,
                     resolution: float = 2.0, line_db: float = 6.0, resonance_db: float = 6.0,
                     max_shaft_order: int = 4, n_harmonics: int | None = None, n_sidebands: int = 3,
-                    discrepancy=None, runup_series=()) -> Comparison:
+                    discrepancy=None) -> Comparison:
     """Compare a simulated and a measured signal (both (n,), same ``fs`` [Hz]) of the same operating point.
 
     ``discrepancy``: a known model-form error taken out of the measured levels first (an object
     with ``at(frequencies) -> dB``, :class:`twin.effects.baseline.Discrepancy`): the distance and
-    the findings are then of what differs beyond it. ``runup_series``: the envelope series of a
-    run-up of the same gearbox (:func:`twin.signals.envelope.order_envelope_series`), which
-    confirm weaker series in this record's envelope (:func:`_envelope_findings`).
+    the findings are then of what differs beyond it.
 
     ``shaft_hz`` is the pinion (input shaft) speed [Hz]; the gear turns at shaft_hz * z1 / z2.
     ``n_harmonics`` defaults to every mesh harmonic in the band: a resonance in the transfer path
@@ -255,8 +253,7 @@ def compare_signals(model: np.ndarray, measured: np.ndarray, fs: float, shaft_hz
         findings.append(Finding("impulsive", f"impulsive once per pinion revolution (TSA kurtosis {kp:.1f} "
                                              f"measured vs {km:.1f} model)", float(shaft_hz), (0.0, float(f[-1])),
                                 kp - km, float(np.sum(d2[~used]) / total), 1.0))
-    findings.extend(_envelope_findings(model, measured, fs, shaft_hz, z1, z2, f, d2, used, total, discrepancy,
-                                       runup_series))
+    findings.extend(_envelope_findings(model, measured, fs, shaft_hz, z1, z2, f, d2, used, total, discrepancy))
     findings.sort(key=lambda x: -x.share)
     f1 = waveform_mismatch(model, measured, fs, shaft_hz)
     f2 = spectrum_mismatch(model, measured, fs, fmin=fmin, fmax=fmax, resolution=resolution)
@@ -264,47 +261,32 @@ def compare_signals(model: np.ndarray, measured: np.ndarray, fs: float, shaft_hz
                       float(shaft_hz), tuple(findings), f, lp, lm)
 
 
-def _envelope_findings(model, measured, fs, shaft_hz, z1, z2, f, d2, used, total, discrepancy,
-                       runup_series=()) -> list[Finding]:
+def _envelope_findings(model, measured, fs, shaft_hz, z1, z2, f, d2, used, total, discrepancy) -> list[Finding]:
     """Harmonic series in the measured record's envelope, locked to neither shaft, that neither
-    the model's envelope nor the baseline's (``discrepancy.envelope_orders``) holds (a series
-    locked to neither shaft within twice the record's location tolerance): repeated
+    the model's envelope nor the baseline's (``discrepancy.envelope_orders``) holds: repeated
     impacts not synchronous with the gears, as a rolling-element bearing defect gives
-    (:mod:`twin.signals.envelope`). A series counts when its fundamental stands
-    :data:`~twin.signals.envelope.SERIES_DB` out, or :data:`~twin.signals.envelope.CONFIRMED_DB`
-    when a run-up of the gearbox holds a series at the same order (``runup_series``, within both
-    spectra's location tolerances: a fixed order through a sweep is locked to a shaft, where a
-    line fixed in frequency smears).
-    ``share``: of the squared level difference in the demodulated band's bins not already
-    explained by another finding (0 when it lies above the compared band); the verdict
-    (:func:`twin.effects.verdict.judge`) counts such a finding whatever its share."""
-    from twin.signals.envelope import CONFIRMED_DB, SERIES_DB, envelope_series
+    (:mod:`twin.signals.envelope`). ``share``: of the squared level difference in the
+    demodulated band's bins not already explained by another finding (0 when it lies above the
+    compared band); the verdict (:func:`twin.effects.verdict.judge`) counts such a finding
+    whatever its share."""
+    from twin.signals.envelope import envelope_series
 
     ratio = z1 / z2
-    measured_series = [s for s in envelope_series(measured, fs, shaft_hz, gear_ratio=ratio, min_db=CONFIRMED_DB)
-                       if s.locked_to is None]
+    measured_series = [s for s in envelope_series(measured, fs, shaft_hz, gear_ratio=ratio) if s.locked_to is None]
     if not measured_series:
         return []
-    # what the model's envelope or the baseline's holds is no change: the same impacts are a series
-    # locked to neither shaft at the same order, within both spectra's location tolerances (a
-    # series locked to a shaft is gear content, whatever order it sits near)
-    known = [m.order for m in envelope_series(model, fs, shaft_hz, gear_ratio=ratio, min_db=CONFIRMED_DB)
-             if m.locked_to is None]
+    known = [s.order for s in envelope_series(model, fs, shaft_hz, gear_ratio=ratio)]
     known += list(getattr(discrepancy, "envelope_orders", ()) or ())
     out = []
     for s in measured_series:
-        if any(abs(s.order - o) <= 2 * s.order_tol for o in known):
-            continue
-        confirmed = [r.order for r in runup_series if s.confirms(r)]
-        if s.prominence_db < SERIES_DB and not confirmed:
+        if any(abs(s.order - o) <= 0.02 * max(s.order, 1.0) for o in known):
             continue
         sel = (f >= s.band_hz[0]) & (f <= s.band_hz[1]) & ~used
-        runup = f" and at {confirmed[0]:.2f}x through the run-up" if confirmed else ""
         out.append(Finding("envelope_line",
                            f"a modulation at {s.frequency_hz:.1f} Hz ({s.order:.2f}x pinion speed, locked to neither "
                            f"shaft) with {s.harmonics} harmonics, {s.prominence_db:+.0f} dB in the envelope of "
-                           f"{s.band_hz[0]:.0f}-{s.band_hz[1]:.0f} Hz{runup}: repeated impacts not synchronous with "
-                           "the gears, as a rolling-element bearing defect gives", s.frequency_hz, s.band_hz,
+                           f"{s.band_hz[0]:.0f}-{s.band_hz[1]:.0f} Hz: repeated impacts not synchronous with the "
+                           "gears, as a rolling-element bearing defect gives", s.frequency_hz, s.band_hz,
                            s.prominence_db, float(np.sum(d2[sel]) / total), s.order))
     return out
 

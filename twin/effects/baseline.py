@@ -69,8 +69,8 @@ class Discrepancy:
     level_db: np.ndarray = field(repr=False)
     # the encoder channel's (twin.angular.AngularDiscrepancy), when both records have an encoder
     angle: object = field(default=None, repr=False)
-    # fundamentals [pinion orders] of the harmonic series locked to neither shaft in the baseline's
-    # envelope (twin.signals.envelope): repeated impacts the gearbox had when calibrated are not a change
+    # fundamentals [pinion orders] of the harmonic series in the baseline's envelope
+    # (twin.signals.envelope): repeated impacts the gearbox had when calibrated are not a change
     envelope_orders: tuple[float, ...] = ()
     # (m,) [dB] how far repeated baseline records of the same operating point differ at each bin
     # (largest over the repeats; None with one baseline record): a line changed by no more than
@@ -156,11 +156,8 @@ def learn(spec: DiscrepancySpec) -> Discrepancy:
             angle = replace(angle, scatter_db=angle_scatter)
     envelope = ()
     if spec.shaft_hz is None and spec.baseline_hz > 0:      # a run-up's stretch smears its series
-        # at the weaker level a run-up may confirm (twin.compare): a series the gearbox had when
-        # calibrated is not a change, however strong
-        from twin.signals.envelope import CONFIRMED_DB, envelope_series
-        envelope = tuple(s.order for s in envelope_series(spec.measured, spec.sample_rate, spec.baseline_hz,
-                                                          min_db=CONFIRMED_DB) if s.locked_to is None)
+        from twin.signals.envelope import envelope_series
+        envelope = tuple(s.order for s in envelope_series(spec.measured, spec.sample_rate, spec.baseline_hz))
     return Discrepancy(spec.record, f, np.clip(level, -MAX_DB, MAX_DB), angle, envelope, scatter,
                        tuple(spec.repeat_names) if spec.repeats else ())
 

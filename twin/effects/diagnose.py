@@ -132,35 +132,16 @@ def _trials(eff: Effect) -> int:
 
 
 def compare_record(sim: np.ndarray, measured: np.ndarray, angle: np.ndarray | None, fs: float, shaft_hz: float,
-                   z1: int, z2: int, discrepancy=None, runup_series=()) -> Comparison:
+                   z1: int, z2: int, discrepancy=None) -> Comparison:
     """The casing channel's comparison (``sim`` (n,) or its first column), with the encoder's
-    folded in when the record has an ``angle`` (n,) [rad] and ``sim`` is (n, 2) (:func:`twin.angular.joint`);
-    ``runup_series`` the run-ups' envelope series (:func:`runup_envelope_series`)."""
+    folded in when the record has an ``angle`` (n,) [rad] and ``sim`` is (n, 2) (:func:`twin.angular.joint`)."""
     from twin.angular import compare_angles, joint
     casing = compare_signals(sim[:, 0] if sim.ndim == 2 else sim, measured, fs, shaft_hz, z1=z1, z2=z2,
-                             discrepancy=discrepancy, runup_series=runup_series)
+                             discrepancy=discrepancy)
     if angle is None:
         return casing
     return joint(casing, compare_angles(sim[:, 1], angle, fs, shaft_hz, z1=z1, z2=z2,
                                         discrepancy=getattr(discrepancy, "angle", None)))
-
-
-def runup_envelope_series(runups, z1: int, z2: int) -> tuple:
-    """The envelope series (:class:`twin.signals.envelope.EnvelopeSeries`, in pinion orders) of
-    each run-up record with a speed per sample; a run-up too short for an order spectrum gives
-    none."""
-    from twin.signals import SignalError
-    from twin.signals.envelope import order_envelope_series
-
-    out = []
-    for r in runups:
-        if r.shaft_hz is None:
-            continue
-        try:
-            out.extend(order_envelope_series(r.signal, r.sample_rate, r.shaft_hz, gear_ratio=z1 / z2))
-        except SignalError:
-            continue
-    return tuple(out)
 
 
 def _candidate(eff: Effect, before: Comparison, fitted: dict, n_eval: int, sim: np.ndarray, measured: np.ndarray,
@@ -334,9 +315,7 @@ def diagnose(fmu_path, measured, sample_rate: float | None = None, nominal_speed
                                 slip_hz=op.drive_hz - op.shaft_hz, fit_load=op.load, executor=ex, progress=progress,
                                 encoder=encoder)
     known = discrepancy.get(fit_rec.name)
-    # a weaker envelope series counts when a run-up holds it at the same order
-    before = compare_record(base_model, measured, fit_angle, sample_rate, shaft, z1, z2, known,
-                            runup_envelope_series(runups, z1, z2))
+    before = compare_record(base_model, measured, fit_angle, sample_rate, shaft, z1, z2, known)
     if base_model.ndim == 2:
         base_model = base_model[:, 0]
 

@@ -177,23 +177,3 @@ def test_the_records_own_speed_beats_a_sideband_taken_for_the_mesh_line(gearbox_
     assert kept.operating.shaft_hz == pytest.approx(shaft, rel=1e-9)
     with pytest.raises(MeasurementError, match="pinion speed is 0 Hz"):
         record_conditions(gearbox_fmu, x, fs, 20.0, 20.0, {}, duration=0.5, shaft_speed=np.zeros(x.size))
-
-
-def test_run_up_envelope_series_are_read_in_pinion_orders_and_short_or_speedless_run_ups_skipped():
-    from twin.effects.diagnose import runup_envelope_series
-    from twin.effects.records import Record
-
-    fs, n = 20000.0, 80000
-    rng = np.random.default_rng(2)
-    speed = np.linspace(8.0, 20.0, n)                              # [Hz]
-    revs = np.cumsum(speed) / fs
-    x = 0.05 * rng.standard_normal(n)
-    ring = np.exp(-np.arange(100) / 15.0) * np.sin(2 * np.pi * 6000.0 * np.arange(100) / fs)
-    for i in np.flatnonzero(np.diff(np.floor(3.585 * revs)) > 0)[:-1]:
-        x[i:i + ring.size] += ring[: n - i]
-    runup = Record("runup", x, fs, 20.0, 20.0, shaft_hz=speed)
-    found = [s for s in runup_envelope_series([runup], 19, 52) if s.locked_to is None]
-    assert found and found[0].order == pytest.approx(3.585, abs=0.01)
-    assert runup_envelope_series([Record("runup", x, fs, 20.0, 20.0)], 19, 52) == ()
-    short = Record("runup", x[:4000], fs, 20.0, 20.0, shaft_hz=speed[:4000])        # 2.6 revolutions
-    assert runup_envelope_series([short], 19, 52) == ()
