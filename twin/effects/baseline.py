@@ -100,10 +100,9 @@ class DiscrepancySpec(HeldOutSpec):
     """
 
     baseline_hz: float = 0.0
-    # other baseline records of the same operating point: ((n,) measured stretch, (n,) angle or
-    # None, mean pinion speed [Hz]) each, for the record-to-record scatter, and their names
+    # other baseline records of the same operating point: (name, (n,) measured stretch, (n,) angle
+    # or None, mean pinion speed [Hz]) each, for the record-to-record scatter
     repeats: tuple = ()
-    repeat_names: tuple[str, ...] = ()
 
 
 def learn(spec: DiscrepancySpec) -> Discrepancy:
@@ -159,7 +158,7 @@ def learn(spec: DiscrepancySpec) -> Discrepancy:
         from twin.signals.envelope import envelope_series
         envelope = tuple(s.order for s in envelope_series(spec.measured, spec.sample_rate, spec.baseline_hz))
     return Discrepancy(spec.record, f, np.clip(level, -MAX_DB, MAX_DB), angle, envelope, scatter,
-                       tuple(spec.repeat_names) if spec.repeats else ())
+                       tuple(name for name, *_ in spec.repeats))
 
 
 def _scatter(spec: DiscrepancySpec, objective, base_psd: np.ndarray, angle_objective, speed: float
@@ -177,11 +176,11 @@ def _scatter(spec: DiscrepancySpec, objective, base_psd: np.ndarray, angle_objec
     f = objective.frequencies
     scatter = np.zeros(f.size)
     angle_scatter = b_angle = None
-    if angle_objective is not None and all(a is not None for _, a, _ in spec.repeats):
+    if angle_objective is not None and all(a is not None for _, _, a, _ in spec.repeats):
         ratio = spec.baseline_hz / speed if spec.baseline_hz > 0 else 1.0
         b_angle = at_speed(angle_objective.frequencies, angle_objective.psd, ratio)[angle_objective.band]
         angle_scatter = np.zeros(b_angle.size)
-    for x, a, hz in spec.repeats:
+    for _, x, a, hz in spec.repeats:
         n = min(x.size, spec.measured.size)
         _, pr = welch_psd(np.asarray(x, float)[-n:], spec.sample_rate, resolution=objective.resolution)
         lb, lr, _ = spectral_levels(at_speed(f, pr, hz / speed)[objective.band], base_psd)
@@ -315,19 +314,17 @@ def learn_all(fmu_path, parameters: Mapping[str, float], records: Sequence, base
                                   record=r.name, duration=duration, solver_step=solver_step, shaft_speed=r.shaft_hz)
             cb = record_conditions(fmu_path, b.signal, b.sample_rate, b.nominal_speed, b.load, parameters,
                                    record=b.name, duration=duration, solver_step=solver_step, shaft_speed=b.shaft_hz)
-            repeats, names = [], []
+            repeats = []
             for o in repeated(b, baseline):
-                names.append(o.name)
                 co = record_conditions(fmu_path, o.signal, o.sample_rate, o.nominal_speed, o.load, parameters,
                                        record=o.name, duration=duration, solver_step=solver_step,
                                        shaft_speed=o.shaft_hz)
-                repeats.append((co.measured, _angle(o, co.measured.size, encoder and r.angle is not None),
+                repeats.append((o.name, co.measured, _angle(o, co.measured.size, encoder and r.angle is not None),
                                 float(co.operating.shaft_hz)))
             specs.append(DiscrepancySpec(b.name, str(fmu_path), dict(parameters), channel, cb.measured, r.sample_rate,
                                          r.load, operating=c.operating, solver_step=solver_step,
                                          angle=_angle(b, cb.measured.size, encoder and r.angle is not None),
-                                         baseline_hz=float(cb.operating.shaft_hz), repeats=tuple(repeats),
-                                         repeat_names=tuple(names)))
+                                         baseline_hz=float(cb.operating.shaft_hz), repeats=tuple(repeats)))
     out = (executor.map(guarded_learn, specs, progress=progress, desc="baseline records") if executor is not None
            else [guarded_learn(sp) for sp in specs])
     bad = [(s.record, v) for s, v in zip(specs, out) if isinstance(v, Exception)]

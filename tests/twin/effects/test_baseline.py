@@ -203,7 +203,7 @@ def test_repeated_baseline_records_give_the_record_to_record_scatter_that_raises
 
     b, again = healthy(1), healthy(2, wander=2.0)            # the 700 Hz line 6 dB apart
     spec = DiscrepancySpec("steady", "unused.fmu", {}, "accel", b, fs, 20.0, baseline_hz=20.0,
-                           repeats=((again, None, 20.0),))
+                           repeats=(("steady_again", again, None, 20.0),))
     objective = _Objective(b, fs)
     scatter, angle_scatter = _scatter(spec, objective, objective.psd[objective.band], None, 20.0)
     f = objective.frequencies
@@ -244,7 +244,7 @@ def test_the_encoder_channel_learns_its_own_scatter_from_repeats_with_an_angle()
 
     x = np.random.default_rng(0).standard_normal(n)
     spec = DiscrepancySpec("steady", "unused.fmu", {}, "accel", x, fs, 20.0, baseline_hz=20.0,
-                           angle=angle(1e-3, 1), repeats=((x, angle(2e-3, 2), 20.0),))
+                           angle=angle(1e-3, 1), repeats=(("steady_again", x, angle(2e-3, 2), 20.0),))
     objective = _Objective(x, fs)
     ao = AngularObjective(spec.angle, fs, objective.resolution)
     _, scatter = _scatter(spec, objective, objective.psd[objective.band], ao, 20.0)
@@ -252,7 +252,7 @@ def test_the_encoder_channel_learns_its_own_scatter_from_repeats_with_an_angle()
     assert scatter[np.argmin(np.abs(f - 7.31))] == pytest.approx(6.0, abs=1.5)
     assert scatter[np.argmin(np.abs(f - 40.0))] < 1.5
     no_angle = DiscrepancySpec("steady", "unused.fmu", {}, "accel", x, fs, 20.0, baseline_hz=20.0,
-                               angle=spec.angle, repeats=((x, None, 20.0),))
+                               angle=spec.angle, repeats=(("steady_again", x, None, 20.0),))
     assert _scatter(no_angle, objective, objective.psd[objective.band], ao, 20.0)[1] is None
 
 
