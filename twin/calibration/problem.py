@@ -367,40 +367,28 @@ def _calibrate(fmu_path, space, target, ex, *, algorithm, pop_size, n_gen, seed,
         # polish from the front member with the best mode fit, not from an extreme of the front
         start = X[int(np.argmin(F[:, target.objectives.index(modal[0])]))]
         if modal[0] == "modes":
-            chosen = space.to_dict(polish_modes(Path(fmu_path), space, target, nominal=nominal, fixed=fixed,
-                                                executor=ex, seed=seed, verbose=verbose))
+            from twin.calibration.modal_fit import fit_modes
+            mid = np.sqrt(space.lower * space.upper)
+            nom = np.array([float((nominal or {}).get(n, m)) for n, m in zip(space.names, mid)])
+            # from the nominal set, where the modes were matched, following them step by step: a
+            # population member far from it may hold two modes in swapped places
+            kw = dict(fixed=dict(fixed or {}), speed_hz=target.drive_hz, load_nm=target.load,
+                      channels=target.mode_channels or (target.channel,), shapes=target.mode_shapes,
+                      pairing=target.pairing, visibility=target.visibility)
+            x0, start_pairing = nom, target.mode_pairing
+            if check_fit(target.fit) == "search":
+                # paired afresh at every candidate set; the descent then starts from a pairing made there
+                x0, _ = search_modes(Path(fmu_path), space.names, space.lower, space.upper, nom,
+                                     target.natural_frequencies, target.rel_sd, executor=ex, seed=seed,
+                                     budget=target.search_budget, progress=verbose, **kw)
+                start_pairing = None
+            chosen = space.to_dict(fit_modes(Path(fmu_path), space.names, space.lower, space.upper, nom, x0,
+                                             target.natural_frequencies, target.rel_sd,
+                                             start_pairing=start_pairing, **kw))
         else:
             chosen = space.to_dict(refine_modes(Path(fmu_path), space, target, start, fixed=fixed))
     return CalibrationResult(space.names, X, F, chosen, space.to_dict(X[knee]),
                              len(problem.history), algorithm, failed, problem.history)
-
-
-def polish_modes(fmu_path: Path, space: ParameterSpace, target: CalibrationTarget, *,
-                 nominal: Mapping[str, float] | None = None, fixed: Mapping[str, float] | None = None,
-                 executor=None, seed: int = 0, verbose: bool = False) -> np.ndarray:
-    """The modes objective's polish (``refine``): the fit in log-parameters about ``nominal``
-    (default: the middle of the box in log), the values (d,) in ``space``'s order.
-
-    It starts from the nominal set, where the modes were matched, and follows them step by step (a
-    population member far from it may hold two modes in swapped places); with ``fit: search`` the
-    start is the search's best set, paired there.  ``fixed`` holds every other parameter, so the
-    same polish run again with a fitted lead mismatch in ``fixed`` fits the modes of the pair as it
-    touches at the operating load."""
-    from twin.calibration.modal_fit import fit_modes
-    mid = np.sqrt(space.lower * space.upper)
-    nom = np.array([float((nominal or {}).get(n, m)) for n, m in zip(space.names, mid)])
-    kw = dict(fixed=dict(fixed or {}), speed_hz=target.drive_hz, load_nm=target.load,
-              channels=target.mode_channels or (target.channel,), shapes=target.mode_shapes,
-              pairing=target.pairing, visibility=target.visibility)
-    x0, start_pairing = nom, target.mode_pairing
-    if check_fit(target.fit) == "search":
-        # paired afresh at every candidate set; the descent then starts from a pairing made there
-        x0, _ = search_modes(Path(fmu_path), space.names, space.lower, space.upper, nom,
-                             target.natural_frequencies, target.rel_sd, executor=executor, seed=seed,
-                             budget=target.search_budget, progress=verbose, **kw)
-        start_pairing = None
-    return fit_modes(Path(fmu_path), space.names, space.lower, space.upper, nom, x0, target.natural_frequencies,
-                     target.rel_sd, start_pairing=start_pairing, **kw)
 
 
 def refine_modes(fmu_path: Path, space: ParameterSpace, target: CalibrationTarget, x0: np.ndarray, *,

@@ -14,8 +14,7 @@ Scenario block (every key but ``parameters`` optional)::
       mesh_form: none             # or fit: the pinion's as-manufactured profile (slope, crowning)
                                   #   fitted to the measured mesh harmonics before the levels
       face_contact_from: light    # a steady record at the same speed and another load: the flanks'
-                                  #   lead mismatch fitted to how the spectrum changes with load (the
-                                  #   modes are then fitted again with it, when it is not 0)
+                                  #   lead mismatch fitted to how the spectrum changes with load
       natural_frequencies: [22, 87, 218, 430]   # or typed by hand [Hz]
       foundation_modes: [13, 41]  # removed from the measured modes (paper: hammer test), in Hz
                                   #   or the name of a hammer-test record to read them from
@@ -336,19 +335,6 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
             chosen.update(contact.parameters)
             if progress:
                 print(contact.describe())
-            if contact.lead_mismatch > 0 and "modes" in objectives and spec.get("refine", True):
-                # the modes were fitted to an aligned pair; in partial face contact the mesh is softer
-                # at the operating load (tangent stiffness sqrt(2 F k / D)), so they are fitted again
-                # with the pair as it touches there
-                from twin.calibration.problem import polish_modes
-                refit = space.to_dict(polish_modes(fmu, space, target, nominal=nominal or None,
-                                                   fixed={**fixed, **(form.parameters if form else {}),
-                                                          **contact.parameters},
-                                                   executor=ex, seed=scenario.seed if seed is None else seed))
-                chosen.update(refit)
-                if progress:
-                    print("modes fitted again with the lead mismatch: "
-                          + ", ".join(f"{k} = {v:.6g}" for k, v in refit.items()))
         if rec is not None and has_levels(spectrum_fmu, channel):
             # the level of the spectrum: sensor gain, roughness and process-force levels (three runs)
             level_kw = dict(speed_hz=target.drive_hz, load_nm=target.load, channel=channel, fmin=band[0],
