@@ -344,7 +344,9 @@ def one_gearbox(rig_name: str, seed: int, out: Path, workers: int, model: str, p
             "first6_hz": first6.tolist(), "first6_twin_hz": [_nearest(twin_visible, f) for f in first6],
             "first6_errors_pc": [100 * e for e in six_err], "first6_pass": bool(max(six_err) <= 0.03),
             "first6_errors_mesh_visible_pc": [100 * e for e in mesh_err], "visibility": visibility,
-            "on_bounds": list(report.warnings), "chosen": list(report.result.chosen),
+            "on_bounds": [w for w in report.warnings if not w.startswith("only ")],
+            "pairing_warning": next((w for w in report.warnings if w.startswith("only ")), None),
+            "chosen": list(report.result.chosen),
             "notes": list(report.notes), "modes_s": t_modes, "calibrate_s": t_cal, "modes_from": list(modes_from),
             "spectrum": spectrum,
             "table2": {"measured": report.measured_modes.tolist(), "after": report.after_modes.tolist()}}

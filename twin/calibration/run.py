@@ -262,7 +262,7 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
                                      {k: v for k, v in fixed.items() if k not in spec["parameters"]})
     timeout = float(spec.get("evaluation_timeout", scenario.executor.get("timeout", 600.0)))
     ex = executor or make_executor({**scenario.executor, "timeout": timeout})
-    path_note = None
+    path_note, attributed = None, []
     try:
         sensitivity = None
         if auto:
@@ -354,6 +354,8 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
                 "beyond what physics allows, so the model's structure may lack something the rig has"
                 for n, lo, hi in zip(space.names, space.lower, space.upper)
                 if n in on_bounds(space.names, [chosen[k] for k in space.names], space.lower, space.upper)]
+    if sensitivity is not None and (few := sensitivity.pairing_warning(attributed)):
+        warnings.append(few)
     if levels is not None and (held := levels.warning()):
         warnings.append(held)
     if form is not None and form.on_bound():

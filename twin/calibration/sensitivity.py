@@ -223,6 +223,24 @@ class Sensitivity:
     visibility: str = "mesh"              # which excitations made a model mode visible (VISIBILITY)
     visible_by: Mapping[str, tuple[float, ...]] = field(default_factory=dict)   # excitation -> visible modes [Hz]
 
+    def pairing_warning(self, sensor_path_hz: Sequence[float] = ()) -> str | None:
+        """A one-line warning when fewer measured modes were paired with a twin mode than were left
+        with none (not paired, not given to the sensor path as ``sensor_path_hz``), else None: the
+        fit then follows a few modes, and the modes it was given say little about the rest."""
+        path = [float(f) for f in sensor_path_hz]
+        left = [float(f) for f in self.unmatched_hz if not np.any(np.isclose(f, path or [np.nan]))]
+        paired = len(self.measured_hz)
+        if len(left) <= paired:
+            return None
+        total = paired + len(self.unmatched_hz)
+        rule = ("visible twin mode within 15 %" if self.pairing_rule == "frequency"
+                else "twin mode that reaches them within the bounds")
+        where = f"; {len(self.unmatched_hz) - len(left)} went to the sensor path" if len(left) < len(self.unmatched_hz) else ""
+        return (f"only {paired} of {total} measured modes paired with a twin mode{where}; {len(left)} have no "
+                f"{rule} ({', '.join(f'{f:.0f}' for f in left)} Hz): the calibration fitted the twin to the "
+                f"paired ones alone, so its structure (or `calibration.visibility`: {self.visibility}) may not "
+                "suit this gearbox")
+
     def bounds(self) -> dict[str, list[float]]:
         by = {c.name: c for c in self.candidates}
         return {n: [by[n].lower, by[n].upper] for n in self.chosen}

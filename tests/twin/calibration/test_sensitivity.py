@@ -99,3 +99,22 @@ def test_a_lateral_force_shows_a_mode_the_mesh_does_not(gearbox_fmu):
     np.testing.assert_allclose(runup.gain_db[mesh.visible] - mesh.gain_db[mesh.visible], 0.0, atol=1e-6)
     with pytest.raises(ValueError, match="visibility 'all'"):
         model_modes(gearbox_fmu, {}, **kw, visibility="all")
+
+
+def test_a_calibration_that_pairs_few_of_the_measured_modes_says_so(gearbox_fmu):
+    mm = model_modes(gearbox_fmu, {}, speed_hz=20.0, load_nm=20.0)
+    visible = np.sort(mm.frequency[mm.visible])
+    # two modes the twin has; three between its modes, more than 15 % from any of them
+    gaps = [np.sqrt(a * b) for a, b in zip(visible[:-1], visible[1:]) if b / a > 1.45][:3]
+    assert len(gaps) == 3
+    measured = np.sort(np.r_[visible[2] * 1.01, visible[3] * 0.99, gaps])
+    sens = mode_sensitivity(gearbox_fmu, {}, measured, speed_hz=20.0, load_nm=20.0)
+    assert len(sens.measured_hz) == 2 and len(sens.unmatched_hz) == 3
+    warning = sens.pairing_warning()
+    assert warning.startswith("only 2 of 5 measured modes paired with a twin mode; 3 have no visible twin mode "
+                              "within 15 %")
+    assert f"{gaps[0]:.0f}" in warning and "calibration.visibility`: mesh" in warning
+    # the modes given to the sensor path are accounted for: then fewer are left than were paired
+    assert sens.pairing_warning(sensor_path_hz=list(sens.unmatched_hz[:2])) is None
+    # a twin that pairs every mode gets no warning
+    assert mode_sensitivity(gearbox_fmu, {}, visible[:4], speed_hz=20.0, load_nm=20.0).pairing_warning() is None
