@@ -77,7 +77,7 @@ def main() -> None:
     nominal = {c.name: c.nominal for c in report.sensitivity.candidates}
     chosen = report.result.chosen
     print("fitted: " + ", ".join(f"{n} {v / nominal[n]:.3g}x" for n, v in chosen.items()))
-    print(f"on a bound: {', '.join(w.split(' = ')[0] for w in report.warnings if not w.startswith('only ')) or 'none'}")
+    print(f"on a bound: {', '.join(w.split(' = ')[0] for w in report.warnings if w != report.pairing_warning) or 'none'}")
 
 
 if __name__ == "__main__":

@@ -92,6 +92,7 @@ class CalibrationReport:
     modes_source: str = "typed in the scenario"
     scenario_file: Path | None = None
     notes: tuple[str, ...] = field(default_factory=tuple)
+    pairing_warning: str | None = None   # also in warnings: most measured modes had no twin mode to pair with
 
     def table(self) -> str:
         """The paper's Table 2 for this run, as text."""
@@ -354,7 +355,8 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
                 "beyond what physics allows, so the model's structure may lack something the rig has"
                 for n, lo, hi in zip(space.names, space.lower, space.upper)
                 if n in on_bounds(space.names, [chosen[k] for k in space.names], space.lower, space.upper)]
-    if sensitivity is not None and (few := sensitivity.pairing_warning(attributed)):
+    few = sensitivity.pairing_warning(attributed) if sensitivity is not None else None
+    if few:
         warnings.append(few)
     if levels is not None and (held := levels.warning()):
         warnings.append(held)
@@ -398,7 +400,7 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
         a = natural_frequencies(fmu, n=freqs.size + 4, parameters={**full_mechanical, **_start(target)})
         mb, ma = b[match_modes(b, freqs)], a[match_modes(a, freqs)]
     report = CalibrationReport(result, freqs, mb, ma, before, after, out_dir, objectives, tuple(warnings),
-                               sensitivity, modes_what, scenario_file, notes)
+                               sensitivity, modes_what, scenario_file, notes, few)
     if rec is not None:       # before: the nominal parameters (with the measured path when there is one)
         psd_overlay(spectrum_fmu, target, {**fixed, **nominal, **path_values}, chosen, settle, duration,
                     out_dir / "report_psd.png")
