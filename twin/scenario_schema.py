@@ -5,6 +5,9 @@ from __future__ import annotations
 from typing import Any
 
 FORMAT_VERSION = 1
+#: Rules for which model modes are visible, i.e. pairing candidates (``calibration.visibility``;
+#: :mod:`twin.calibration.model_modes`).
+VISIBILITY_RULES = ("mesh", "run-up", "mesh+dominant", "run-up+dominant")
 
 _NUM = {"type": "number"}
 _POS = {"type": "number", "exclusiveMinimum": 0}
@@ -105,7 +108,7 @@ CALIBRATION_SCHEMA: dict[str, Any] = {
                                "paired afresh at every candidate set, then that descent)"},
         "search_budget": {"type": "integer", "minimum": 8,
                           "description": "linearisations of the modes search (fit: search; default 160)"},
-        "visibility": {"enum": ["mesh", "run-up", "mesh+dominant", "run-up+dominant"],
+        "visibility": {"enum": list(VISIBILITY_RULES),
                        "description": "which excitations make a model mode visible (a pairing candidate): the "
                                       "mesh's alone (default) or any of a run-up's (mesh, drive and load torque, "
                                       "lateral forces at the gears, the process force); '+dominant': a mode that "

@@ -19,6 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
+from twin.scenario_schema import VISIBILITY_RULES
+
 #: Parameters moved together to form a transmission error (mesh excitation) in GearTwin models.
 MESH_EXCITATION = "profile_deviation"
 #: Levels of the broadband sources of GearTwin.Gearbox21Measured, set to zero to linearise.
@@ -27,7 +29,7 @@ BROADBAND_LEVELS = ("pinion_roughness.rms", "gear_roughness.rms", "process.rms")
 #: any of a run-up's excitations (:data:`RUNUP_EXCITATIONS`, :data:`LATERAL_FORCES`); with
 #: ``+dominant`` a mode that dominates one of them at its own frequency counts too
 #: (:func:`dominant_modes`), not only one that makes a peak.
-VISIBILITY = ("mesh", "run-up", "mesh+dominant", "run-up+dominant")
+VISIBILITY = VISIBILITY_RULES
 #: Excitations of a run-up that are FMU inputs, by column name (a unit change of the input). The
 #: speed reference acts through the motor's slip law as ``c_motor`` times the drive torque: the
 #: same column scaled, so it is not repeated.

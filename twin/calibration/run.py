@@ -138,7 +138,8 @@ def _face_contact_record(scenario, mset, spec, rec, channel, source, measurement
 
 
 def _block(scenario, modes_from: str | None, pairing: str | None = None, foundation_from: str | None = None,
-           path_from: dict[str, str] | None = None, face_contact_from: str | None = None) -> dict:
+           path_from: dict[str, str] | None = None, face_contact_from: str | None = None,
+           visibility: str | None = None) -> dict:
     import jsonschema
 
     spec = scenario.raw.get("calibration")
@@ -153,6 +154,8 @@ def _block(scenario, modes_from: str | None, pairing: str | None = None, foundat
         spec["modes_from"] = modes_from
     if pairing is not None:
         spec["pairing"] = pairing
+    if visibility is not None:
+        spec["visibility"] = visibility
     if foundation_from is not None:
         spec["foundation_modes"] = foundation_from
     if path_from is not None:
@@ -172,12 +175,12 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
                     progress: bool = True, seed: int | None = None, resume: bool = False,
                     modes_from: str | list[str] | None = None, pairing: str | None = None,
                     foundation_from: str | None = None, path_from: dict[str, str] | None = None,
-                    face_contact_from: str | None = None) -> CalibrationReport:
+                    face_contact_from: str | None = None, visibility: str | None = None) -> CalibrationReport:
     """Calibrate the scenario's FMU to a measurement file, or with ``measurements=None`` to the
     block's typed natural frequencies alone (see the module docstring); ``modes_from``,
-    ``pairing``, ``foundation_from`` (a hammer record: ``foundation_modes``), ``path_from``
-    ({hammer record: bearing force}) and ``face_contact_from`` (a steady record at another load)
-    override the calibration block's keys."""
+    ``pairing``, ``visibility``, ``foundation_from`` (a hammer record: ``foundation_modes``),
+    ``path_from`` ({hammer record: bearing force}) and ``face_contact_from`` (a steady record at
+    another load) override the calibration block's keys."""
     from twin._atomic import check_output_dir
     from twin.calibration.levels import fit_levels_and_panels, has_levels
     from twin.calibration.modal_fit import mode_errors, on_bounds
@@ -198,7 +201,7 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
     if measurements is None and scenario.raw.get("calibration") is None:
         raise ScenarioError([(source, "calibration", "the scenario has no calibration block: without --measurements "
                               "it must type the measured natural_frequencies [Hz]")])
-    spec = _block(scenario, modes_from, pairing, foundation_from, path_from, face_contact_from)
+    spec = _block(scenario, modes_from, pairing, foundation_from, path_from, face_contact_from, visibility)
     pairing = spec.get("pairing", "frequency")
     visibility = spec.get("visibility", "mesh")
     fit = spec.get("fit", "follow")
@@ -447,7 +450,8 @@ def _start(target) -> dict:
 
 
 def scenario_sensitivity(scenario, measurements: str | Path | None = None, *, modes_from: str | list[str] | None = None,
-                         n_modes: int = 8, executor=None, pairing: str | None = None):
+                         n_modes: int = 8, executor=None, pairing: str | None = None,
+                         visibility: str | None = None):
     """The sensitivity study ``parameters: auto`` runs (:class:`twin.calibration.sensitivity.Sensitivity`).
 
     Measured modes from ``modes_from`` (or the scenario's calibration block) when measurements
@@ -455,11 +459,12 @@ def scenario_sensitivity(scenario, measurements: str | Path | None = None, *, mo
     ``n_modes`` visible modes, i.e. what a run-up of a rig exactly like the model would identify.
     The operating point is the steady record's, else the block's ``speed`` and ``load``, else the
     scenario's speed and load at its start time (20 Hz, 20 N.m when it has none).
-    ``pairing`` (default: the block's ``pairing``, else ``"frequency"``) as in ``twin calibrate``.
+    ``pairing`` (default: the block's ``pairing``, else ``"frequency"``) and ``visibility`` (the
+    block's, else ``"mesh"``) as in ``twin calibrate``.
     """
     import tempfile
 
-    from twin.calibration.model_modes import model_modes
+    from twin.calibration.model_modes import check_visibility, model_modes
     from twin.calibration.sensitivity import mode_sensitivity
     from twin.measurements import load_measurements
 
@@ -467,7 +472,7 @@ def scenario_sensitivity(scenario, measurements: str | Path | None = None, *, mo
     if modes_from is not None:
         spec["modes_from"] = modes_from
     pairing = pairing or spec.get("pairing", "frequency")
-    visibility = spec.get("visibility", "mesh")
+    visibility = check_visibility(visibility or spec.get("visibility", "mesh"))
     speed = scenario.inputs.get("motor_speed_ref")
     load = scenario.inputs.get("load_torque")
     speed_hz = speed(scenario.start_time) / (2 * np.pi) if speed is not None else 20.0

@@ -238,8 +238,9 @@ class Sensitivity:
         where = f"; {len(self.unmatched_hz) - len(left)} went to the sensor path" if len(left) < len(self.unmatched_hz) else ""
         return (f"only {paired} of {total} measured modes paired with a twin mode{where}; {len(left)} have no "
                 f"{rule} ({', '.join(f'{f:.0f}' for f in left)} Hz): the calibration fitted the twin to the "
-                f"paired ones alone, so its structure (or `calibration.visibility`: {self.visibility}) may not "
-                "suit this gearbox")
+                f"paired ones alone, so its structure (or `calibration.visibility`: {self.visibility}"
+                + ("; `--visibility run-up` to try" if self.visibility.startswith("mesh") else "")
+                + ") may not suit this gearbox")
 
     def bounds(self) -> dict[str, list[float]]:
         by = {c.name: c for c in self.candidates}

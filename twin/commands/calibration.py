@@ -56,7 +56,7 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     report = lib("twin.calibration.run").run_calibration(scenario, measurements, Path(args.out),
                                                           progress=not args.no_progress, seed=args.seed,
                                                           resume=args.resume, modes_from=args.modes_from,
-                                                          pairing=args.pairing,
+                                                          pairing=args.pairing, visibility=args.visibility,
                                                           foundation_from=args.foundation_from,
                                                           path_from=dict(args.path_from) if args.path_from else None,
                                                           face_contact_from=args.face_contact_from)
@@ -79,7 +79,8 @@ def _cmd_sensitivity(args: argparse.Namespace) -> int:
     scenario = lib("twin.scenario").load_scenario(Path(args.scenario))
     sens = lib("twin.calibration.run").scenario_sensitivity(
         scenario, Path(args.measurements) if args.measurements else None, modes_from=args.modes_from,
-        n_modes=args.modes, executor=local_executor(args.workers), pairing=args.pairing)
+        n_modes=args.modes, executor=local_executor(args.workers), pairing=args.pairing,
+        visibility=args.visibility)
     print(sens.table())
     if args.json is not None:
         import json
@@ -113,9 +114,14 @@ def _record_list(text: str):
 
 
 def _add_pairing_option(p) -> None:
+    from twin.scenario_schema import VISIBILITY_RULES
     p.add_argument("--pairing", choices=("frequency", "shape"),
                    help="pair measured with model modes by frequency (the nearest visible model mode within 15 %%; "
                         "default) or by frequency, shape at the sensors and reach; overrides calibration.pairing")
+    p.add_argument("--visibility", choices=VISIBILITY_RULES,
+                   help="which model modes are pairing candidates: those the mesh shows at the sensor (mesh, the "
+                        "default) or any of a run-up's forces (run-up); +dominant also counts a mode that dominates "
+                        "a response at its own frequency; overrides calibration.visibility")
 
 
 def _cmd_compare(args: argparse.Namespace) -> int:

@@ -164,3 +164,17 @@ def test_cli_sensitivity_from_a_runup(gearbox_fmu, rig_file, tmp_path, capsys):
     assert main(["sensitivity", str(sc), "--json", str(tmp_path / "missing" / "s.json")]) == 2
     assert main(["sensitivity", str(sc), "--pairing", "by-shape"]) == 2
     assert "argument --pairing: invalid choice: 'by-shape'" in capsys.readouterr().err
+
+
+def test_cli_visibility_overrides_the_calibration_block(gearbox_fmu, rig_file, tmp_path, capsys):
+    path, _ = rig_file
+    sc = tmp_path / "sc.yaml"
+    sc.write_text(json.dumps({"version": 1, "name": "cli", "fmu": str(gearbox_fmu), "stop_time": 0.2,
+                              "output": {"sample_rate": FS, "variables": ["accel_pinion_casing"]},
+                              "calibration": {"parameters": "auto", "visibility": "mesh"}}))
+    assert main(["sensitivity", str(sc), "--measurements", str(path), "--modes-from", "runup", "--visibility",
+                 "run-up", "--json", str(tmp_path / "s.json")]) == 0
+    assert "by excitation (visibility: run-up; any column counts" in capsys.readouterr().out
+    assert json.loads((tmp_path / "s.json").read_text())["visibility"] == "run-up"
+    assert main(["calibrate", str(sc), "--measurements", str(path), "--visibility", "all"]) == 2
+    assert "argument --visibility: invalid choice: 'all'" in capsys.readouterr().err
