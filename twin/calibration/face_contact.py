@@ -85,7 +85,7 @@ class FaceContactFit:
     @property
     def parameters(self) -> dict[str, float]:
         out = {PARAMETER: self.lead_mismatch}
-        if self.flank_layer_share > 0:
+        if len(self.shares) > 1 or self.flank_layer_share > 0:     # the layer was fitted: 0 replaces an earlier one
             out.update({LAYER: self.flank_layer_share, REFERENCE: self.reference_torque})
         return out
 
@@ -221,7 +221,9 @@ def fit_face_contact(fmu_path, parameters: Mapping[str, float], records, channel
         return out
 
     try:
-        layer = lambda q: {LAYER: q, REFERENCE: float(la)} if q > 0 else {}
+        # with the layer fitted every run sets it (a share in ``parameters`` from an earlier calibration
+        # must not stay under the runs of share 0); without, an FMU may not have it at all
+        layer = lambda q: {LAYER: q, REFERENCE: float(la)} if len(shares) > 1 or q > 0 else {}
         share_dist = (distances([{PARAMETER: 0.0, **layer(q)} for q in shares], "rough layer")
                       if len(shares) > 1 else [])
         share = choose(share_dist, shares) if share_dist else float(shares[0])

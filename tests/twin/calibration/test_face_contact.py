@@ -52,7 +52,7 @@ def test_the_fit_tells_a_rough_layer_from_a_lead_mismatch(measured_fmu, share, m
     fit = fit_face_contact(measured_fmu, {}, _pair(measured_fmu, made), CH, FS, 20.0, duration=1.0, grid=GRID,
                            shares=SHARES)
     assert fit.flank_layer_share == share and fit.lead_mismatch == pytest.approx(mismatch, abs=1e-12), fit.describe()
-    assert fit.parameters == made
+    assert fit.parameters == {"lead_mismatch": mismatch, "flank_layer_share": share, "layer_reference_torque": 20.0}
     by_share, by_mismatch = dict(zip(fit.shares, fit.share_distances_db)), dict(zip(fit.grid, fit.distances_db))
     if share:
         # a linear mesh's modes do not move with load: its ratio is far from the records'
@@ -62,6 +62,16 @@ def test_the_fit_tells_a_rough_layer_from_a_lead_mismatch(measured_fmu, share, m
         assert by_mismatch[0.0] > by_mismatch[mismatch] + 1.0 and not fit.on_bound(), fit.describe()
     assert ("rough layer 0.3 of the mesh compliance at 20 N.m (the mesh 0.53 times as stiff at 5 N.m)" in fit.describe()
             if share else "no rough layer" in fit.describe())
+
+
+def test_a_layer_from_an_earlier_calibration_does_not_stay_under_the_fit(measured_fmu):
+    """Fitting a calibrated scenario again: its share 0.45 is replaced in every run, and a linear
+    mesh's records are fitted with none."""
+    earlier = {"flank_layer_share": 0.45, "layer_reference_torque": 20.0}
+    fit = fit_face_contact(measured_fmu, earlier, _pair(measured_fmu, {}), CH, FS, 20.0, duration=1.0,
+                           grid=(0.0, 15e-6), shares=(0.0, 0.45))
+    assert fit.flank_layer_share == 0.0 and fit.parameters["flank_layer_share"] == 0.0, fit.describe()
+    assert fit.share_distances_db[0] < 0.5 < fit.share_distances_db[1]
 
 
 def test_the_layer_factor_is_the_models():
