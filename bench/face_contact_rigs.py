@@ -1,4 +1,4 @@
-"""Benchmark: the light-load law (rough layer, lead mismatch) from a load pair, on gearboxes the twin did not generate.
+"""Benchmark: the flanks' lead mismatch from a load pair, on gearboxes the twin did not generate.
 
     python bench/face_contact_rigs.py --calibrated DIR [DIR ...] [--rigs pedestal beam]
                                       [--seeds 2 4 5 6] [--out bench_out/face_contact_rigs]
@@ -7,15 +7,13 @@ Per rig and seed: the gearbox ``Rig().scattered(seed, 0.12)`` as ``bench/calibra
 --path`` calibrated it (``<rig>_<seed>_cal/calibrated.yaml`` and its measurement file under one of
 the ``--calibrated`` directories). The rig writes two more steady records of that gearbox at the
 same speed (20 Hz): 5 N.m (the light-load record of the pair) and 10 N.m (held out: nothing is
-fitted on it). ``twin.calibration.face_contact`` fits ``flank_layer_share`` and then
-``lead_mismatch`` to the calibration's 20 N.m steady record and the 5 N.m one (as
-``calibration.face_contact_from`` does), and the levels are fitted again with them on the 20 N.m
-record (as the calibration does after it).
+fitted on it). ``twin.calibration.face_contact`` fits ``lead_mismatch`` to the calibration's
+20 N.m steady record and the 5 N.m one (as ``calibration.face_contact_from`` does), and the
+levels are fitted again with it on the 20 N.m record (as the calibration does after it).
 
 Scored by ``bench/spectral_distance.py`` (floor-aware, gain-free, written apart from ``twin``):
-each record against the calibrated twin with a linear, aligned mesh (no rough layer, lead
-mismatch 0, its levels fitted again by the current code on the 20 N.m record) and against the
-twin with the fitted law, both simulated at the operating point the record shows (measured speed, its
+each record against the calibrated twin (lead mismatch 0, its levels fitted again by the current
+code on the 20 N.m record) and against the twin with the fitted lead mismatch, both simulated at the operating point the record shows (measured speed, its
 load). The held-out 10 N.m distance is the figure; the 20 N.m one must not get worse. For the
 pedestal rig its own linearisation names its mesh-controlled mode (truth, read for the report
 only). Writes results.json under --out and prints a Markdown table. Run once per method change.
@@ -67,7 +65,7 @@ def _distances(fmu, parameter_sets, rec) -> tuple[float, ...]:
 def one(rig: str, seed: int, calibrated: Path, out: Path, ex) -> dict:
     from diagnosis_rigs import calibration_records
 
-    from twin.calibration.face_contact import fit_face_contact, has_layer
+    from twin.calibration.face_contact import fit_face_contact
     from twin.calibration.levels import fit_levels_and_panels
     from twin.measurements import load_measurements
     from twin.scenario import load_scenario
@@ -83,44 +81,31 @@ def one(rig: str, seed: int, calibrated: Path, out: Path, ex) -> dict:
             "steady": load_measurements(calibration_records(calibrated, rig, seed))["steady"]}
     sc = load_scenario(calibrated / f"{rig}_{seed}_cal" / "calibrated.yaml")
     fmu, params = str(sc.fmu_path()), dict(sc.parameters)
-    # the reference arm: a linear, aligned mesh (a calibration with a load pair wrote its law)
-    params = {**params, "lead_mismatch": 0.0, **({"flank_layer_share": 0.0} if has_layer(fmu) else {})}
     base = recs["steady"]
     fs = float(base.sample_rate)
     # the aligned twin's levels fitted again by the current code, as the fitted arm's are below, so
-    # that the two arms differ only by the light-load law (the calibrated levels may come from an
+    # that the two arms differ only by the lead mismatch (the calibrated levels may come from an
     # older excitation model)
     _, levels0 = fit_levels_and_panels(fmu, params, np.asarray(base[CHANNEL], float), fs, channel=CHANNEL,
                                        speed_hz=float(base.nominal_speed), load_nm=float(base.load),
                                        fmin=10.0, fmax=5000.0, settle=0.1)
     params = {**params, **levels0}
-    steady = (np.asarray(base[CHANNEL], float), base.load)
-    light = (np.asarray(recs["light"][CHANNEL], float), recs["light"].load)
-
-    def law(shares):
-        """The law fitted with ``shares`` (``(0.0,)``: the lead mismatch alone), its levels fitted again."""
-        t0 = time.perf_counter()
-        fit = fit_face_contact(fmu, params, [steady, light], CHANNEL, fs, float(base.nominal_speed), executor=ex,
-                               **({} if shares is None else {"shares": shares}))
-        fitted = {**params, **fit.parameters}
-        _, levels = fit_levels_and_panels(fmu, fitted, steady[0], fs, channel=CHANNEL,
-                                          speed_hz=float(base.nominal_speed), load_nm=float(base.load),
-                                          fmin=10.0, fmax=5000.0, settle=0.1)
-        return fit, {**fitted, **levels}, time.perf_counter() - t0
-
-    # the lead mismatch alone (the law before the rough layer) and the rough layer then the mismatch
-    fit_d, fitted_d, _ = law((0.0,))
-    fit, fitted, fit_s = law(None) if has_layer(fmu) else (fit_d, fitted_d, 0.0)
+    t0 = time.perf_counter()
+    fit = fit_face_contact(fmu, params, [(np.asarray(base[CHANNEL], float), base.load),
+                                         (np.asarray(recs["light"][CHANNEL], float), recs["light"].load)],
+                           CHANNEL, fs, float(base.nominal_speed), executor=ex)
+    fitted = {**params, **fit.parameters}
+    _, levels = fit_levels_and_panels(fmu, fitted, np.asarray(base[CHANNEL], float), fs, channel=CHANNEL,
+                                      speed_hz=float(base.nominal_speed), load_nm=float(base.load),
+                                      fmin=10.0, fmax=5000.0, settle=0.1)
+    fitted.update(levels)
+    fit_s = time.perf_counter() - t0
     row = {"rig": rig, "seed": seed, "lead_mismatch_um": 1e6 * fit.lead_mismatch,
-           "flank_layer_share": fit.flank_layer_share, "describe": fit.describe(),
-           "mismatch_alone_um": 1e6 * fit_d.lead_mismatch,
-           "share_distance_db": dict(zip([f"{q:g}" for q in fit.shares], fit.share_distances_db)),
            "ratio_distance_db": dict(zip([f"{1e6 * g:g}" for g in fit.grid], fit.distances_db)),
            "fit_s": fit_s, "load_average": os.getloadavg()[0]}
-    # each record: (linear aligned mesh, lead mismatch alone, rough layer then lead mismatch)
     for name in ("steady", "light", "held_out"):
         rec = recs[name]
-        row[f"distance_{name}"] = _distances(fmu, (params, fitted_d, fitted), rec)
+        row[f"distance_{name}"] = _distances(fmu, (params, fitted), rec)
     if rig == "pedestal":
         row["rig_mesh_mode_hz"] = {f"{load:g}": next((m.frequency for m in box.modes(speed=SPEED, load=load)
                                                        if "on mesh" in m.label), None)
@@ -129,19 +114,14 @@ def one(rig: str, seed: int, calibrated: Path, out: Path, ex) -> dict:
 
 
 def table(rows: list[dict]) -> str:
-    head = ("| rig | seed | lead mismatch alone [um] | rough layer share; lead mismatch [um] | ratio distance, linear "
-            "aligned -> fitted [dB] | distance at 20 N.m (fitted on), linear aligned / mismatch alone / layer then "
-            "mismatch [dB] | 5 N.m (the pair) | 10 N.m (held out) | fit + levels [s] |\n"
-            "|---|---|---|---|---|---|---|---|---|")
+    head = ("| rig | seed | lead mismatch fitted [um] | ratio distance at 0 -> fitted [dB] | distance at 20 N.m "
+            "(fitted on) [dB] | 5 N.m (the pair) | 10 N.m (held out) | fit + levels [s] |\n|---|---|---|---|---|---|---|---|")
     lines = [head]
     for r in rows:
-        rd, sd = r["ratio_distance_db"], r.get("share_distance_db") or {}
+        rd = r["ratio_distance_db"]
         key = f"{r['lead_mismatch_um']:g}"
-        share = r.get("flank_layer_share", 0.0)
-        at0 = sd.get("0", rd["0"])
-        lines.append(f"| {r['rig']} | {r['seed']} | {r.get('mismatch_alone_um', 0.0):g} | {share:g}; {key} | "
-                     f"{at0:.2f} -> {rd[key]:.2f} | "
-                     + " | ".join(" / ".join(f"{d:.1f}" for d in r[f"distance_{n}"])
+        lines.append(f"| {r['rig']} | {r['seed']} | {key} | {rd['0']:.2f} -> {rd[key]:.2f} | "
+                     + " | ".join(f"{r[f'distance_{n}'][0]:.1f} -> {r[f'distance_{n}'][1]:.1f}"
                                   for n in ("steady", "light", "held_out"))
                      + f" | {r['fit_s']:.0f} |")
     return "\n".join(lines)

@@ -76,7 +76,7 @@ CALIBRATION_SCHEMA: dict[str, Any] = {
                                      "levels; none (default): perfect involutes"},
         "face_contact_from": {"type": "string", "minLength": 1,
                               "description": "a steady record at the steady record's speed and another load: the "
-                                             "flanks' rough layer (flank_layer_share), then their lead mismatch (lead_mismatch), fitted to how the spectrum's "
+                                             "flanks' lead mismatch (lead_mismatch) fitted to how the spectrum's "
                                              "shape changes between the two loads, before the levels"},
         "path_sections": {"type": "integer", "minimum": 1, "maximum": 200,
                           "description": "second-order sections fitted to each measured path (default 32)"},

@@ -31,16 +31,6 @@ model Gearbox21 "21-DOF lumped model of the UNSW spur-gear test rig (Feng et al.
   parameter Real c_mesh(unit = "N.s/m", min = 0) = 1.1e3 "Mesh damping along the line of action";
   parameter Real contact_damping_width(unit = "m", min = 0) = 1e-8 "Approach over which the mesh damping engages when the flanks touch";
   parameter Real lead_mismatch(unit = "m") = 0 "Lead mismatch of the flanks across the face (misalignment): the gap at one face end while the other touches";
-  // The flanks' rough layer (asperity heights exponentially distributed, Greenwood & Williamson
-  // 1966) carries a load that grows exponentially as the surfaces close, so its compliance is
-  // h / F at force F: large at light load, small at heavy load, in series with the teeth. The
-  // pair law stays linear, with the tangent stiffness at the static mesh force (load_start): the
-  // pair stiffnesses (k_pair times mesh_stiffness_scale) hold at layer_reference_torque, where the
-  // layer takes the share flank_layer_share of the mesh compliance, and at a brake torque T the
-  // mesh is T / ((1 - share) T + share T_ref) times as stiff (share 0: a linear mesh).
-  parameter Real flank_layer_share(min = 0, max = 0.95) = 0 "Share of the flanks' rough layer in the mesh's tangent compliance at layer_reference_torque (0: no layer)";
-  parameter Real layer_reference_torque(unit = "N.m", min = 0) = 20.0 "Brake torque at which the pair stiffnesses are the mesh's tangent stiffness";
-  parameter Real flank_layer_factor(min = 0) = max(abs(load_start), 1e-3) / ((1 - flank_layer_share) * max(abs(load_start), 1e-3) + flank_layer_share * layer_reference_torque) "Tangent mesh stiffness at load_start relative to that at layer_reference_torque";
   parameter Real mesh_phase0(unit = "rad") = 0.0 "Mesh phase at theta5 = 0";
   parameter Real contact_smoothing = 0.01 "Half-width of the entry/exit ramp of a tooth pair, as a fraction of the path of contact";
 
@@ -132,7 +122,7 @@ model Gearbox21 "21-DOF lumped model of the UNSW spur-gear test rig (Feng et al.
   parameter Real pitch_curvature_gear(unit = "m", min = 0) = 0.5 * module * z2 * sin(alpha) "Radius of curvature of the gear flank at the pitch point";
   parameter Real hertz_half_width(unit = "m", min = 0) = sqrt(8 * max(mesh_force_static, 0) / face_width * (pitch_curvature_pinion * pitch_curvature_gear / (pitch_curvature_pinion + pitch_curvature_gear)) * (1 - gear_poisson_ratio ^ 2) / (GearTwin.pi * gear_youngs_modulus)) "Hertzian half-width of the static mesh force on one pair at the pitch point (line contact)";
   parameter Real speed_start(unit = "rad/s") = speed_ref_start - torque_in / c_motor "Motor speed at t = 0 (steady slip under the static load)";
-  parameter Real k_mesh_mean(unit = "N/m", min = 0, nominal = 1e8) = mesh_stiffness_scale * flank_layer_factor * contact_ratio * sum(k_pair) / n_profile "Approximate mean mesh stiffness at load_start";
+  parameter Real k_mesh_mean(unit = "N/m", min = 0, nominal = 1e8) = mesh_stiffness_scale * contact_ratio * sum(k_pair) / n_profile "Approximate mean mesh stiffness";
 
   // ---- States ----------------------------------------------------------------------------------
   Real theta1(unit = "rad", start = 0.0, fixed = true) "Rotation angle of the motor";
@@ -292,7 +282,7 @@ equation
   // around it (the same hat functions as below, restricted to the two that are not zero).
   pair_pit_field = {tooth_pit_field[noEvent(integer((pair_tooth[i] - 1) * n_profile + pair_node[i])) + 1] * noEvent(max(0.0, 1 - abs(profile_position[i] - pair_node[i]))) + tooth_pit_field[noEvent(integer((pair_tooth[i] - 1) * n_profile + pair_node[i])) + 2] * noEvent(max(0.0, 1 - abs(profile_position[i] - (pair_node[i] + 1)))) for i in 1:3};
   // Piecewise-linear interpolation along the profile: hat functions on n_profile nodes.
-  pair_stiffness = {mesh_stiffness_scale * flank_layer_factor * window[i] * pair_tooth_factor[i] * sum(k_pair[n] * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[i]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile) for i in 1:3};
+  pair_stiffness = {mesh_stiffness_scale * window[i] * pair_tooth_factor[i] * sum(k_pair[n] * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[i]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile) for i in 1:3};
   pair_deviation = {pair_tooth_offset[i] + effect_pair_deviation[i] + pair_pit_field[i] + sum((profile_deviation[n] + effect_profile_deviation[n]) * noEvent(max(0.0, 1 - abs(noEvent(min(1.0, max(0.0, roll[i]))) * (n_profile - 1) - (n - 1)))) for n in 1:n_profile) for i in 1:3};
   mesh_deflection = rb1 * theta5 - rb2 * theta10 + (x5 - x10) * sin(alpha) + (y5 - y10) * cos(alpha) + effect_mesh_displacement + excitation_mesh_displacement;
   mesh_deflection_rate = rb1 * omega5 - rb2 * omega10 + (vx5 - vx10) * sin(alpha) + (vy5 - vy10) * cos(alpha) + effect_mesh_displacement_rate + excitation_mesh_displacement_rate;

@@ -1,40 +1,24 @@
-"""How the mesh softens at light load, fitted to how the spectrum changes between two loads.
+"""The flanks' lead mismatch, fitted to how the spectrum changes between two loads.
 
-Two mechanisms make a real mesh softer at light load, and the twin has one parameter for each:
-
-* **The flanks' rough layer** (``flank_layer_share`` q, :data:`SHARES`): asperity heights
-  exponentially distributed (Greenwood & Williamson, 1966) carry a load that grows exponentially as
-  the surfaces close, so the layer's compliance is h / F at force F, in series with the teeth.
-  ``GearTwin.Gearbox21`` linearises it at the static mesh force: the pair stiffnesses hold at
-  ``layer_reference_torque`` (set here to the steady record's load, where the modes were fitted,
-  so the fitted modes stay where they are), and at brake torque T the mesh is
-  ``T / ((1 - q) T + q T_ref)`` times as stiff.  q is the layer's share of the mesh compliance at
-  the reference: with the default mesh (about 4e8 N/m) and 273 N of mesh force at 20 N.m,
-  q = 0.1-0.6 is a height scale h = q F / k of 0.07-0.4 um, the composite roughness of ground to
-  finely hobbed flanks.  Every real pair has some; ISO 6336-1 reduces its single stiffness
-  below 100 N/mm of line load for the same reason.
-* **The flanks' lead mismatch** (``lead_mismatch`` D, :data:`GRID`): a spur pair whose leads differ
-  by D across the face (helix slope deviations of both gears, shaft and housing misalignment:
-  ISO 6336-1's equivalent misalignment F_beta_x) touches first at one face end.  Up to the load
-  that closes the gap the pair carries ``k a^2 / (2 D)`` at approach a (the thin-slice law of
-  ``GearTwin.Gearbox21``): its tangent stiffness grows as the square root of the load, and the
-  contact pattern, hence the mesh excitation, changes with it.  Bounds: 0 to 45 um, two to four
-  times the 10-20 um of helix deviation and misalignment an ISO 1328-1 grade 7-8 pair of this
-  face width has.
-
-The layer is fitted first (every pair has one; a misalignment is particular to a gearbox), then
-the mismatch with the layer fixed, so a mismatch is taken only for what the layer cannot explain.
-The defaults (q = 0, D = 0) are a linear, aligned mesh, whose modes do not move with load at all.
+A spur pair whose leads differ by D across the face (helix slope deviations of both gears, shaft
+and housing misalignment: ISO 6336-1's equivalent misalignment F_beta_x) touches first at one
+face end.  Up to the load that closes the gap the pair carries ``k a^2 / (2 D)`` at approach a
+(the thin-slice law of ``GearTwin.Gearbox21``, ``lead_mismatch``): its tangent stiffness grows
+as the square root of the load, so the mesh-controlled mode climbs with load, and above it the
+mesh is the full-face line contact.  The twin's default D = 0 is a perfectly aligned pair, whose
+mesh mode does not move with load at all.
 
 At one speed and two loads the ratio of the two spectra at a sensor does not hold the transfer
 path or the sensor gain (they divide out), so it is the mesh's own load dependence that the ratio
-shows.  Each value is simulated at both records' loads and speed; both spectra are Welch PSDs
-smoothed by a running median over :data:`SMOOTH_HZ` (wider than the mesh-harmonic spacing, so the
-broadband shape is compared, not the lines), the ratio in dB is compared with the records' over
-[:data:`FMIN`, min(:data:`FMAX`, 0.4 fs)] with its median removed (gain-free), and the distance is
-the RMS.  A flat ratio says little: in each stage the smallest value whose distance is within
-:data:`TOLERANCE_DB` of the stage's best is taken, so a gearbox whose spectrum does not change its
-shape with load keeps a linear, aligned mesh.  A fit at a grid's top is reported as a warning.
+shows.  Each D of :data:`GRID` is simulated at both records' loads and speed; both spectra are
+Welch PSDs smoothed by a running median over :data:`SMOOTH_HZ` (wider than the mesh-harmonic
+spacing, so the broadband shape is compared, not the lines), the ratio in dB is compared with the
+records' over [:data:`FMIN`, min(:data:`FMAX`, 0.4 fs)] with its median removed (gain-free), and
+the distance is the RMS. A flat ratio says little about D: the smallest D whose distance is within
+:data:`TOLERANCE_DB` of the best is taken, so a gearbox whose spectrum does not change its shape
+with load keeps an aligned pair.  Bounds: 0 to 45 um, two to four times the 10-20 um of helix
+deviation and misalignment an ISO 1328-1 grade 7-8 pair of this face width has; a fit at the bound
+is reported as a warning.
 """
 from __future__ import annotations
 
@@ -47,9 +31,6 @@ import numpy as np
 PARAMETER = "lead_mismatch"
 #: Lead mismatches tried [m].
 GRID = (0.0, 2.5e-6, 5e-6, 7.5e-6, 10e-6, 15e-6, 20e-6, 30e-6, 45e-6)
-LAYER, REFERENCE = "flank_layer_share", "layer_reference_torque"
-#: Rough-layer shares of the mesh compliance at the steady record's load tried [-].
-SHARES = (0.0, 0.05, 0.1, 0.15, 0.2, 0.3, 0.45, 0.6)
 #: Smallest D within this distance of the best is taken [dB].
 TOLERANCE_DB = 0.25
 #: Band of the compared ratio [Hz] (the top also at most 0.4 times the sample rate).
@@ -62,65 +43,27 @@ SEGMENT_S = 0.08
 
 @dataclass(frozen=True)
 class FaceContactFit:
-    """The light-load law chosen from the load pair.
-
-    ``flank_layer_share`` [-] from ``shares`` with ``share_distances_db`` (len(shares),) the ratio
-    distance [dB] at each (lead mismatch 0); ``reference_torque`` [N.m] the steady record's load,
-    where the layer leaves the mesh as the modes fitted it; ``lead_mismatch`` [m] from ``grid`` [m]
-    with ``distances_db`` (len(grid),) at each (with the chosen share); ``loads`` [N.m] (steady
-    first) and ``speed_hz`` of the pair."""
+    """``lead_mismatch`` [m] chosen from the load pair; ``distances_db`` (len(GRID),) the ratio
+    distance [dB] at each D of ``grid`` [m]; ``loads`` [N.m] and ``speed_hz`` of the pair."""
     lead_mismatch: float
     grid: tuple[float, ...]
     distances_db: tuple[float, ...]
     loads: tuple[float, float]
     speed_hz: float
-    flank_layer_share: float = 0.0
-    shares: tuple[float, ...] = (0.0,)
-    share_distances_db: tuple[float, ...] = ()
-
-    @property
-    def reference_torque(self) -> float:
-        return self.loads[0]
 
     @property
     def parameters(self) -> dict[str, float]:
-        out = {PARAMETER: self.lead_mismatch}
-        if len(self.shares) > 1 or self.flank_layer_share > 0:     # the layer was fitted: 0 replaces an earlier one
-            out.update({LAYER: self.flank_layer_share, REFERENCE: self.reference_torque})
-        return out
+        return {PARAMETER: self.lead_mismatch}
 
     def on_bound(self) -> bool:
         return self.lead_mismatch >= max(self.grid)
 
-    def layer_on_bound(self) -> bool:
-        return len(self.shares) > 1 and self.flank_layer_share >= max(self.shares)
-
     def describe(self) -> str:
         best = float(min(self.distances_db))
-        at0 = (self.share_distances_db[self.shares.index(0.0)] if 0.0 in self.shares and self.share_distances_db
-               else self.distances_db[self.grid.index(0.0)] if 0.0 in self.grid else float("nan"))
-        light = layer_factor(self.flank_layer_share, self.loads[1], self.loads[0])
-        layer = ("" if len(self.shares) < 2 else "no rough layer, " if not self.flank_layer_share else
-                 f"rough layer {self.flank_layer_share:g} of the mesh compliance at {self.loads[0]:g} N.m (the mesh "
-                 f"{light:.2f} times as stiff at {self.loads[1]:g} N.m), ")
-        return (f"{layer}lead mismatch {1e6 * self.lead_mismatch:g} um from the spectra at {self.loads[0]:g} and "
-                f"{self.loads[1]:g} N.m ({self.speed_hz:g} Hz): their ratio {at0:.2f} dB from a linear aligned "
-                f"mesh's, {best:.2f} dB at best")
-
-
-def layer_factor(share: float, torque: float, reference: float) -> float:
-    """Tangent mesh stiffness at brake torque ``torque`` relative to that at ``reference`` [N.m] with a
-    rough layer of ``share`` [-] (``GearTwin.Gearbox21.flank_layer_factor``)."""
-    t = max(abs(torque), 1e-3)
-    return t / ((1 - share) * t + share * reference)
-
-
-def has_layer(fmu_path) -> bool:
-    """Whether the FMU has the rough-layer parameters (an FMU built before them, or another tool's, has not)."""
-    from twin.fmu import FMU
-    with FMU(fmu_path) as fmu:
-        names = set(fmu.variables)
-    return LAYER in names and REFERENCE in names
+        at0 = self.distances_db[self.grid.index(0.0)] if 0.0 in self.grid else float("nan")
+        return (f"lead mismatch {1e6 * self.lead_mismatch:g} um from the spectra at {self.loads[0]:g} and "
+                f"{self.loads[1]:g} N.m ({self.speed_hz:g} Hz): their ratio {at0:.2f} dB from the aligned "
+                f"pair's, {best:.2f} dB at best")
 
 
 def load_pair_problem(steady, other) -> str | None:
@@ -182,15 +125,13 @@ def _simulate(task) -> np.ndarray:
 
 
 def fit_face_contact(fmu_path, parameters: Mapping[str, float], records, channel: str, fs: float, speed_hz: float,
-                     *, settle: float = 0.3, duration: float = 2.0, grid=GRID, shares=SHARES, executor=None,
+                     *, settle: float = 0.3, duration: float = 2.0, grid=GRID, executor=None,
                      progress: bool = False) -> FaceContactFit:
-    """Fit ``flank_layer_share``, then ``lead_mismatch``, to two steady records at one speed and two loads.
+    """Fit ``lead_mismatch`` to two steady records at one speed and two loads.
 
-    records : two (signal (n,), load [N.m]) pairs of ``channel`` sampled at ``fs`` [Hz], the steady
-    record (whose load the modes were fitted at) first.  ``speed_hz`` is the drive speed both were
-    taken at; ``duration`` [s] is simulated per run after ``settle`` (at most each record's length);
-    ``shares`` the rough-layer shares tried [-] (``(0.0,)``: no layer), ``grid`` the lead
-    mismatches tried [m].
+    records : two (signal (n,), load [N.m]) pairs of ``channel`` sampled at ``fs`` [Hz].
+    ``speed_hz`` is the drive speed both were taken at; ``duration`` [s] is simulated per run
+    after ``settle`` (at most each record's length); ``grid`` the lead mismatches tried [m].
     """
     from twin.executor import LocalExecutor
     from twin.errors import MeasurementError
@@ -206,34 +147,18 @@ def fit_face_contact(fmu_path, parameters: Mapping[str, float], records, channel
     measured = (a_db - b_db)[band]
     n = min(len(xa), len(xb))
     duration = min(float(duration), n / fs)
+    tasks = [(str(fmu_path), float(speed_hz), float(load), {**parameters, PARAMETER: d}, settle, duration, channel, fs)
+             for d in grid for load in (la, lb)]
     own = executor is None
     ex = executor or LocalExecutor(1)
-
-    def distances(values: list[dict[str, float]], desc: str) -> list[float]:
-        tasks = [(str(fmu_path), float(speed_hz), float(load), {**parameters, **v}, settle, duration, channel, fs)
-                 for v in values for load in (la, lb)]
-        runs = ex.map(_simulate, tasks, progress=progress, desc=desc)
-        out = []
-        for i in range(len(values)):
-            _, sa = smoothed_db(runs[2 * i], fs)
-            _, sb = smoothed_db(runs[2 * i + 1], fs)
-            out.append(ratio_distance(measured, (sa - sb)[band]))
-        return out
-
     try:
-        # with the layer fitted every run sets it (a share in ``parameters`` from an earlier calibration
-        # must not stay under the runs of share 0); without, an FMU may not have it at all
-        layer = lambda q: {LAYER: q, REFERENCE: float(la)} if len(shares) > 1 or q > 0 else {}
-        share_dist = (distances([{PARAMETER: 0.0, **layer(q)} for q in shares], "rough layer")
-                      if len(shares) > 1 else [])
-        share = choose(share_dist, shares) if share_dist else float(shares[0])
-        # the mismatch with the layer fixed; with no mismatch it is the layer's own run
-        known = dict(zip(shares, share_dist)) if share_dist else {}
-        rest = [d for d in grid if not (d == 0.0 and share in known)]
-        got = dict(zip(rest, distances([{PARAMETER: d, **layer(share)} for d in rest], "lead mismatch")))
-        dist = [known[share] if (d == 0.0 and share in known) else got[d] for d in grid]
+        runs = ex.map(_simulate, tasks, progress=progress, desc="lead mismatch")
     finally:
         if own:
             ex.close()
-    return FaceContactFit(choose(dist, grid), tuple(grid), tuple(dist), (float(la), float(lb)), float(speed_hz),
-                          float(share), tuple(shares), tuple(share_dist))
+    dist = []
+    for i in range(len(grid)):
+        _, sa = smoothed_db(runs[2 * i], fs)
+        _, sb = smoothed_db(runs[2 * i + 1], fs)
+        dist.append(ratio_distance(measured, (sa - sb)[band]))
+    return FaceContactFit(choose(dist, grid), tuple(grid), tuple(dist), (float(la), float(lb)), float(speed_hz))

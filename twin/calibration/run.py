@@ -14,8 +14,7 @@ Scenario block (every key but ``parameters`` optional)::
       mesh_form: none             # or fit: the pinion's as-manufactured profile (slope, crowning)
                                   #   fitted to the measured mesh harmonics before the levels
       face_contact_from: light    # a steady record at the same speed and another load: the flanks'
-                                  #   rough layer, then their lead mismatch, fitted to how the
-                                  #   spectrum changes with load
+                                  #   lead mismatch fitted to how the spectrum changes with load
       natural_frequencies: [22, 87, 218, 430]   # or typed by hand [Hz]
       foundation_modes: [13, 41]  # removed from the measured modes (paper: hammer test), in Hz
                                   #   or the name of a hammer-test record to read them from
@@ -331,14 +330,12 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
                 print(form.describe())
         contact = None
         if rec is not None and light is not None:
-            # the light-load law (rough layer, lead mismatch) from how the spectrum changes with load (path and
-            # gain divide out)
-            from twin.calibration.face_contact import SHARES, fit_face_contact, has_layer
+            # the flanks' lead mismatch from how the spectrum changes with load (path and gain divide out)
+            from twin.calibration.face_contact import fit_face_contact
             contact = fit_face_contact(spectrum_fmu, {**fixed, **chosen},
                                        [(np.asarray(rec[channel], float), rec.load),
                                         (np.asarray(light[channel], float), light.load)],
-                                       channel, rec.sample_rate, target.drive_hz, executor=ex, progress=progress,
-                                       shares=SHARES if has_layer(spectrum_fmu) else (0.0,))
+                                       channel, rec.sample_rate, target.drive_hz, executor=ex, progress=progress)
             chosen.update(contact.parameters)
             if progress:
                 print(contact.describe())
@@ -370,9 +367,6 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
         from twin.calibration.mesh_form import BOUND
         warnings.append(f"{form.describe()}: on the bound of +-{1e6 * BOUND:g} um (about ISO 1328-1 grade 9); "
                         "the mesh harmonics ask for more than a gear's profile deviation")
-    if contact is not None and contact.layer_on_bound():
-        warnings.append(f"{contact.describe()}: the rough layer on the bound of {max(contact.shares):g} of the mesh "
-                        "compliance; the load dependence asks for more than the flanks' roughness")
     if contact is not None and contact.on_bound():
         warnings.append(f"{contact.describe()}: on the bound of {1e6 * max(contact.grid):g} um; the load dependence "
                         "asks for more than a misaligned pair")

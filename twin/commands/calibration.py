@@ -30,8 +30,8 @@ def add_subcommands(sub) -> None:
                         "for (e.g. hammer_pinion=bearing_force_input_y; repeat per record): the casing sensors then "
                         "read the model's bearing forces through the measured path (calibration.path_from)")
     p.add_argument("--face-contact-from", metavar="RECORD",
-                   help="a steady record at the steady record's speed and another load: the flanks' rough layer, "
-                        "then their lead mismatch, fitted to how the spectrum changes with load (calibration.face_contact_from)")
+                   help="a steady record at the steady record's speed and another load: the flanks' lead mismatch "
+                        "fitted to how the spectrum changes with load (calibration.face_contact_from)")
     _add_pairing_option(p)
     p.add_argument("--no-progress", action="store_true", help="quiet")
     p.set_defaults(handler=_cmd_calibrate)

@@ -119,8 +119,6 @@ class GearboxParams:
     c_mesh: float = 1.1e3                # N.s/m, along the line of action
     contact_damping_width: float = 1e-8  # m, approach over which the mesh damping engages
     lead_mismatch: float = 0.0           # m, lead mismatch of the flanks across the face (misalignment)
-    flank_layer_share: float = 0.0       # -, the flanks' rough layer's share of the mesh compliance at the reference torque
-    layer_reference_torque: float = 20.0  # N.m, brake torque at which the pair stiffnesses are the tangent stiffness
     mesh_phase0: float = 0.0             # rad, mesh phase at theta5 = 0
     contact_smoothing: float = 0.01      # fraction of the path of contact
     # ---- inertias [kg.m2] and masses [kg]
@@ -217,10 +215,6 @@ class GearboxParams:
                              f"got {len(self.wheel_tooth_deviation_offset)}")
         if self.n_profile < 2:
             raise ValueError("n_profile must be >= 2 (hat interpolation needs two nodes)")
-        if not 0.0 <= self.flank_layer_share <= 0.95:
-            raise ValueError(f"flank_layer_share must be in [0, 0.95], got {self.flank_layer_share!r}")
-        if not self.layer_reference_torque > 0:
-            raise ValueError(f"layer_reference_torque must be > 0 N.m, got {self.layer_reference_torque!r}")
 
     def replace(self, **changes) -> "GearboxParams":
         """Copy with some fields changed (``dataclasses.replace``)."""
@@ -306,17 +300,9 @@ class GearboxParams:
         return self.speed_ref_start - self.torque_in / self.c_motor
 
     @property
-    def flank_layer_factor(self) -> float:
-        """Tangent mesh stiffness at ``load_start`` relative to that at ``layer_reference_torque`` [-]:
-        the rough layer's compliance h / F in series with the teeth, linearised at the static force."""
-        t = max(abs(self.load_start), 1e-3)
-        return t / ((1 - self.flank_layer_share) * t + self.flank_layer_share * self.layer_reference_torque)
-
-    @property
     def k_mesh_mean(self) -> float:
-        """Approximate mean mesh stiffness [N/m] at ``load_start``, used for the static pre-load."""
-        return (self.mesh_stiffness_scale * self.flank_layer_factor * self.contact_ratio * sum(self.k_pair)
-                / self.n_profile)
+        """Approximate mean mesh stiffness [N/m] used for the static pre-load."""
+        return self.mesh_stiffness_scale * self.contact_ratio * sum(self.k_pair) / self.n_profile
 
     def fmu_start_values(self, only_changed: bool = True, variant: bool = False) -> dict[str, float]:
         """Start values for the compiled FMU, keyed by its variable names (``k_pair[3]``, ...).
@@ -352,7 +338,7 @@ class _Constants:
         self.contact_ratio = p.contact_ratio
         self.sin_a = math.sin(p.alpha)
         self.cos_a = math.cos(p.alpha)
-        self.k_pair = p.mesh_stiffness_scale * p.flank_layer_factor * np.asarray(p.k_pair)   # (n_profile,)
+        self.k_pair = p.mesh_stiffness_scale * np.asarray(p.k_pair)          # (n_profile,)
         self.profile_deviation = np.asarray(p.profile_deviation) + np.asarray(p.effect_profile_deviation)
         self.node_index = np.arange(p.n_profile, dtype=float)                # (n_profile,)
         self.tooth_factor = np.asarray(p.tooth_stiffness_factor) * np.asarray(p.effect_tooth_stiffness_factor)

@@ -40,8 +40,6 @@ else:  # loaded from the FMU's resources/ folder, next to gearbox_numpy.py
 PARAMETERS: dict[str, str] = {
     "c_mesh": "Mesh damping along the line of action [N.s/m]",
     "mesh_stiffness_scale": "Calibration multiplier of all pair stiffnesses [-]",
-    "flank_layer_share": "Share of the flanks' rough layer in the mesh's tangent compliance at layer_reference_torque [-]",
-    "layer_reference_torque": "Brake torque at which the pair stiffnesses are the mesh's tangent stiffness [N.m]",
     "mesh_phase0": "Mesh phase at theta5 = 0 [rad]",
     "contact_smoothing": "Half-width of the entry/exit ramp of a tooth pair, fraction of the path of contact [-]",
     "I5": "Pinion and input shaft through casing [kg.m2]",

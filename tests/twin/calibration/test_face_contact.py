@@ -31,55 +31,26 @@ def test_the_ratio_distance_is_gain_free_and_smoothing_removes_the_lines():
     assert np.ptp(db[band]) < 1.5
 
 
-SHARES = (0.0, 0.15, 0.3, 0.45)
-
-
-def _pair(fmu, parameters, seed=0):
+def _pair(fmu, lead_mismatch, seed=0):
     from twin.operating import simulate_operating_point
     rng = np.random.default_rng(seed)
     out = []
     for load in (20.0, 5.0):
-        y = simulate_operating_point(fmu, 20.0, load, parameters=parameters, settle=0.3,
+        y = simulate_operating_point(fmu, 20.0, load, parameters={"lead_mismatch": lead_mismatch}, settle=0.3,
                                      duration=1.0, channels=[CH], output_interval=1.0 / FS)[:, 0]
         out.append((3.0 * y + rng.normal(0.0, 1e-3 * y.std(), y.size), load))     # a gain the fit must not see
     return out
 
 
-@pytest.mark.parametrize("share, mismatch", [(0.0, 15e-6), (0.3, 0.0), (0.0, 0.0)])
-def test_the_fit_tells_a_rough_layer_from_a_lead_mismatch(measured_fmu, share, mismatch):
-    """Records made with one light-load mechanism are fitted with that one and not the other."""
-    made = {"lead_mismatch": mismatch, **({"flank_layer_share": share, "layer_reference_torque": 20.0} if share else {})}
-    fit = fit_face_contact(measured_fmu, {}, _pair(measured_fmu, made), CH, FS, 20.0, duration=1.0, grid=GRID,
-                           shares=SHARES)
-    assert fit.flank_layer_share == share and fit.lead_mismatch == pytest.approx(mismatch, abs=1e-12), fit.describe()
-    assert fit.parameters == {"lead_mismatch": mismatch, "flank_layer_share": share, "layer_reference_torque": 20.0}
-    by_share, by_mismatch = dict(zip(fit.shares, fit.share_distances_db)), dict(zip(fit.grid, fit.distances_db))
-    if share:
-        # a linear mesh's modes do not move with load: its ratio is far from the records'
-        assert by_share[0.0] > by_share[share] + 1.0 and not fit.layer_on_bound(), fit.describe()
-        assert min(by_mismatch[d] for d in GRID if d) > by_mismatch[0.0] + 1.0, fit.describe()
-    if mismatch:
-        assert by_mismatch[0.0] > by_mismatch[mismatch] + 1.0 and not fit.on_bound(), fit.describe()
-    assert ("rough layer 0.3 of the mesh compliance at 20 N.m (the mesh 0.53 times as stiff at 5 N.m)" in fit.describe()
-            if share else "no rough layer" in fit.describe())
-
-
-def test_a_layer_from_an_earlier_calibration_does_not_stay_under_the_fit(measured_fmu):
-    """Fitting a calibrated scenario again: its share 0.45 is replaced in every run, and a linear
-    mesh's records are fitted with none."""
-    earlier = {"flank_layer_share": 0.45, "layer_reference_torque": 20.0}
-    fit = fit_face_contact(measured_fmu, earlier, _pair(measured_fmu, {}), CH, FS, 20.0, duration=1.0,
-                           grid=(0.0, 15e-6), shares=(0.0, 0.45))
-    assert fit.flank_layer_share == 0.0 and fit.parameters["flank_layer_share"] == 0.0, fit.describe()
-    assert fit.share_distances_db[0] < 0.5 < fit.share_distances_db[1]
-
-
-def test_the_layer_factor_is_the_models():
-    from twin.calibration.face_contact import layer_factor
-    from twin.reference.gearbox_numpy import GearboxParams
-    for t in (2.0, 5.0, 20.0, 60.0):
-        p = GearboxParams(flank_layer_share=0.3, layer_reference_torque=20.0, load_start=t)
-        assert layer_factor(0.3, t, 20.0) == pytest.approx(p.flank_layer_factor, rel=1e-15)
+@pytest.mark.parametrize("made_with", [15e-6, 0.0])
+def test_the_fit_finds_the_lead_mismatch_the_records_were_made_with(measured_fmu, made_with):
+    fit = fit_face_contact(measured_fmu, {}, _pair(measured_fmu, made_with), CH, FS, 20.0, duration=1.0, grid=GRID)
+    assert fit.lead_mismatch == pytest.approx(made_with, abs=1e-12), fit.describe()
+    d = dict(zip(fit.grid, fit.distances_db))
+    if made_with:
+        # an aligned pair's mesh mode does not move with load: its ratio is far from the records'
+        assert d[0.0] > d[made_with] + 1.0, fit.describe()
+        assert not fit.on_bound() and fit.parameters == {"lead_mismatch": made_with}
 
 
 def test_a_load_pair_that_is_not_one_speed_and_two_loads_is_refused_by_name():
