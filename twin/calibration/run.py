@@ -67,6 +67,7 @@ Outputs in ``out_dir``:
 from __future__ import annotations
 
 import json
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -137,31 +138,21 @@ def _face_contact_record(scenario, mset, spec, rec, channel, source, measurement
     return other
 
 
-def _block(scenario, modes_from: str | None, pairing: str | None = None, foundation_from: str | None = None,
-           path_from: dict[str, str] | None = None, face_contact_from: str | None = None,
-           visibility: str | None = None) -> dict:
+def _block(scenario, overrides: Mapping[str, object] | None = None) -> dict:
+    """The scenario's calibration block with ``overrides`` (block key -> value; None leaves the key
+    as the block has it) in place, checked against the schema (:class:`ScenarioError` naming each
+    bad key)."""
     import jsonschema
 
+    overrides = {k: v for k, v in (overrides or {}).items() if v is not None}
     spec = scenario.raw.get("calibration")
     if spec is None:
-        if modes_from is None:
+        if "modes_from" not in overrides:
             raise ScenarioError([(str(scenario.source), "calibration", "the scenario has no calibration block "
                                   "(add one, or give --modes-from RECORD to calibrate the parameters chosen "
                                   "automatically to that record's modes)")])
         spec = {"parameters": "auto"}
-    spec = dict(spec)
-    if modes_from is not None:
-        spec["modes_from"] = modes_from
-    if pairing is not None:
-        spec["pairing"] = pairing
-    if visibility is not None:
-        spec["visibility"] = visibility
-    if foundation_from is not None:
-        spec["foundation_modes"] = foundation_from
-    if path_from is not None:
-        spec["path_from"] = dict(path_from)
-    if face_contact_from is not None:
-        spec["face_contact_from"] = face_contact_from
+    spec = {**spec, **{k: dict(v) if isinstance(v, Mapping) else v for k, v in overrides.items()}}
     errors = [(str(scenario.source), "calibration." + ".".join(map(str, e.absolute_path)),
                "must be 'auto' or a mapping of parameter name to [lower, upper]"
                if e.validator == "oneOf" else e.message)
@@ -201,7 +192,9 @@ def run_calibration(scenario, measurements: str | Path | None, out_dir: str | Pa
     if measurements is None and scenario.raw.get("calibration") is None:
         raise ScenarioError([(source, "calibration", "the scenario has no calibration block: without --measurements "
                               "it must type the measured natural_frequencies [Hz]")])
-    spec = _block(scenario, modes_from, pairing, foundation_from, path_from, face_contact_from, visibility)
+    spec = _block(scenario, {"modes_from": modes_from, "pairing": pairing, "visibility": visibility,
+                             "foundation_modes": foundation_from, "path_from": path_from,
+                             "face_contact_from": face_contact_from})
     pairing = spec.get("pairing", "frequency")
     visibility = spec.get("visibility", "mesh")
     fit = spec.get("fit", "follow")

@@ -235,7 +235,8 @@ class Sensitivity:
         total = paired + len(self.unmatched_hz)
         rule = ("visible twin mode within 15 %" if self.pairing_rule == "frequency"
                 else "twin mode that reaches them within the bounds")
-        where = f"; {len(self.unmatched_hz) - len(left)} went to the sensor path" if len(left) < len(self.unmatched_hz) else ""
+        to_path = len(self.unmatched_hz) - len(left)
+        where = f"; {to_path} went to the sensor path" if to_path else ""
         return (f"only {paired} of {total} measured modes paired with a twin mode{where}; {len(left)} have no "
                 f"{rule} ({', '.join(f'{f:.0f}' for f in left)} Hz): the calibration fitted the twin to the "
                 f"paired ones alone, so its structure (or `calibration.visibility`: {self.visibility}"

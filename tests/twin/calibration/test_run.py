@@ -162,8 +162,8 @@ def test_lscf_in_the_block_fits_the_hammer_records_together(gearbox_fmu, tmp_pat
 def test_foundation_from_overrides_the_block(gearbox_fmu):
     from twin.calibration.run import _block
 
-    assert _block(_scenario(gearbox_fmu), None, None, "impact")["foundation_modes"] == "impact"
-    assert _block(_scenario(gearbox_fmu), None)["foundation_modes"] == [13.0]
+    assert _block(_scenario(gearbox_fmu), {"foundation_modes": "impact"})["foundation_modes"] == "impact"
+    assert _block(_scenario(gearbox_fmu))["foundation_modes"] == [13.0]
 
 
 def test_modes_read_from_several_records_together(tmp_path):
@@ -206,9 +206,9 @@ def test_modes_from_on_the_command_line_takes_several_records(capsys):
 def test_a_bad_list_of_modes_records_is_refused_by_the_schema(gearbox_fmu, bad):
     from twin.calibration.run import _block
 
-    assert _block(_scenario(gearbox_fmu, modes_from=["runup", "hammer_a"]), None)["modes_from"] == ["runup", "hammer_a"]
+    assert _block(_scenario(gearbox_fmu, modes_from=["runup", "hammer_a"]))["modes_from"] == ["runup", "hammer_a"]
     with pytest.raises(ScenarioError, match="calibration.modes_from"):
-        _block(_scenario(gearbox_fmu, modes_from=bad), None)
+        _block(_scenario(gearbox_fmu, modes_from=bad))
 
 
 def test_struck_shafts_give_each_measured_mode_its_shaft(hammer_factory, gearbox_fmu, tmp_path):

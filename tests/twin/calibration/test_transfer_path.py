@@ -271,10 +271,10 @@ def test_path_from_on_the_command_line(capsys, shafts_fmu):
     assert main(["calibrate", "s.yaml", "--path-from", "hammer_a"]) == 2
     assert "expected RECORD=FORCE" in capsys.readouterr().err
     scenario = _path_scenario(str(shafts_fmu))
-    assert _block(scenario, None, path_from={"h": "bearing_force_output_x"})["path_from"] == {"h": "bearing_force_output_x"}
+    assert _block(scenario, {"path_from": {"h": "bearing_force_output_x"}})["path_from"] == {"h": "bearing_force_output_x"}
     from twin.errors import ScenarioError
     with pytest.raises(ScenarioError, match="bearing_force_sideways"):
-        _block(scenario, None, path_from={"h": "bearing_force_sideways"})
+        _block(scenario, {"path_from": {"h": "bearing_force_sideways"}})
 
 
 def test_a_record_without_blows_or_coherence_is_named():
