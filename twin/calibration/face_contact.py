@@ -19,6 +19,12 @@ the distance is the RMS. A flat ratio says little about D: the smallest D whose 
 with load keeps an aligned pair.  Bounds: 0 to 45 um, two to four times the 10-20 um of helix
 deviation and misalignment an ISO 1328-1 grade 7-8 pair of this face width has; a fit at the bound
 is reported as a warning.
+
+The note also reports where the ratio rises and falls most (:func:`load_lobes`), for the records and
+for the twin at the fitted D: a mode that moves down as the load falls (the mesh-controlled mode of
+a mesh that softens at light load) reads as a rise near its frequency at the heavier load and a fall
+near its frequency at the lighter one, so the user sees whether the twin's moving mode sits where the
+rig's does.  Nothing is fitted on it.
 """
 from __future__ import annotations
 
@@ -39,6 +45,37 @@ FMIN, FMAX = 1000.0, 8000.0
 SMOOTH_HZ = 380.0
 #: Welch segment [s].
 SEGMENT_S = 0.08
+#: Narrower smoothing for the ratio's lobes (a mode that moves with load) [Hz], and their band's start.
+LOBE_SMOOTH_HZ, LOBE_FMIN = 150.0, 1500.0
+
+
+@dataclass(frozen=True)
+class LoadLobes:
+    """Where the ratio of a load pair's spectra (heavier load over lighter, dB, median removed)
+    rises and falls most in :data:`LOBE_FMIN`-:data:`FMAX`: a mode that moves down as the load falls (the
+    mesh-controlled mode of a mesh that softens at light load) shows as a rise near its frequency
+    at the heavier load and a fall near its frequency at the lighter one, each read a little
+    outward of the mode (the extremes of a ratio of two overlapping humps). ``rise_hz``,
+    ``fall_hz`` [Hz]; ``rise_db``, ``fall_db`` [dB]."""
+    rise_hz: float
+    rise_db: float
+    fall_hz: float
+    fall_db: float
+
+    def describe(self) -> str:
+        return f"{self.rise_db:+.1f} dB at {self.rise_hz:.0f} Hz, {self.fall_db:+.1f} dB at {self.fall_hz:.0f} Hz"
+
+
+def load_lobes(heavy, light, fs: float) -> LoadLobes:
+    """The :class:`LoadLobes` of two records (n,) of one channel sampled at ``fs`` [Hz], ``heavy``
+    at the heavier load, from :data:`LOBE_FMIN` to the fit's band top (:data:`FMAX`, at most 0.4 ``fs``)."""
+    f, a = smoothed_db(heavy, fs, LOBE_SMOOTH_HZ)
+    _, b = smoothed_db(light, fs, LOBE_SMOOTH_HZ)
+    band = (f >= LOBE_FMIN) & (f <= min(FMAX, 0.4 * fs))
+    r, fb = (a - b)[band], f[band]
+    r = r - np.median(r)
+    i, j = int(np.argmax(r)), int(np.argmin(r))
+    return LoadLobes(float(fb[i]), float(r[i]), float(fb[j]), float(r[j]))
 
 
 @dataclass(frozen=True)
@@ -50,6 +87,8 @@ class FaceContactFit:
     distances_db: tuple[float, ...]
     loads: tuple[float, float]
     speed_hz: float
+    lobes_measured: LoadLobes | None = None
+    lobes_model: LoadLobes | None = None
 
     @property
     def parameters(self) -> dict[str, float]:
@@ -61,9 +100,12 @@ class FaceContactFit:
     def describe(self) -> str:
         best = float(min(self.distances_db))
         at0 = self.distances_db[self.grid.index(0.0)] if 0.0 in self.grid else float("nan")
+        lobes = (f"; the records' ratio {self.lobes_measured.describe()} (a mode moving down with load "
+                 f"reads as such a pair), the fitted twin's {self.lobes_model.describe()}"
+                 if self.lobes_measured is not None and self.lobes_model is not None else "")
         return (f"lead mismatch {1e6 * self.lead_mismatch:g} um from the spectra at {self.loads[0]:g} and "
                 f"{self.loads[1]:g} N.m ({self.speed_hz:g} Hz): their ratio {at0:.2f} dB from the aligned "
-                f"pair's, {best:.2f} dB at best")
+                f"pair's, {best:.2f} dB at best{lobes}")
 
 
 def load_pair_problem(steady, other) -> str | None:
@@ -79,14 +121,14 @@ def load_pair_problem(steady, other) -> str | None:
     return None
 
 
-def smoothed_db(x: np.ndarray, fs: float) -> tuple[np.ndarray, np.ndarray]:
+def smoothed_db(x: np.ndarray, fs: float, smooth_hz: float = SMOOTH_HZ) -> tuple[np.ndarray, np.ndarray]:
     """Frequencies [Hz] (n,) and the Welch PSD of ``x`` in dB with a running median over
-    :data:`SMOOTH_HZ` (n,)."""
+    ``smooth_hz`` [Hz] (n,)."""
     from scipy.ndimage import median_filter
     from scipy.signal import welch
     nper = int(2 ** round(np.log2(SEGMENT_S * fs)))
     f, p = welch(np.asarray(x, float), fs, nperseg=nper, noverlap=nper // 2)
-    size = max(3, int(round(SMOOTH_HZ / (f[1] - f[0]))) | 1)
+    size = max(3, int(round(smooth_hz / (f[1] - f[0]))) | 1)
     return f, median_filter(10.0 * np.log10(np.maximum(p, 1e-300)), size=size, mode="nearest")
 
 
@@ -161,4 +203,9 @@ def fit_face_contact(fmu_path, parameters: Mapping[str, float], records, channel
         _, sa = smoothed_db(runs[2 * i], fs)
         _, sb = smoothed_db(runs[2 * i + 1], fs)
         dist.append(ratio_distance(measured, (sa - sb)[band]))
-    return FaceContactFit(choose(dist, grid), tuple(grid), tuple(dist), (float(la), float(lb)), float(speed_hz))
+    d = choose(dist, grid)
+    k = 2 * list(grid).index(d)
+    # heavier load first: a mode that moves down with load rises where it sits at the heavier one
+    heavy_first = (lambda a, b: (a, b)) if abs(la) >= abs(lb) else (lambda a, b: (b, a))
+    return FaceContactFit(d, tuple(grid), tuple(dist), (float(la), float(lb)), float(speed_hz),
+                          load_lobes(*heavy_first(xa, xb), fs), load_lobes(*heavy_first(runs[k], runs[k + 1]), fs))
