@@ -206,6 +206,6 @@ def fit_face_contact(fmu_path, parameters: Mapping[str, float], records, channel
     d = choose(dist, grid)
     k = 2 * list(grid).index(d)
     # heavier load first: a mode that moves down with load rises where it sits at the heavier one
-    heavy_first = (lambda a, b: (a, b)) if abs(la) >= abs(lb) else (lambda a, b: (b, a))
-    return FaceContactFit(d, tuple(grid), tuple(dist), (float(la), float(lb)), float(speed_hz),
-                          load_lobes(*heavy_first(xa, xb), fs), load_lobes(*heavy_first(runs[k], runs[k + 1]), fs))
+    order = (0, 1) if abs(la) >= abs(lb) else (1, 0)
+    lobes = [load_lobes(*(pair[i] for i in order), fs) for pair in ((xa, xb), (runs[k], runs[k + 1]))]
+    return FaceContactFit(d, tuple(grid), tuple(dist), (float(la), float(lb)), float(speed_hz), *lobes)

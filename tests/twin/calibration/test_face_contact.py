@@ -76,6 +76,15 @@ def test_the_fit_finds_the_lead_mismatch_the_records_were_made_with(measured_fmu
         assert not fit.on_bound() and fit.parameters == {"lead_mismatch": made_with}
 
 
+def test_the_lobes_read_the_heavier_load_first_whichever_record_is_the_steady_one(measured_fmu):
+    from twin.calibration.face_contact import load_lobes
+
+    (heavy, lh), (light, ll) = _pair(measured_fmu, 15e-6)
+    fit = fit_face_contact(measured_fmu, {}, [(light, ll), (heavy, lh)], CH, FS, 20.0, duration=1.0, grid=(0.0,))
+    assert fit.lobes_measured == load_lobes(heavy, light, FS)
+    assert fit.lobes_measured.rise_hz > fit.lobes_measured.fall_hz      # the twin's mesh mode moves down
+
+
 def test_a_load_pair_that_is_not_one_speed_and_two_loads_is_refused_by_name():
     from twin.calibration.run import _face_contact_record
     from twin.errors import ScenarioError
