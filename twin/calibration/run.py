@@ -138,21 +138,27 @@ def _face_contact_record(scenario, mset, spec, rec, channel, source, measurement
     return other
 
 
+def _overridden(spec: Mapping | None, overrides: Mapping[str, object] | None) -> dict:
+    """A copy of a calibration block (None: empty) with ``overrides`` (block key -> value) in place;
+    an override of None leaves the key as the block has it."""
+    given = {k: dict(v) if isinstance(v, Mapping) else v for k, v in (overrides or {}).items() if v is not None}
+    return {**(spec or {}), **given}
+
+
 def _block(scenario, overrides: Mapping[str, object] | None = None) -> dict:
     """The scenario's calibration block with ``overrides`` (block key -> value; None leaves the key
     as the block has it) in place, checked against the schema (:class:`ScenarioError` naming each
     bad key)."""
     import jsonschema
 
-    overrides = {k: v for k, v in (overrides or {}).items() if v is not None}
     spec = scenario.raw.get("calibration")
     if spec is None:
-        if "modes_from" not in overrides:
+        if (overrides or {}).get("modes_from") is None:
             raise ScenarioError([(str(scenario.source), "calibration", "the scenario has no calibration block "
                                   "(add one, or give --modes-from RECORD to calibrate the parameters chosen "
                                   "automatically to that record's modes)")])
         spec = {"parameters": "auto"}
-    spec = {**spec, **{k: dict(v) if isinstance(v, Mapping) else v for k, v in overrides.items()}}
+    spec = _overridden(spec, overrides)
     errors = [(str(scenario.source), "calibration." + ".".join(map(str, e.absolute_path)),
                "must be 'auto' or a mapping of parameter name to [lower, upper]"
                if e.validator == "oneOf" else e.message)
@@ -461,11 +467,10 @@ def scenario_sensitivity(scenario, measurements: str | Path | None = None, *, mo
     from twin.calibration.sensitivity import mode_sensitivity
     from twin.measurements import load_measurements
 
-    spec = dict(scenario.raw.get("calibration") or {})
-    if modes_from is not None:
-        spec["modes_from"] = modes_from
-    pairing = pairing or spec.get("pairing", "frequency")
-    visibility = check_visibility(visibility or spec.get("visibility", "mesh"))
+    spec = _overridden(scenario.raw.get("calibration"),
+                       {"modes_from": modes_from, "pairing": pairing, "visibility": visibility})
+    pairing = spec.get("pairing", "frequency")
+    visibility = check_visibility(spec.get("visibility", "mesh"))
     speed = scenario.inputs.get("motor_speed_ref")
     load = scenario.inputs.get("load_torque")
     speed_hz = speed(scenario.start_time) / (2 * np.pi) if speed is not None else 20.0
